@@ -1,0 +1,31 @@
+# `make test` and `make demo` each build .venv on first use and install what they need.
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.installed
+
+.PHONY: test demo lint bench clean
+
+$(STAMP): pyproject.toml constraints.txt
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	# torch first, from the pin, so nothing later resolves a CUDA build
+	$(PY) -m pip install --quiet -c constraints.txt torch==2.13.0
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[render,train,dev]"
+	touch $(STAMP)
+
+test: $(STAMP)
+	$(PY) -m ruff check bearing_env agents train tests benchmarks
+	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m "not slow"
+
+demo: $(STAMP)
+	SDL_VIDEODRIVER=dummy $(PY) -m train.demo
+
+bench: $(STAMP)
+	$(PY) benchmarks/bench_slam.py
+
+lint: $(STAMP)
+	$(PY) -m ruff check bearing_env agents train tests benchmarks
+
+clean:
+	rm -rf $(VENV) .pytest_cache .hypothesis build *.egg-info

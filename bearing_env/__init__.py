@@ -1,0 +1,19 @@
+"""bearing_env: active exploration in bearing-only polygon SLAM.
+
+The world model (:mod:`bearing_env.slam`) is pure numpy and imports neither gymnasium
+nor pygame. Importing this package registers the Gymnasium ids ``BearingSLAM-v0`` and
+``BearingSLAMDiscrete-v0`` when gymnasium is installed.
+"""
+
+__version__ = "0.1.0"
+
+try:
+    import gymnasium  # noqa: F401
+except ImportError:  # the world model alone (e.g. on logged robot data) needs no gymnasium
+    pass
+else:
+    from bearing_env.registration import register_envs
+
+    register_envs()
+
+__all__ = ["__version__"]

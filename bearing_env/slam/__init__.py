@@ -1,0 +1,52 @@
+"""The world model: the paper's bearing-only polygon SLAM, as a pure numpy library.
+
+This package imports neither gymnasium nor pygame: it runs on bearings logged by a real
+robot as well as on the simulator's.
+
+Public API:
+
+* :class:`PolygonSLAM` and :class:`UpdateResult`: the map, fused over movements.
+* :func:`fr_region`: the FR region of one landmark from a bearing pair.
+* :func:`transfer_polygon` / :func:`transfer_point`: the FR -> FL transfer of a region
+  or a point, as shapely geometry (one movement, for inspection and tests).
+* :func:`world_to_fl` / :func:`fl_to_world`: frame conversions given L1 and L2.
+* :mod:`bearing_env.slam.geometry`: the batched kernels underneath.
+"""
+
+from bearing_env.slam.api import fr_region, transfer_point, transfer_polygon
+from bearing_env.slam.polygon_slam import (
+    FRAME_L1_L2_OVERLAP,
+    FRAME_L1_UNBOUNDED,
+    FRAME_L2_UNBOUNDED,
+    FRAME_OK,
+    INCONSISTENCY_POLICIES,
+    LANDMARK_INCONSISTENT,
+    LANDMARK_SKIPPED,
+    LANDMARK_UNBOUNDED,
+    LANDMARK_UPDATED,
+    PolygonSLAM,
+    UpdateResult,
+    fl_to_world,
+    world_to_fl,
+)
+from bearing_env.slam.transfer import TRANSFERS
+
+__all__ = [
+    "FRAME_L1_L2_OVERLAP",
+    "FRAME_L1_UNBOUNDED",
+    "FRAME_L2_UNBOUNDED",
+    "FRAME_OK",
+    "INCONSISTENCY_POLICIES",
+    "LANDMARK_INCONSISTENT",
+    "LANDMARK_SKIPPED",
+    "LANDMARK_UNBOUNDED",
+    "LANDMARK_UPDATED",
+    "TRANSFERS",
+    "PolygonSLAM",
+    "UpdateResult",
+    "fl_to_world",
+    "fr_region",
+    "transfer_point",
+    "transfer_polygon",
+    "world_to_fl",
+]

@@ -1,0 +1,76 @@
+"""One-movement functions returning shapely geometry: for inspection, plots and tests.
+
+The map (:class:`~bearing_env.slam.PolygonSLAM`) uses the batched kernels directly;
+these wrappers give the exact polygons of a single movement.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from numpy.typing import ArrayLike
+
+from bearing_env.slam.geometry import FR_BOUNDED, cone_intersections
+from bearing_env.slam.transfer import transfer_points_fl
+
+
+def fr_region(bearing_start: float, bearing_end: float, epsilon: float) -> shapely.Polygon | None:
+    """Region of one landmark in FR (R1 = (0, 0), R2 = (1, 0)); None if unbounded or empty."""
+    verts, status = cone_intersections(
+        np.array([bearing_start], float), np.array([bearing_end], float), float(epsilon)
+    )
+    if status[0] != FR_BOUNDED:
+        return None
+    return _polygon(verts[0])
+
+
+def transfer_polygon(
+    region_fr: shapely.Polygon | ArrayLike,
+    l1_fr: shapely.Polygon | ArrayLike,
+    l2_fr: shapely.Polygon | ArrayLike,
+    transfer: str = "conservative",
+    edge_samples: int = 3,
+) -> shapely.Polygon | None:
+    """The FL region of an FR region given the FR regions of L1 and L2.
+
+    ``"paper"`` returns exactly the convex hull of the vertex-hypothesis images;
+    ``"conservative"`` returns the sampled hull grown (mitred, so never inside the true
+    offset) by the bound of :mod:`bearing_env.slam.transfer`. None when L1 and L2 overlap.
+    """
+    out = transfer_points_fl(
+        _vertices(region_fr), _vertices(l1_fr), _vertices(l2_fr), transfer, edge_samples
+    )
+    if out is None:
+        return None
+    cloud, radius = out
+    hull = shapely.convex_hull(shapely.multipoints(np.stack([cloud.real, cloud.imag], -1)))
+    if radius > 0:
+        hull = shapely.buffer(hull, radius, join_style="mitre", mitre_limit=1e6)
+    return hull
+
+
+def transfer_point(
+    point_fr: ArrayLike,
+    l1_fr: shapely.Polygon | ArrayLike,
+    l2_fr: shapely.Polygon | ArrayLike,
+    transfer: str = "conservative",
+    edge_samples: int = 3,
+) -> shapely.Polygon | None:
+    """The FL region of an FR point (e.g. R1 = (0, 0) or R2 = (1, 0))."""
+    p = np.asarray(point_fr, dtype=float).reshape(1, 2)
+    return transfer_polygon(p, l1_fr, l2_fr, transfer, edge_samples)
+
+
+def _vertices(region: shapely.Polygon | ArrayLike) -> np.ndarray:
+    if isinstance(region, shapely.Polygon):
+        xy = np.asarray(region.exterior.coords)[:-1]
+        if shapely.is_ccw(region.exterior) is False:
+            xy = xy[::-1]
+    else:
+        xy = np.asarray(region, dtype=float).reshape(-1, 2)
+    return xy[:, 0] + 1j * xy[:, 1]
+
+
+def _polygon(verts: np.ndarray) -> shapely.Polygon:
+    xy = np.stack([verts.real, verts.imag], -1)
+    return shapely.convex_hull(shapely.multipoints(xy))

@@ -1,0 +1,281 @@
+"""Batched convex geometry in pure numpy: bearing cones and fixed-normal convex polygons.
+
+Points are complex numbers (x + iy). Every function works on arrays with arbitrary
+leading batch dimensions, so one call handles all landmarks of a movement (and, later,
+many environments).
+
+Two polygon representations are used:
+
+* **vertex arrays**: complex ``(..., V)`` arrays in counter-clockwise order, padded by
+  repeating a vertex (zero-length edges are harmless everywhere below). Used for the
+  small regions in the robot frame FR.
+* **support K-gons**: the map's regions in the landmark frame FL are stored as the
+  support values ``h`` of a convex set in ``K`` fixed, evenly spaced outward normals
+  ``u_k = exp(2i pi k / K)``. The K-gon ``{x : <u_k, x> <= h_k}`` *contains* the set
+  (it is circumscribed), intersection of two K-gons is exact, and all arrays have a
+  fixed size. A K-gon is *tight* when every ``h_k`` is attained (each line touches the
+  polygon); the functions below take and return tight K-gons.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+ComplexArray = NDArray[np.complex128]
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+#: FR-region vertices farther than this (in FR units, |R1 R2| = 1) mean near-parallel
+#: cones: the region is numerically unbounded and carries no usable information.
+MAX_FR_EXTENT = 1e4
+
+
+def wrap_angle(angle: NDArray[np.float64] | float) -> NDArray[np.float64]:
+    """Wrap angles to [-pi, pi)."""
+    return (np.asarray(angle, dtype=np.float64) + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def cross(a: ComplexArray, b: ComplexArray) -> FloatArray:
+    """2-D cross product ``a.x * b.y - a.y * b.x`` of complex points."""
+    return (np.conj(a) * b).imag
+
+
+def dot(a: ComplexArray, b: ComplexArray) -> FloatArray:
+    """2-D dot product of complex points."""
+    return (np.conj(a) * b).real
+
+
+# --------------------------------------------------------------------------------------
+# Cones in the robot frame FR (R1 = 0, R2 = 1)
+# --------------------------------------------------------------------------------------
+
+FR_BOUNDED = 0
+FR_UNBOUNDED = 1
+FR_EMPTY = 2
+
+
+def cone_intersections(
+    bearings_start: FloatArray, bearings_end: FloatArray, epsilon: float
+) -> tuple[ComplexArray, NDArray[np.int8]]:
+    """Regions ``A_Li`` in FR: the cone at R1 = 0 intersected with the cone at R2 = 1.
+
+    Args:
+        bearings_start: bearings at R1, radians counter-clockwise from the motion.
+        bearings_end: bearings at R2, same shape.
+        epsilon: half-width of each cone (radians, 0 < epsilon < pi/2).
+
+    Returns:
+        ``(vertices, status)``: ``vertices`` is complex ``(..., 4)`` in counter-clockwise
+        order (padded by repetition; ``nan`` where not bounded) and ``status`` is
+        :data:`FR_BOUNDED`, :data:`FR_UNBOUNDED` (the cones' direction ranges overlap,
+        or the region is numerically unbounded) or :data:`FR_EMPTY` (the cones miss each
+        other: the bearings are inconsistent with epsilon).
+    """
+    a = np.asarray(bearings_start, dtype=np.float64)
+    b = np.asarray(bearings_end, dtype=np.float64)
+    shape = a.shape
+    a, b = a.reshape(-1), b.reshape(-1)
+    n = a.size
+    half = np.exp(1j * np.array([-epsilon, epsilon]))
+    # Rays of the two cones: R1 + t * r (t >= 0) and R2 + s * q (s >= 0).
+    r = np.exp(1j * a)[:, None] * half  # (n, 2)
+    q = np.exp(1j * b)[:, None] * half
+    rr = r[:, :, None]
+    qq = q[:, None, :]
+    denom = (np.conj(rr) * qq).imag  # cross(r, q): (n, 2, 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # P + t r = Q + s q with P = 0, Q = 1: t = cross(Q - P, q) / cross(r, q).
+        t = qq.imag / denom
+        s = rr.imag / denom
+    cand = np.empty((n, 6), dtype=complex)
+    ok = np.empty((n, 6), dtype=bool)
+    ok[:, :4] = ((np.abs(denom) > 1e-12) & (t >= 0.0) & (s >= 0.0)).reshape(n, 4)
+    cand[:, :4] = (t * rr).reshape(n, 4)
+    # An apex is a vertex of the intersection when it lies inside the other cone.
+    cand[:, 4] = 0.0
+    cand[:, 5] = 1.0
+    ok[:, 4] = np.abs(wrap_angle(np.pi - b)) <= epsilon
+    ok[:, 5] = np.abs(wrap_angle(-a)) <= epsilon
+    cand[~ok] = 0.0
+    n_ok = ok.sum(axis=-1)
+
+    unbounded = (np.abs(wrap_angle(b - a)) <= 2.0 * epsilon) | np.any(
+        np.abs(cand) > MAX_FR_EXTENT, axis=-1
+    )
+    empty = ~unbounded & (n_ok == 0)
+
+    # A bounded intersection of four half-planes has at most 4 distinct vertices. Sort
+    # the candidates counter-clockwise around their mean (equal points end up adjacent),
+    # drop repeats, move the valid ones first and pad with the first vertex.
+    centre = cand.sum(axis=-1) / np.maximum(n_ok, 1)
+    angle = np.where(ok, np.angle(cand - centre[:, None]), np.inf)
+    rows = np.arange(n)[:, None]
+    order = np.argsort(angle, axis=-1)
+    cand, ok = cand[rows, order], ok[rows, order]
+    scale = 1e-12 * (1.0 + np.abs(cand).max(axis=-1, keepdims=True))
+    ok[:, 1:] &= ~(ok[:, :-1] & (np.abs(cand[:, 1:] - cand[:, :-1]) <= scale))
+    order = np.argsort(~ok, axis=-1, kind="stable")
+    cand, ok = cand[rows, order], ok[rows, order]
+    verts = np.where(ok[:, :4], cand[:, :4], cand[:, :1])
+
+    status = np.full(n, FR_BOUNDED, dtype=np.int8)
+    status[unbounded] = FR_UNBOUNDED
+    status[empty] = FR_EMPTY
+    verts[status != FR_BOUNDED] = np.nan
+    return verts.reshape(*shape, 4), status.reshape(shape)
+
+
+# --------------------------------------------------------------------------------------
+# Convex polygons as vertex arrays
+# --------------------------------------------------------------------------------------
+
+
+def polygon_distance(p: ComplexArray, q: ComplexArray) -> float:
+    """Distance between two convex polygons (vertex arrays, CCW); 0 when they touch.
+
+    Overlap is decided by the separating-axis test over both polygons' edge normals; the
+    distance of disjoint polygons is the smallest vertex-to-edge distance either way.
+    """
+    polys = np.stack([p, q])  # (2, V)
+    others = polys[::-1]
+    edges = np.roll(polys, -1, axis=-1) - polys
+    # Separating axes: outward edge normals of both polygons (CCW order).
+    normals = (-1j * edges).reshape(-1)
+    proj = (np.conj(normals)[:, None, None] * polys[None]).real  # (2V, 2, V)
+    gap = np.maximum(
+        proj[:, 1].min(axis=-1) - proj[:, 0].max(axis=-1),
+        proj[:, 0].min(axis=-1) - proj[:, 1].max(axis=-1),
+    )
+    if not np.any((np.abs(normals) > 0) & (gap > 0)):
+        return 0.0
+    # Vertices of each polygon against the edges of the other.
+    w = polys[:, :, None] - others[:, None, :]  # (2, V points, V edges)
+    d = np.roll(others, -1, axis=-1) - others
+    len2 = (np.abs(d) ** 2)[:, None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.clip(np.where(len2 > 0, (np.conj(d)[:, None, :] * w).real / len2, 0.0), 0, 1)
+    return float(np.abs(w - t * d[:, None, :]).min())
+
+
+def polygons_overlap(p: ComplexArray, q: ComplexArray) -> bool:
+    """Whether two convex polygons (vertex arrays, CCW) touch or overlap."""
+    return polygon_distance(p, q) == 0.0
+
+
+def boundary_samples(poly: ComplexArray, per_edge: int) -> ComplexArray:
+    """``per_edge`` evenly spaced points on each edge (vertex included): (..., V*per_edge)."""
+    t = np.arange(per_edge) / per_edge
+    nxt = np.roll(poly, -1, axis=-1)
+    pts = poly[..., :, None] + t * (nxt - poly)[..., :, None]
+    return pts.reshape(*poly.shape[:-1], poly.shape[-1] * per_edge)
+
+
+def max_edge_length(poly: ComplexArray) -> FloatArray:
+    return np.abs(np.roll(poly, -1, axis=-1) - poly).max(axis=-1)
+
+
+# --------------------------------------------------------------------------------------
+# Support K-gons in the landmark frame FL
+# --------------------------------------------------------------------------------------
+
+
+class KGon:
+    """The fixed set of ``K`` outward normals and the operations on support K-gons."""
+
+    def __init__(self, directions: int) -> None:
+        if directions < 8 or directions % 2:
+            raise ValueError(f"directions must be an even integer >= 8, got {directions!r}")
+        self.k = directions
+        self.theta = 2.0 * np.pi * np.arange(directions) / directions
+        self.normals = np.exp(1j * self.theta)
+        self._step_sin = np.sin(2.0 * np.pi / directions)
+        # Real matrix for supports of point clouds: <u_k, p> = x cos + y sin.
+        self._proj = np.stack([self.normals.real, self.normals.imag])  # (2, K)
+        self._next = (np.arange(directions) + 1) % directions
+        self._prev = (np.arange(directions) - 1) % directions
+
+    # -- construction ------------------------------------------------------------------
+
+    def support_of_points(self, points: ComplexArray, axis: int = -1) -> FloatArray:
+        """Tight circumscribed K-gon of a point cloud: ``max_p <u_k, p>``; shape (..., K)."""
+        pts = np.moveaxis(points, axis, -1)
+        xy = np.stack([pts.real, pts.imag], axis=-1)  # (..., P, 2)
+        return (xy @ self._proj).max(axis=-2)
+
+    # -- geometry of a K-gon -----------------------------------------------------------
+
+    def vertices(self, h: FloatArray) -> ComplexArray:
+        """Vertex ``k`` is where the lines of normals ``k`` and ``k+1`` meet: (..., K)."""
+        u = self.normals
+        return (h * u[self._next] - h[..., self._next] * u) / (1j * self._step_sin)
+
+    def area_centroid(self, h: FloatArray) -> tuple[FloatArray, ComplexArray]:
+        """Area and centroid of tight K-gons (shoelace over the K vertices)."""
+        v = self.vertices(h)
+        w = v[..., self._next]
+        c = cross(v, w)
+        area2 = c.sum(axis=-1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            centroid = ((v + w) * c).sum(axis=-1) / (3.0 * area2)
+        # Degenerate (segment or point) regions: fall back to the vertex mean.
+        degenerate = ~(np.abs(area2) > 1e-300)
+        centroid = np.where(degenerate, v.mean(axis=-1), centroid)
+        return 0.5 * area2, centroid
+
+    def contains(self, h: FloatArray, points: ComplexArray, rtol: float = 1e-9) -> BoolArray:
+        """Whether each point (shape ``h.shape[:-1]``) lies in its K-gon (boundary counts)."""
+        proj = dot(self.normals, points[..., None])
+        scale = 1.0 + np.abs(h).max(axis=-1, initial=0.0, where=np.isfinite(h))[..., None]
+        return np.all(proj <= h + rtol * scale, axis=-1)
+
+    def intersect(self, hp: FloatArray, hc: FloatArray) -> tuple[FloatArray, BoolArray]:
+        """Exact intersection of two tight K-gons, returned tight.
+
+        ``min(hp, hc)`` already describes the intersection as a set, but is not tight
+        where the two boundaries cross. Each edge ``k`` of the intersection lies on the
+        line of whichever polygon is lower in direction ``k`` (its *owner*): it is the
+        owner's edge ``k`` clipped by the other polygon (Cyrus-Beck, all edges at once).
+        A direction whose edge vanishes gets the support of the corner that replaces it,
+        which is the end of the previous surviving edge.
+
+        Returns:
+            ``(h, empty)``: tight supports and a mask of empty intersections (where ``h``
+            is undefined).
+        """
+        u = self.normals
+        vp, vc = self.vertices(hp), self.vertices(hc)
+        owner_p = hp <= hc
+        h_own = np.where(owner_p, hp, hc)
+        # Edge k runs from vertex k-1 to vertex k of its owner.
+        start = np.where(owner_p, vp[..., self._prev], vc[..., self._prev])
+        end = np.where(owner_p, vp, vc)
+        seg = end - start
+        h_other = np.where(owner_p[..., :, None], hc[..., None, :], hp[..., None, :])  # (..., K, K)
+        denom = dot(u, seg[..., :, None])  # (..., K edges, K constraints)
+        numer = h_other - dot(u, start[..., :, None])
+        scale = 1.0 + np.abs(h_own).max(axis=-1)[..., None, None]
+        tiny = 1e-12 * (np.abs(seg)[..., :, None] + 1e-300)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = numer / denom
+        t_lo = np.maximum(0.0, np.where(denom < -tiny, ratio, -np.inf).max(axis=-1))
+        t_hi = np.minimum(1.0, np.where(denom > tiny, ratio, np.inf).min(axis=-1))
+        parallel_out = np.any((np.abs(denom) <= tiny) & (numer < -1e-9 * scale), axis=-1)
+        seg_len = np.abs(seg)
+        t_tol = 1e-9 * scale[..., 0] / np.maximum(seg_len, 1e-300)
+        survives = (t_lo <= t_hi + t_tol) & ~parallel_out
+        empty = ~survives.any(axis=-1)
+
+        corner = start + np.clip(t_hi, 0.0, 1.0) * seg  # end of each (clipped) edge
+        k = self.k
+        idx = np.arange(k)
+        # Index of the last surviving edge at or before k, cyclically: scan two laps, the
+        # first lap shifted by -K, with a filler below every real index.
+        filler = -(2 * k)
+        doubled = np.concatenate(
+            [np.where(survives, idx - k, filler), np.where(survives, idx, filler)], axis=-1
+        )
+        prev = np.maximum.accumulate(doubled, axis=-1)[..., k:] % k
+        corner_prev = np.take_along_axis(corner, prev, axis=-1)
+        h = np.where(survives, h_own, dot(u, corner_prev))
+        return h, empty

@@ -1,0 +1,97 @@
+"""Throughput of PolygonSLAM.update() against CartPole-v1 steps, measured in one run.
+
+Absolute times drift on shared machines, so every figure is also given as a ratio to
+Gymnasium's CartPole-v1 ``env.step`` rate measured in the same process.
+
+    python benchmarks/bench_slam.py [--seconds 2] [--json out.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import gymnasium as gym
+import numpy as np
+
+from bearing_env.slam import PolygonSLAM
+
+
+def cartpole_steps_per_second(seconds: float) -> float:
+    env = gym.make("CartPole-v1")
+    env.reset(seed=0)
+    steps, action = 0, 0
+    start = time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        for _ in range(500):
+            _, _, terminated, truncated, _ = env.step(action)
+            action ^= 1
+            if terminated or truncated:
+                env.reset()
+        steps += 500
+    return steps / (time.perf_counter() - start)
+
+
+def make_readings(n_landmarks: int, n_moves: int, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Noisy bearing pairs of a random polygonal walk in a 100 x 100 arena."""
+    rng = np.random.default_rng(seed)
+    eps = np.deg2rad(2.0)
+    landmarks = rng.uniform(0, 100, n_landmarks) + 1j * rng.uniform(0, 100, n_landmarks)
+    landmarks[1] = landmarks[0] + 20.0
+    pos = 50.0 + 50.0j
+    readings = []
+    for _ in range(n_moves):
+        heading = np.exp(1j * rng.uniform(-np.pi, np.pi))
+        nxt = pos + 25.0 * heading
+        if not (0 < nxt.real < 100 and 0 < nxt.imag < 100):
+            nxt, heading = pos - 25.0 * heading, -heading
+            if not (0 < nxt.real < 100 and 0 < nxt.imag < 100):
+                nxt = pos + 0.5 * (50 + 50j - pos)
+                heading = (nxt - pos) / abs(nxt - pos)
+        b1 = np.angle((landmarks - pos) / heading) + rng.uniform(-eps, eps, n_landmarks)
+        b2 = np.angle((landmarks - nxt) / heading) + rng.uniform(-eps, eps, n_landmarks)
+        readings.append((b1, b2))
+        pos = nxt
+    return readings
+
+
+def updates_per_second(n_landmarks: int, transfer: str, seconds: float) -> float:
+    readings = make_readings(n_landmarks, 20, seed=n_landmarks)
+    slam = PolygonSLAM(n_landmarks, np.deg2rad(2.0), transfer=transfer)
+    count = 0
+    start = time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        slam.reset()
+        for b1, b2 in readings:
+            slam.update(b1, b2)
+        count += len(readings)
+    return count / (time.perf_counter() - start)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=2.0, help="time per measurement")
+    parser.add_argument("--json", type=str, default=None, help="also write results here")
+    args = parser.parse_args()
+
+    cartpole = cartpole_steps_per_second(args.seconds)
+    print(f"CartPole-v1 env.step: {cartpole:10.0f} steps/s (reference, same run)")
+    results: dict[str, float] = {"cartpole_steps_per_s": cartpole}
+    for transfer in ("conservative", "paper"):
+        base = None
+        for n in (4, 16, 64):
+            rate = updates_per_second(n, transfer, args.seconds)
+            base = base or rate
+            results[f"{transfer}_{n}_updates_per_s"] = rate
+            print(
+                f"update() {transfer:>12} {n:3d} landmarks: {rate:8.0f} /s"
+                f"  = {rate / cartpole:6.1%} of CartPole   {rate / base:5.2f} x the 4-landmark rate"
+            )
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(results, fh, indent=2)
+
+
+if __name__ == "__main__":
+    main()
