@@ -76,39 +76,69 @@ def cone_intersections(
     b = np.asarray(bearings_end, dtype=np.float64)
     shape = a.shape
     a, b = a.reshape(-1), b.reshape(-1)
-    n = a.size
+    # Rays of the two cones: R1 + t * r (t >= 0) and R2 + s * q (s >= 0), each pair
+    # ordered (-epsilon, +epsilon).
     half = np.exp(1j * np.array([-epsilon, epsilon]))
-    # Rays of the two cones: R1 + t * r (t >= 0) and R2 + s * q (s >= 0).
-    r = np.exp(1j * a)[:, None] * half  # (n, 2)
+    r = np.exp(1j * a)[:, None] * half
     q = np.exp(1j * b)[:, None] * half
-    rr = r[:, :, None]
-    qq = q[:, None, :]
-    denom = (np.conj(rr) * qq).imag  # cross(r, q): (n, 2, 2)
+    # Ray-ray intersections in the cyclic order (r-, q-), (r-, q+), (r+, q+), (r+, q-):
+    # walking the quadrilateral's boundary along r-, q+, r+ and q- in turn.
+    rr = r[:, [0, 0, 1, 1]]
+    qq = q[:, [0, 1, 1, 0]]
+    denom = (np.conj(rr) * qq).imag  # cross(r, q)
     with np.errstate(divide="ignore", invalid="ignore"):
         # P + t r = Q + s q with P = 0, Q = 1: t = cross(Q - P, q) / cross(r, q).
         t = qq.imag / denom
         s = rr.imag / denom
-    cand = np.empty((n, 6), dtype=complex)
-    ok = np.empty((n, 6), dtype=bool)
-    ok[:, :4] = ((np.abs(denom) > 1e-12) & (t >= 0.0) & (s >= 0.0)).reshape(n, 4)
-    cand[:, :4] = (t * rr).reshape(n, 4)
+    ray_ok = (np.abs(denom) > 1e-12) & (t >= 0.0) & (s >= 0.0)
+    quad = t * rr
     # An apex is a vertex of the intersection when it lies inside the other cone.
-    cand[:, 4] = 0.0
-    cand[:, 5] = 1.0
-    ok[:, 4] = np.abs(wrap_angle(np.pi - b)) <= epsilon
-    ok[:, 5] = np.abs(wrap_angle(-a)) <= epsilon
+    r1_in_cone2 = np.abs(wrap_angle(np.pi - b)) <= epsilon
+    r2_in_cone1 = np.abs(wrap_angle(-a)) <= epsilon
+    n_rays = ray_ok.sum(axis=-1)
+
+    unbounded = np.abs(wrap_angle(b - a)) <= 2.0 * epsilon
+    with np.errstate(invalid="ignore"):
+        unbounded |= np.any(ray_ok & (np.abs(quad) > MAX_FR_EXTENT), axis=-1)
+    simple = ~(r1_in_cone2 | r2_in_cone1)
+    empty = ~unbounded & simple & (n_rays == 0)
+
+    # Without an apex inside the other cone, a bounded non-empty intersection is exactly
+    # the quadrilateral of the four ray intersections; only its orientation varies.
+    verts = quad
+    flip = cross(quad, quad[:, [1, 2, 3, 0]]).sum(axis=-1) < 0
+    if flip.any():
+        verts = np.where(flip[:, None], quad[:, ::-1], quad)
+    general = ~unbounded & ~(simple & ((n_rays == 4) | (n_rays == 0)))
+    if general.any():
+        verts = verts.copy()
+        verts[general] = _general_cone_vertices(
+            quad[general], ray_ok[general], r1_in_cone2[general], r2_in_cone1[general]
+        )
+        empty |= general & ~(ray_ok.any(axis=-1) | r1_in_cone2 | r2_in_cone1)
+
+    status = np.full(a.size, FR_BOUNDED, dtype=np.int8)
+    status[unbounded] = FR_UNBOUNDED
+    status[empty] = FR_EMPTY
+    if not (status == FR_BOUNDED).all():
+        verts = np.where((status == FR_BOUNDED)[:, None], verts, np.nan)
+    return verts.reshape(*shape, 4), status.reshape(shape)
+
+
+def _general_cone_vertices(
+    quad: ComplexArray, ray_ok: BoolArray, r1_in: BoolArray, r2_in: BoolArray
+) -> ComplexArray:
+    """Vertices when an apex lies inside the other cone (a landmark near the line of motion).
+
+    The candidates are the valid ray intersections and the apexes; a bounded intersection
+    of four half-planes has at most 4 distinct ones. Sort them counter-clockwise around
+    their mean (equal points end up adjacent), drop repeats, pad with the first vertex.
+    """
+    n = quad.shape[0]
+    cand = np.concatenate([quad, np.zeros((n, 1)), np.ones((n, 1))], axis=-1).astype(complex)
+    ok = np.concatenate([ray_ok, r1_in[:, None], r2_in[:, None]], axis=-1)
     cand[~ok] = 0.0
-    n_ok = ok.sum(axis=-1)
-
-    unbounded = (np.abs(wrap_angle(b - a)) <= 2.0 * epsilon) | np.any(
-        np.abs(cand) > MAX_FR_EXTENT, axis=-1
-    )
-    empty = ~unbounded & (n_ok == 0)
-
-    # A bounded intersection of four half-planes has at most 4 distinct vertices. Sort
-    # the candidates counter-clockwise around their mean (equal points end up adjacent),
-    # drop repeats, move the valid ones first and pad with the first vertex.
-    centre = cand.sum(axis=-1) / np.maximum(n_ok, 1)
+    centre = cand.sum(axis=-1) / np.maximum(ok.sum(axis=-1), 1)
     angle = np.where(ok, np.angle(cand - centre[:, None]), np.inf)
     rows = np.arange(n)[:, None]
     order = np.argsort(angle, axis=-1)
@@ -117,13 +147,7 @@ def cone_intersections(
     ok[:, 1:] &= ~(ok[:, :-1] & (np.abs(cand[:, 1:] - cand[:, :-1]) <= scale))
     order = np.argsort(~ok, axis=-1, kind="stable")
     cand, ok = cand[rows, order], ok[rows, order]
-    verts = np.where(ok[:, :4], cand[:, :4], cand[:, :1])
-
-    status = np.full(n, FR_BOUNDED, dtype=np.int8)
-    status[unbounded] = FR_UNBOUNDED
-    status[empty] = FR_EMPTY
-    verts[status != FR_BOUNDED] = np.nan
-    return verts.reshape(*shape, 4), status.reshape(shape)
+    return np.where(ok[:, :4], cand[:, :4], cand[:, :1])
 
 
 # --------------------------------------------------------------------------------------
