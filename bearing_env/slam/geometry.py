@@ -163,7 +163,7 @@ def polygon_distance(p: ComplexArray, q: ComplexArray) -> float:
     """
     polys = np.stack([p, q])  # (2, V)
     others = polys[::-1]
-    edges = np.roll(polys, -1, axis=-1) - polys
+    edges = _next_vertex(polys) - polys
     # Separating axes: outward edge normals of both polygons (CCW order).
     normals = (-1j * edges).reshape(-1)
     proj = (np.conj(normals)[:, None, None] * polys[None]).real  # (2V, 2, V)
@@ -175,7 +175,7 @@ def polygon_distance(p: ComplexArray, q: ComplexArray) -> float:
         return 0.0
     # Vertices of each polygon against the edges of the other.
     w = polys[:, :, None] - others[:, None, :]  # (2, V points, V edges)
-    d = np.roll(others, -1, axis=-1) - others
+    d = _next_vertex(others) - others
     len2 = (np.abs(d) ** 2)[:, None, :]
     with np.errstate(divide="ignore", invalid="ignore"):
         t = np.clip(np.where(len2 > 0, (np.conj(d)[:, None, :] * w).real / len2, 0.0), 0, 1)
@@ -190,13 +190,18 @@ def polygons_overlap(p: ComplexArray, q: ComplexArray) -> bool:
 def boundary_samples(poly: ComplexArray, per_edge: int) -> ComplexArray:
     """``per_edge`` evenly spaced points on each edge (vertex included): (..., V*per_edge)."""
     t = np.arange(per_edge) / per_edge
-    nxt = np.roll(poly, -1, axis=-1)
+    nxt = _next_vertex(poly)
     pts = poly[..., :, None] + t * (nxt - poly)[..., :, None]
     return pts.reshape(*poly.shape[:-1], poly.shape[-1] * per_edge)
 
 
 def max_edge_length(poly: ComplexArray) -> FloatArray:
-    return np.abs(np.roll(poly, -1, axis=-1) - poly).max(axis=-1)
+    return np.abs(_next_vertex(poly) - poly).max(axis=-1)
+
+
+def _next_vertex(poly: ComplexArray) -> ComplexArray:
+    n = poly.shape[-1]
+    return poly[..., np.r_[1:n, 0]]
 
 
 # --------------------------------------------------------------------------------------
@@ -213,6 +218,7 @@ class KGon:
         self.k = directions
         self.theta = 2.0 * np.pi * np.arange(directions) / directions
         self.normals = np.exp(1j * self.theta)
+        self._conj_normals = np.conj(self.normals)
         self._step_sin = np.sin(2.0 * np.pi / directions)
         # Real matrix for supports of point clouds: <u_k, p> = x cos + y sin.
         self._proj = np.stack([self.normals.real, self.normals.imag])  # (2, K)
@@ -267,27 +273,25 @@ class KGon:
             ``(h, empty)``: tight supports and a mask of empty intersections (where ``h``
             is undefined).
         """
-        u = self.normals
         vp, vc = self.vertices(hp), self.vertices(hc)
         owner_p = hp <= hc
         h_own = np.where(owner_p, hp, hc)
         # Edge k runs from vertex k-1 to vertex k of its owner.
         start = np.where(owner_p, vp[..., self._prev], vc[..., self._prev])
-        end = np.where(owner_p, vp, vc)
-        seg = end - start
-        h_other = np.where(owner_p[..., :, None], hc[..., None, :], hp[..., None, :])  # (..., K, K)
-        denom = dot(u, seg[..., :, None])  # (..., K edges, K constraints)
-        numer = h_other - dot(u, start[..., :, None])
-        scale = 1.0 + np.abs(h_own).max(axis=-1)[..., None, None]
-        tiny = 1e-12 * (np.abs(seg)[..., :, None] + 1e-300)
+        seg = np.where(owner_p, vp, vc) - start
+        h_other = np.where(owner_p[..., :, None], hc[..., None, :], hp[..., None, :])  # (.., K, K)
+        # Constraint j on the point start + t seg: t * denom <= numer.
+        denom = (self._conj_normals * seg[..., :, None]).real
+        numer = h_other - (self._conj_normals * start[..., :, None]).real
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = numer / denom
-        t_lo = np.maximum(0.0, np.where(denom < -tiny, ratio, -np.inf).max(axis=-1))
-        t_hi = np.minimum(1.0, np.where(denom > tiny, ratio, np.inf).min(axis=-1))
-        parallel_out = np.any((np.abs(denom) <= tiny) & (numer < -1e-9 * scale), axis=-1)
-        seg_len = np.abs(seg)
-        t_tol = 1e-9 * scale[..., 0] / np.maximum(seg_len, 1e-300)
-        survives = (t_lo <= t_hi + t_tol) & ~parallel_out
+        # A zero-length edge gives tiny denominators of either sign; the sign of each bound
+        # still says on which side of constraint j the point is, so no threshold is needed.
+        t_lo = np.where(denom < 0.0, ratio, 0.0).max(axis=-1)
+        t_hi = np.where(denom > 0.0, ratio, 1.0).min(axis=-1)
+        tol = 1e-9 * (1.0 + np.abs(h_own).max(axis=-1))
+        parallel_out = ((denom == 0.0) & (numer < -tol[..., None, None])).any(axis=-1)
+        survives = (t_lo <= t_hi + 1e-9) & ~parallel_out
         empty = ~survives.any(axis=-1)
 
         corner = start + np.clip(t_hi, 0.0, 1.0) * seg  # end of each (clipped) edge
@@ -301,5 +305,5 @@ class KGon:
         )
         prev = np.maximum.accumulate(doubled, axis=-1)[..., k:] % k
         corner_prev = np.take_along_axis(corner, prev, axis=-1)
-        h = np.where(survives, h_own, dot(u, corner_prev))
+        h = np.where(survives, h_own, (self._conj_normals * corner_prev).real)
         return h, empty

@@ -14,7 +14,6 @@ from bearing_env.slam.geometry import (
     FR_EMPTY,
     KGon,
     cone_intersections,
-    cross,
 )
 from bearing_env.slam.transfer import TRANSFERS, make_hypotheses, transfer_support
 
@@ -228,9 +227,8 @@ class PolygonSLAM:
         self._robot_centroid = complex(centroid[0])
         self._areas[idx] = area[1:]
         self._centroids[idx] = centroid[1:]
-        # Heading: the FR x-axis seen through T at the centroids of A_L1 and A_L2.
-        c1, c2 = _vertex_centroid(regions[0]), _vertex_centroid(regions[1])
-        self._robot_heading = float(-np.angle(c2 - c1))
+        # Heading: the FR x-axis seen through T at the vertex means of A_L1 and A_L2.
+        self._robot_heading = float(-np.angle(regions[1].mean() - regions[0].mean()))
 
         n_bad = int(np.count_nonzero(status == LANDMARK_INCONSISTENT))
         self.n_inconsistent += n_bad
@@ -323,15 +321,6 @@ class PolygonSLAM:
         if self._robot_support is None:
             return False
         return bool(self.kgon.contains(self._robot_support, _to_complex(point_fl)))
-
-
-def _vertex_centroid(poly: NDArray[np.complex128]) -> complex:
-    w = np.roll(poly, -1)
-    c = cross(poly, w)
-    area2 = c.sum()
-    if abs(area2) <= 1e-300:
-        return complex(poly.mean())
-    return complex(((poly + w) * c).sum() / (3.0 * area2))
 
 
 def _kgon_vertices_xy(kgon: KGon, h: NDArray[np.float64]) -> NDArray[np.float64]:

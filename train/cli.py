@@ -1,0 +1,41 @@
+"""The ``bearing-env`` command line.
+
+    bearing-env demo [...]    the random polygonal demo in the Khepera scenario (make demo)
+    bearing-env bench [...]   world-model throughput against CartPole-v1
+
+Each subcommand forwards its remaining arguments to the module that implements it, so
+``bearing-env demo --help`` shows that module's options.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    "demo": ("train.demo", "random polygonal exploration in the Khepera scenario"),
+    "bench": ("benchmarks.bench_slam", "world-model update() throughput vs CartPole-v1"),
+}
+
+
+def main(argv: list[str] | None = None) -> None:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = argparse.ArgumentParser(prog="bearing-env", description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "command",
+        choices=sorted(SUBCOMMANDS),
+        help="; ".join(f"{name}: {text}" for name, (_, text) in SUBCOMMANDS.items()),
+    )
+    if not argv or argv[0] in ("-h", "--help"):
+        parser.print_help()
+        return
+    args = parser.parse_args(argv[:1])
+    module_name, _ = SUBCOMMANDS[args.command]
+    module = importlib.import_module(module_name)
+    sys.argv = [f"bearing-env {args.command}", *argv[1:]]
+    module.main()
+
+
+if __name__ == "__main__":
+    main()
