@@ -1,8 +1,9 @@
 """Gymnasium registration of the bearing_env ids.
 
-Called on ``import bearing_env`` and, through the ``gymnasium.envs`` entry point, by
-Gymnasium itself, so ``gym.make("bearing_env:BearingSLAM-v0")`` works without importing
-first. Importing this module stays cheap: the environment modules load on first make.
+Called on ``import bearing_env``. ``gym.make("bearing_env:BearingSLAM-v0")`` works without
+importing first because Gymnasium imports the module named before the colon (Gymnasium
+1.x no longer loads ``gymnasium.envs`` entry-point plugins). Importing this module stays
+cheap: the environment modules load on first make.
 """
 
 from __future__ import annotations

@@ -16,6 +16,7 @@ Public API:
 from bearing_env.slam.api import fr_region, transfer_point, transfer_polygon
 from bearing_env.slam.polygon_slam import (
     FRAME_L1_L2_OVERLAP,
+    FRAME_L1_L2_TOO_CLOSE,
     FRAME_L1_UNBOUNDED,
     FRAME_L2_UNBOUNDED,
     FRAME_OK,
@@ -33,6 +34,7 @@ from bearing_env.slam.transfer import TRANSFERS
 
 __all__ = [
     "FRAME_L1_L2_OVERLAP",
+    "FRAME_L1_L2_TOO_CLOSE",
     "FRAME_L1_UNBOUNDED",
     "FRAME_L2_UNBOUNDED",
     "FRAME_OK",

@@ -158,15 +158,21 @@ def _general_cone_vertices(
 def polygon_distance(p: ComplexArray, q: ComplexArray) -> float:
     """Distance between two convex polygons (vertex arrays, CCW); 0 when they touch.
 
-    Overlap is decided by the separating-axis test over both polygons' edge normals; the
-    distance of disjoint polygons is the smallest vertex-to-edge distance either way.
+    Overlap is decided by the separating-axis test; the distance of disjoint polygons is
+    the smallest vertex-to-edge distance either way. Degenerate polygons (a point, a
+    segment, padded by repeated vertices) are handled.
     """
+    if p.shape[-1] != q.shape[-1]:  # pad the shorter by repeating its last vertex
+        size = max(p.shape[-1], q.shape[-1])
+        p = np.concatenate([p, np.repeat(p[-1:], size - p.shape[-1])])
+        q = np.concatenate([q, np.repeat(q[-1:], size - q.shape[-1])])
     polys = np.stack([p, q])  # (2, V)
     others = polys[::-1]
     edges = _next_vertex(polys) - polys
-    # Separating axes: outward edge normals of both polygons (CCW order).
-    normals = (-1j * edges).reshape(-1)
-    proj = (np.conj(normals)[:, None, None] * polys[None]).real  # (2V, 2, V)
+    # Candidate separating axes: the edge normals of both polygons, and the directions
+    # between their vertices, which separate degenerate regions (points, segments).
+    normals = np.concatenate([(-1j * edges).reshape(-1), (q[:, None] - p[None, :]).reshape(-1)])
+    proj = (np.conj(normals)[:, None, None] * polys[None]).real  # (axes, 2, V)
     gap = np.maximum(
         proj[:, 1].min(axis=-1) - proj[:, 0].max(axis=-1),
         proj[:, 0].min(axis=-1) - proj[:, 1].max(axis=-1),

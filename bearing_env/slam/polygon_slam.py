@@ -15,12 +15,13 @@ from bearing_env.slam.geometry import (
     KGon,
     cone_intersections,
 )
-from bearing_env.slam.transfer import TRANSFERS, make_hypotheses, transfer_support
+from bearing_env.slam.transfer import TRANSFERS, Hypotheses, make_hypotheses, transfer_support
 
 FRAME_OK = "ok"
 FRAME_L1_UNBOUNDED = "l1_unbounded"
 FRAME_L2_UNBOUNDED = "l2_unbounded"
 FRAME_L1_L2_OVERLAP = "l1_l2_overlap"
+FRAME_L1_L2_TOO_CLOSE = "l1_l2_too_close"
 
 LANDMARK_UPDATED = "updated"
 LANDMARK_UNBOUNDED = "unbounded"
@@ -38,7 +39,9 @@ class UpdateResult:
         frame_changed: the movement could change frames and update the map.
         frame_status: ``"ok"``, or why not: ``"l1_unbounded"`` / ``"l2_unbounded"`` (a
             cone pair of L1 or L2 is near-parallel or misses), ``"l1_l2_overlap"`` (their
-            FR regions touch, so ``h2 - h1`` can be 0).
+            FR regions touch, so ``h2 - h1`` can be 0), ``"l1_l2_too_close"`` (conservative
+            transfer only: they are disjoint but so close, relative to their size, that
+            the transfer has no useful bound).
         landmark_status: per landmark ``i >= 3`` (index ``i - 3``): ``"updated"``,
             ``"unbounded"`` (its cones gave no bounded region; left alone),
             ``"inconsistent"`` (empty cone intersection, or empty intersection with the
@@ -185,12 +188,11 @@ class PolygonSLAM:
             frame_status = FRAME_L1_UNBOUNDED
         elif fr_status[1] != FR_BOUNDED:
             frame_status = FRAME_L2_UNBOUNDED
-        hyp = None
+        hyp: Hypotheses | str = frame_status
         if frame_status == FRAME_OK:
             hyp = make_hypotheses(regions[0], regions[1], self.transfer, self.edge_samples)
-            if hyp is None:
-                frame_status = FRAME_L1_L2_OVERLAP
-        if hyp is None:
+        if isinstance(hyp, str):
+            frame_status = hyp
             skipped = np.full(n_mapped, LANDMARK_SKIPPED, dtype="<U12")
             return UpdateResult(False, frame_status, skipped, 0)
 

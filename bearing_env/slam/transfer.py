@@ -28,12 +28,11 @@ Two transfers are offered:
        the other region. Applying this once per hypothesis, every image lies within
        ``r = (V2 delta1**2 + V1 delta2**2) / (4 D**3)`` of the hull of the sampled images.
 
-    The sagitta bound needs ``delta <= 2 D`` (arcs under a half circle). A first-order
-    bound always holds: ``|grad_h1 T| <= V2 / D**2`` and ``|grad_h2 T| <= V1 / D**2``, and
-    every hypothesis is within ``delta / 2`` of a sample on its edge, so
-    ``r = (V2 delta1 + V1 delta2) / (2 D**2)``. The smaller valid bound is used. The
-    region is the sampled hull grown by ``r``, which shrinks with the square of the
-    number of samples per edge whenever L1 and L2 are well separated.
+    The sagitta bound needs ``delta <= 2 D`` (arcs under a half circle). When L1's and
+    L2's regions are too close for that, relative to their size, a movement cannot bound
+    its transfer usefully and is refused (``"l1_l2_too_close"``). The region is the
+    sampled hull grown by ``r``, which shrinks with the square of the number of samples
+    per edge.
 """
 
 from __future__ import annotations
@@ -80,39 +79,41 @@ class Hypotheses:
             return np.zeros(targets.shape[:-1])
         v1 = np.abs(targets[..., :, None] - self.a1).max(axis=(-1, -2))
         v2 = np.abs(targets[..., :, None] - self.a2).max(axis=(-1, -2))
-        dist = self.distance
-        first_order = (v2 * self.delta1 + v1 * self.delta2) / (2.0 * dist**2)
-        r = first_order
-        if max(self.delta1, self.delta2) <= 2.0 * dist:
-            sagitta = (v2 * self.delta1**2 + v1 * self.delta2**2) / (4.0 * dist**3)
-            r = np.minimum(sagitta, first_order)
+        r = (v2 * self.delta1**2 + v1 * self.delta2**2) / (4.0 * self.distance**3)
         # A relative margin far above rounding error keeps the bound a bound in floats.
         return r + 1e-9 * (1.0 + v1 / self.distance)
 
 
 def make_hypotheses(
     a1: ComplexArray, a2: ComplexArray, transfer: str, edge_samples: int
-) -> Hypotheses | None:
-    """Sample the hypotheses ``(h1, h2)``; None when A_L1 and A_L2 touch or overlap.
+) -> Hypotheses | str:
+    """Sample the hypotheses ``(h1, h2)`` of one movement.
 
     Args:
         a1, a2: vertex arrays (4,) of the FR regions of L1 and L2.
         transfer: ``"paper"`` (vertex pairs) or ``"conservative"``.
         edge_samples: samples per edge for the conservative transfer.
+
+    Returns:
+        The hypotheses, or why the frame cannot be changed: ``"l1_l2_overlap"`` when the
+        regions touch (``h2 - h1`` can be 0), ``"l1_l2_too_close"`` when the conservative
+        bound does not apply (a sampled edge piece is longer than twice the distance).
     """
     if transfer not in TRANSFERS:
         raise ValueError(f"transfer must be one of {TRANSFERS}, got {transfer!r}")
     distance = float(polygon_distance(a1, a2))
     if not distance > 0.0:
-        return None
+        return "l1_l2_overlap"
     if transfer == "paper":
         h1, h2 = a1, a2
         delta1 = delta2 = 0.0
     else:
-        h1 = boundary_samples(a1, edge_samples)
-        h2 = boundary_samples(a2, edge_samples)
         delta1 = float(max_edge_length(a1)) / edge_samples
         delta2 = float(max_edge_length(a2)) / edge_samples
+        if max(delta1, delta2) > 2.0 * distance:
+            return "l1_l2_too_close"
+        h1 = boundary_samples(a1, edge_samples)
+        h2 = boundary_samples(a2, edge_samples)
     h1_pairs = np.repeat(h1, h2.shape[-1])
     h2_pairs = np.tile(h2, h1.shape[-1])
     return Hypotheses(
@@ -157,10 +158,11 @@ def transfer_points_fl(
     """The FL point cloud and inflation radius for one FR region (vertex array).
 
     The transferred region is ``hull(cloud)`` grown by ``radius`` (``radius == 0`` for
-    the paper transfer, whose region is exactly the hull). None when L1 and L2 overlap.
+    the paper transfer, whose region is exactly the hull). None when the frame cannot be
+    changed (see :func:`make_hypotheses`).
     """
     hyp = make_hypotheses(np.asarray(a1, complex), np.asarray(a2, complex), transfer, edge_samples)
-    if hyp is None:
+    if isinstance(hyp, str):
         return None
     pts = np.atleast_1d(np.asarray(points_fr, complex))
     cloud = hyp.images(pts).reshape(-1)

@@ -1,0 +1,406 @@
+"""The simulated world: arena, true landmarks, robot pose, motion and the bearing sensor.
+
+Pure numpy (no gymnasium, no pygame), so it can be reused by planners and benchmarks.
+
+Units: lengths are in **metres**, angles in **radians** (the public constructor arguments
+that are in degrees say so in their names, e.g. ``bound_deg``). The paper's Khepera field
+is 1.05 m x 0.68 m. World coordinates have their origin at the lower-left corner of the
+arena, x to the right, y up; headings are counter-clockwise from +x.
+
+All randomness goes through a :class:`numpy.random.Generator` passed in by the caller, so
+the same generator state gives the same world, bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+FloatArray = NDArray[np.float64]
+
+#: The Khepera robot-soccer field of the paper's real-robot experiment (metres).
+KHEPERA_ARENA_SIZE: tuple[float, float] = (1.05, 0.68)
+
+#: Lengths that are not given explicitly (move length, wall margin, landmark spacing)
+#: are scaled with the arena's longer side relative to the Khepera field, so that a
+#: scenario behaves the same at any scale.
+REFERENCE_ARENA_SIDE: float = KHEPERA_ARENA_SIZE[0]
+
+#: Default move length range on the Khepera field (metres): from a nudge to ~30% of
+#: the field's length. The reference greedy/random runs of DESIGN.md use 0.25 m.
+REFERENCE_MOVE_LENGTH: tuple[float, float] = (0.05, 0.30)
+
+#: The Khepera robot's radius: the robot centre stops this far from a wall.
+REFERENCE_WALL_MARGIN: float = 0.025
+
+#: A move shorter than this (metres, times the arena scale) is "no move": the two readings
+#: are taken from the same place, the robot frame FR (R1 = 0, R2 = 1) does not exist and
+#: the SLAM update is skipped.
+REFERENCE_MIN_BASELINE: float = 1e-4
+
+NOISE_KINDS: tuple[str, ...] = ("uniform", "gaussian", "none")
+
+
+def wrap_angle(angle: ArrayLike) -> FloatArray:
+    """Wrap angles to [-pi, pi)."""
+    return (np.asarray(angle, dtype=np.float64) + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def _check_finite_positive(value: Any, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name} must be a number, got {value!r}")
+    out = float(value)
+    if not math.isfinite(out) or out <= 0.0:
+        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
+    return out
+
+
+# --------------------------------------------------------------------------------------
+# Arena
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Arena:
+    """A rectangular arena ``[0, width] x [0, height]`` in metres."""
+
+    width: float
+    height: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "width", _check_finite_positive(self.width, "arena width"))
+        object.__setattr__(self, "height", _check_finite_positive(self.height, "arena height"))
+
+    @property
+    def scale(self) -> float:
+        """The arena's longer side relative to the Khepera field (1.0 for Khepera)."""
+        return max(self.width, self.height) / REFERENCE_ARENA_SIDE
+
+    @property
+    def wall_margin(self) -> float:
+        """How close (metres) the robot centre may come to a wall."""
+        return min(REFERENCE_WALL_MARGIN * self.scale, 0.25 * min(self.width, self.height))
+
+    @property
+    def default_move_length(self) -> tuple[float, float]:
+        """Default move length range (metres) at this arena's scale."""
+        lo, hi = REFERENCE_MOVE_LENGTH
+        return (lo * self.scale, hi * self.scale)
+
+    def contains(self, points: ArrayLike, margin: float = 0.0) -> NDArray[np.bool_]:
+        """Whether points (..., 2) lie inside the arena shrunk by ``margin``."""
+        p = np.asarray(points, dtype=np.float64)
+        x, y = p[..., 0], p[..., 1]
+        return (
+            (x >= margin) & (x <= self.width - margin) & (y >= margin) & (y <= self.height - margin)
+        )
+
+    def free_distance(self, position: ArrayLike, heading: float, margin: float) -> float:
+        """Distance the robot can travel from ``position`` along ``heading`` before it
+        comes within ``margin`` of a wall (0 if it already is, facing the wall)."""
+        x, y = (float(v) for v in np.asarray(position, dtype=np.float64))
+        dx, dy = math.cos(heading), math.sin(heading)
+        limits = []
+        # Per axis: the wall the heading points at is the only one that can stop it.
+        if dx > 0.0:
+            limits.append((self.width - margin - x) / dx)
+        elif dx < 0.0:
+            limits.append((margin - x) / dx)
+        if dy > 0.0:
+            limits.append((self.height - margin - y) / dy)
+        elif dy < 0.0:
+            limits.append((margin - y) / dy)
+        return max(0.0, min(limits)) if limits else math.inf
+
+
+# --------------------------------------------------------------------------------------
+# Bearing sensor noise
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class NoiseModel:
+    """The *true* bearing noise of the simulated sensor (the SLAM only knows epsilon).
+
+    Attributes:
+        kind: ``"uniform"`` (error uniform in ``[-bound, +bound]``), ``"gaussian"``
+            (error normal with standard deviation ``sigma``) or ``"none"``.
+        bound_deg: half-width of the uniform error in degrees; ``None`` means "equal to
+            the SLAM's epsilon", the paper's assumption. It may exceed epsilon to model a
+            sensor that is worse than the SLAM believes.
+        sigma_deg: standard deviation of the Gaussian error in degrees; ``None`` means
+            epsilon / 2 (so ~95% of readings fall within +-epsilon).
+        outlier_rate: probability, per landmark per reading, that the bearing is replaced
+            by a uniformly random angle (a mis-identified blob in the panoramic image).
+    """
+
+    kind: str = "uniform"
+    bound_deg: float | None = None
+    sigma_deg: float | None = None
+    outlier_rate: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.kind not in NOISE_KINDS:
+            raise ValueError(f"noise kind must be one of {NOISE_KINDS}, got {self.kind!r}")
+        for name in ("bound_deg", "sigma_deg"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            if isinstance(value, bool) or not isinstance(
+                value, (int, float, np.integer, np.floating)
+            ):
+                raise TypeError(f"noise {name} must be a number or None, got {value!r}")
+            if not math.isfinite(float(value)) or float(value) < 0.0:
+                raise ValueError(f"noise {name} must be finite and >= 0, got {value!r}")
+            object.__setattr__(self, name, float(value))
+        rate = self.outlier_rate
+        if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)):
+            raise TypeError(f"noise outlier_rate must be a number, got {rate!r}")
+        if not 0.0 <= float(rate) <= 1.0:
+            raise ValueError(f"noise outlier_rate must be in [0, 1], got {rate!r}")
+        object.__setattr__(self, "outlier_rate", float(rate))
+
+    @classmethod
+    def parse(cls, spec: NoiseModel | Mapping[str, Any] | str | None) -> NoiseModel:
+        """Build a noise model from a :class:`NoiseModel`, a mapping of its fields (e.g.
+        ``{"kind": "gaussian", "sigma_deg": 1.0}``, handy in YAML configs), a kind name,
+        or ``None`` (the default: uniform within +-epsilon)."""
+        if spec is None:
+            return cls()
+        if isinstance(spec, NoiseModel):
+            return spec
+        if isinstance(spec, str):
+            return cls(kind=spec)
+        if isinstance(spec, Mapping):
+            unknown = set(spec) - {"kind", "bound_deg", "sigma_deg", "outlier_rate"}
+            if unknown:
+                raise TypeError(f"unknown noise fields {sorted(unknown)!r} in {dict(spec)!r}")
+            return cls(**spec)
+        raise TypeError(f"noise must be a NoiseModel, a mapping, a str or None, got {spec!r}")
+
+    def corrupt(
+        self, rng: np.random.Generator, true_bearings: FloatArray, epsilon: float
+    ) -> FloatArray:
+        """Noisy bearings (radians, wrapped to [-pi, pi)) from true ones.
+
+        Args:
+            rng: the generator all draws come from.
+            true_bearings: noise-free bearings (n,), radians.
+            epsilon: the SLAM's error bound (radians), the default scale of the noise.
+        """
+        size = true_bearings.shape[0]
+        if self.kind == "uniform":
+            bound = epsilon if self.bound_deg is None else math.radians(self.bound_deg)
+            noisy = true_bearings + rng.uniform(-bound, bound, size)
+        elif self.kind == "gaussian":
+            sigma = 0.5 * epsilon if self.sigma_deg is None else math.radians(self.sigma_deg)
+            noisy = true_bearings + rng.normal(0.0, sigma, size)
+        else:
+            noisy = np.array(true_bearings, dtype=np.float64)
+        if self.outlier_rate > 0.0:
+            # Both arrays are drawn in full, so the stream of draws does not depend on
+            # which landmarks turn out to be outliers.
+            is_outlier = rng.random(size) < self.outlier_rate
+            random_bearing = rng.uniform(-np.pi, np.pi, size)
+            noisy = np.where(is_outlier, random_bearing, noisy)
+        return wrap_angle(noisy)
+
+
+# --------------------------------------------------------------------------------------
+# Scenarios and layouts
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A named world: arena size and, unless random, fixed landmark positions."""
+
+    name: str
+    arena_size: tuple[float, float]
+    landmarks: tuple[tuple[float, float], ...] | None
+    description: str = field(default="", compare=False)
+
+    @property
+    def n_landmarks(self) -> int | None:
+        return None if self.landmarks is None else len(self.landmarks)
+
+
+SCENARIOS: dict[str, Scenario] = {
+    # The paper's Fig 8/9: L1 and L2, 20 cm apart, side by side on the near half of the
+    # field; L3 (right) and L4 (left) further up the field. The paper gives no
+    # coordinates beyond L1-L2 = 20 cm; these reproduce the figure's arrangement.
+    "khepera": Scenario(
+        name="khepera",
+        arena_size=KHEPERA_ARENA_SIZE,
+        landmarks=((0.425, 0.16), (0.625, 0.16), (0.78, 0.50), (0.30, 0.52)),
+        description="the paper's real arena: Khepera field 1.05 x 0.68 m, 4 landmarks, "
+        "L1-L2 = 0.20 m",
+    ),
+    # The paper's simulation (Sec 3.2, Fig 7): four landmarks around the centre of a
+    # square world, the robot wandering around the centre. L1-L2 = 0.5 m = 1 FL unit.
+    "paper_sim": Scenario(
+        name="paper_sim",
+        arena_size=(2.0, 2.0),
+        landmarks=((0.75, 0.60), (1.25, 0.60), (1.35, 1.30), (0.65, 1.40)),
+        description="the paper's simulation: 4 landmarks around the centre of a 2 x 2 m "
+        "square",
+    ),
+    "random": Scenario(
+        name="random",
+        arena_size=KHEPERA_ARENA_SIZE,
+        landmarks=None,
+        description="a new random layout of n_landmarks every episode",
+    ),
+    "custom": Scenario(
+        name="custom",
+        arena_size=KHEPERA_ARENA_SIZE,
+        landmarks=None,
+        description="the explicit landmark positions passed as `landmarks`",
+    ),
+}
+
+
+def random_layout(
+    rng: np.random.Generator, arena: Arena, n_landmarks: int, max_attempts: int = 200
+) -> FloatArray:
+    """Draw ``n_landmarks`` landmark positions (n, 2) uniformly in the arena.
+
+    Landmarks keep away from the walls (the robot must be able to get round them) and
+    from each other (two landmarks on top of each other are one landmark). L1 and L2 are
+    at least a quarter of the arena's shorter side apart, so the landmark frame FL is well
+    conditioned: the FL unit |L1 - L2| is then never tiny compared with the arena.
+    """
+    if n_landmarks < 2:
+        raise ValueError(f"n_landmarks must be >= 2, got {n_landmarks}")
+    inset = min(0.05 * arena.scale, 0.2 * min(arena.width, arena.height))
+    low = np.array([inset, inset])
+    high = np.array([arena.width - inset, arena.height - inset])
+    free_area = float(np.prod(high - low))
+    # Spacing: ~a Khepera diameter at Khepera scale, less when many landmarks must fit.
+    spacing = min(0.08 * arena.scale, 0.5 * math.sqrt(free_area / n_landmarks))
+    frame_spacing = max(spacing, 0.25 * min(arena.width, arena.height))
+    while True:
+        points = np.empty((n_landmarks, 2))
+        count = 0
+        attempts = 0
+        while count < n_landmarks and attempts < max_attempts * n_landmarks:
+            attempts += 1
+            candidate = rng.uniform(low, high)
+            if count > 0:
+                distances = np.hypot(*(points[:count] - candidate).T)
+                if distances.min() < spacing or (count == 1 and distances[0] < frame_spacing):
+                    continue
+            points[count] = candidate
+            count += 1
+        if count == n_landmarks:
+            return points
+        # Too crowded for this spacing (deterministic given rng): relax and redraw.
+        spacing *= 0.8
+        frame_spacing = max(spacing, 0.8 * frame_spacing)
+
+
+def random_start(
+    rng: np.random.Generator, arena: Arena, landmarks: FloatArray, max_attempts: int = 1000
+) -> tuple[FloatArray, float]:
+    """A random start pose: position inside the wall margin, not on top of a landmark,
+    and a uniform heading."""
+    margin = arena.wall_margin
+    low = np.array([margin, margin])
+    high = np.array([arena.width - margin, arena.height - margin])
+    clearance = 0.04 * arena.scale
+    position = rng.uniform(low, high)
+    for _ in range(max_attempts):
+        if np.min(np.hypot(*(landmarks - position).T)) >= clearance:
+            break
+        position = rng.uniform(low, high)
+    heading = float(rng.uniform(-np.pi, np.pi))
+    return position, heading
+
+
+# --------------------------------------------------------------------------------------
+# The world
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class MoveResult:
+    """What one straight move did."""
+
+    requested: float
+    travelled: float
+    blocked: bool
+
+
+class World:
+    """Ground truth: the arena, the landmarks, the robot pose; motion and sensing.
+
+    Args:
+        arena: the arena.
+        landmarks: true landmark positions (n, 2), metres; index 0 is L1, 1 is L2.
+        position: robot start position (2,).
+        heading: robot start heading, radians CCW from +x.
+        noise: the true bearing noise model.
+        epsilon: the SLAM's bearing error bound in radians (the default noise bounds are
+            expressed relative to it).
+    """
+
+    def __init__(
+        self,
+        arena: Arena,
+        landmarks: ArrayLike,
+        position: ArrayLike,
+        heading: float,
+        noise: NoiseModel,
+        epsilon: float,
+    ) -> None:
+        self.arena = arena
+        self.landmarks = np.array(landmarks, dtype=np.float64)
+        if self.landmarks.ndim != 2 or self.landmarks.shape[1] != 2:
+            raise ValueError(f"landmarks must have shape (n, 2), got {self.landmarks.shape}")
+        self.position = np.array(position, dtype=np.float64)
+        self.heading = float(wrap_angle(heading))
+        self.noise = noise
+        self.epsilon = float(epsilon)
+
+    @property
+    def n_landmarks(self) -> int:
+        return int(self.landmarks.shape[0])
+
+    @property
+    def min_baseline(self) -> float:
+        return REFERENCE_MIN_BASELINE * self.arena.scale
+
+    def turn(self, angle: float) -> None:
+        """Turn on the spot by ``angle`` radians (CCW positive)."""
+        self.heading = float(wrap_angle(self.heading + angle))
+
+    def move(self, length: float) -> MoveResult:
+        """Move straight ahead by ``length`` metres, stopping at the wall margin."""
+        free = self.arena.free_distance(self.position, self.heading, self.arena.wall_margin)
+        if free < self.min_baseline:
+            # Against the wall (up to rounding): the robot does not move at all.
+            free = 0.0
+        travelled = min(float(length), free)
+        direction = np.array([math.cos(self.heading), math.sin(self.heading)])
+        new_position = self.position + travelled * direction
+        # Rounding can leave the robot a hair outside the margin; clamp so the invariant
+        # "always inside the margin" holds exactly.
+        margin = self.arena.wall_margin
+        new_position[0] = min(max(new_position[0], margin), self.arena.width - margin)
+        new_position[1] = min(max(new_position[1], margin), self.arena.height - margin)
+        self.position = new_position
+        return MoveResult(requested=float(length), travelled=travelled, blocked=free < length)
+
+    def true_bearings(self) -> FloatArray:
+        """Noise-free bearings (n,) of all landmarks, relative to the heading, [-pi, pi)."""
+        delta = self.landmarks - self.position
+        return wrap_angle(np.arctan2(delta[:, 1], delta[:, 0]) - self.heading)
+
+    def read_bearings(self, rng: np.random.Generator) -> FloatArray:
+        """A panoramic reading: noisy bearings (n,) relative to the heading, [-pi, pi)."""
+        return self.noise.corrupt(rng, self.true_bearings(), self.epsilon)

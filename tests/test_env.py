@@ -1,0 +1,571 @@
+"""The Gymnasium environments: API conformance, determinism, rewards, validation."""
+
+from __future__ import annotations
+
+import math
+import os
+import pickle
+import subprocess
+import sys
+import warnings
+from typing import Any
+
+os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import bearing_env
+from bearing_env.envs import BearingSLAMDiscreteEnv, BearingSLAMEnv
+from bearing_env.envs.bearing_slam import (
+    AREA_FLOOR,
+    DEFAULT_AREA_CAP,
+    DEFAULT_MAX_MOVES,
+    observation_size,
+    observation_slices,
+)
+from bearing_env.registration import MAX_EPISODE_STEPS, register_envs
+
+ENV_IDS = sorted(
+    spec.id
+    for spec in gym.registry.values()
+    if isinstance(spec.entry_point, str) and spec.entry_point.startswith("bearing_env.")
+)
+INFO_KEYS = {
+    "landmark_area",
+    "landmark_error",
+    "landmark_contains_truth",
+    "total_area",
+    "robot_error",
+    "frame_changed",
+    "inconsistent",
+    "path_length",
+    "rewards",
+}
+
+
+def test_both_ids_are_registered() -> None:
+    assert ENV_IDS == ["BearingSLAM-v0", "BearingSLAMDiscrete-v0"]
+    for env_id in ENV_IDS:
+        assert gym.spec(env_id).max_episode_steps == MAX_EPISODE_STEPS == DEFAULT_MAX_MOVES
+
+
+def test_registration_can_run_twice_silently() -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        register_envs()
+        register_envs()
+        bearing_env.register_envs()
+    assert ENV_IDS == sorted(i for i in gym.registry if i.startswith("BearingSLAM"))
+
+
+def test_make_by_module_prefixed_id_without_importing_first() -> None:
+    code = (
+        "import sys, gymnasium as gym\n"
+        "assert 'bearing_env' not in sys.modules\n"
+        "for i in ('BearingSLAM-v0', 'BearingSLAMDiscrete-v0'):\n"
+        "    env = gym.make('bearing_env:' + i, n_landmarks=8)\n"
+        "    obs, _ = env.reset(seed=0)\n"
+        "    env.step(env.action_space.sample())\n"
+        "# Rendering is optional: nothing imported pygame.\n"
+        "assert 'pygame' not in sys.modules\n"
+        "print('ok', obs.shape)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "ok (63,)"
+
+
+# --------------------------------------------------------------------------------------
+# API conformance, for every registered id
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_gymnasium_check_env_without_warnings(env_id: str) -> None:
+    env = gym.make(env_id)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped)
+    env.close()
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_sb3_check_env_without_warnings(env_id: str) -> None:
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    env = gym.make(env_id)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sb3_check_env(env)
+    env.close()
+
+
+def assert_same(a: Any, b: Any) -> None:
+    """Exact equality, nested, with NaN equal to NaN and types compared."""
+    assert type(a) is type(b), (a, b)
+    if isinstance(a, dict):
+        assert a.keys() == b.keys()
+        for key in a:
+            assert_same(a[key], b[key])
+    elif isinstance(a, (tuple, list)):
+        assert len(a) == len(b)
+        for item_a, item_b in zip(a, b, strict=True):
+            assert_same(item_a, item_b)
+    elif isinstance(a, np.ndarray):
+        assert a.dtype == b.dtype and a.shape == b.shape
+        np.testing.assert_array_equal(a, b)
+    elif isinstance(a, float) and math.isnan(a):
+        assert math.isnan(b)
+    else:
+        assert a == b
+
+
+def rollout(env: gym.Env, seed: int, steps: int) -> list[tuple[Any, ...]]:
+    env.action_space.seed(seed)
+    observation, info = env.reset(seed=seed)
+    record: list[tuple[Any, ...]] = [(observation, info)]
+    for _ in range(steps):
+        observation, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        record.append((observation, reward, terminated, truncated, info))
+        if terminated or truncated:
+            observation, info = env.reset()
+            record.append((observation, info))
+    return record
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_same_seed_same_episode_bit_for_bit(env_id: str) -> None:
+    kwargs = {"noise": {"kind": "gaussian", "outlier_rate": 0.05}, "n_landmarks": 5}
+    first = rollout(gym.make(env_id, **kwargs), seed=42, steps=50)
+    second = rollout(gym.make(env_id, **kwargs), seed=42, steps=50)
+    assert len(first) == len(second) > 50
+    for a, b in zip(first, second, strict=True):
+        assert_same(a, b)
+    other = rollout(gym.make(env_id, **kwargs), seed=43, steps=5)
+    assert not np.array_equal(first[0][0], other[0][0])
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_pickle_round_trip_continues_identically(env_id: str) -> None:
+    env = gym.make(env_id, render_mode="rgb_array")
+    env.action_space.seed(0)
+    env.reset(seed=3)
+    for _ in range(3):
+        env.step(env.action_space.sample())
+    env.render()  # a live pygame surface must not break pickling
+    clone = pickle.loads(pickle.dumps(env))
+    actions = [env.action_space.sample() for _ in range(5)]
+    for action in actions:
+        assert_same(env.step(action), clone.step(action))
+    assert clone.render().shape == env.render().shape
+
+
+def _make_and_step(env_id: str) -> tuple[int, bool]:
+    """Run in a spawned process: import, make, step."""
+    env = gym.make(env_id)
+    observation, _ = env.reset(seed=0)
+    observation, *_ = env.step(env.action_space.sample())
+    return observation.shape[0], bool(np.all(np.isfinite(observation)))
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_make_in_a_spawned_process(env_id: str) -> None:
+    import multiprocessing
+
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        size, finite = pool.apply(_make_and_step, (env_id,))
+    assert size == observation_size(8) and finite
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("mode", ["sync", "async"])
+def test_make_vec_runs(env_id: str, mode: str) -> None:
+    vector_kwargs = {"context": "spawn"} if mode == "async" else {}
+    envs = gym.make_vec(
+        env_id, num_envs=2, vectorization_mode=mode, vector_kwargs=vector_kwargs, n_landmarks=5
+    )
+    try:
+        envs.action_space.seed(0)
+        observations, infos = envs.reset(seed=[1, 2])
+        assert observations.shape == (2, observation_size(8))
+        assert not np.array_equal(observations[0], observations[1])
+        episode_ends = 0
+        for _ in range(25):  # crosses the 20-move truncation and the autoreset
+            observations, rewards, terminated, truncated, infos = envs.step(
+                envs.action_space.sample()
+            )
+            assert np.all(np.isfinite(observations)) and np.all(np.isfinite(rewards))
+            episode_ends += int(np.sum(terminated | truncated))
+        assert episode_ends >= 2
+        assert infos["landmark_area"].shape == (2, 3)
+    finally:
+        envs.close()
+
+
+def test_sb3_subproc_vec_env_with_spawn() -> None:
+    from stable_baselines3.common.env_util import make_vec_env
+    from stable_baselines3.common.vec_env import SubprocVecEnv
+
+    venv = make_vec_env(
+        # A spawned worker has not imported bearing_env: the module prefix does it.
+        "bearing_env:BearingSLAMDiscrete-v0",
+        n_envs=2,
+        seed=0,
+        vec_env_cls=SubprocVecEnv,
+        vec_env_kwargs={"start_method": "spawn"},
+    )
+    try:
+        observations = venv.reset()
+        for _ in range(3):
+            observations, _, _, infos = venv.step(np.array([0, 5]))
+        assert observations.shape == (2, observation_size(8))
+        assert set(infos[0]) >= INFO_KEYS
+    finally:
+        venv.close()
+
+
+# --------------------------------------------------------------------------------------
+# Observation and info
+# --------------------------------------------------------------------------------------
+
+
+def test_info_keys_and_shapes() -> None:
+    env = BearingSLAMEnv(n_landmarks=6)
+    _, info = env.reset(seed=0)
+    assert set(info) == INFO_KEYS
+    assert np.all(np.isinf(info["landmark_area"])) and math.isinf(info["total_area"])
+    for _ in range(8):
+        _, reward, _, _, info = env.step(env.action_space.sample())
+        assert set(info) == INFO_KEYS
+        assert info["landmark_area"].shape == (4,)
+        assert info["landmark_error"].shape == (4,)
+        assert info["landmark_contains_truth"].dtype == bool
+        assert info["total_area"] == pytest.approx(float(np.sum(info["landmark_area"])))
+        assert isinstance(info["frame_changed"], bool)
+        assert isinstance(info["inconsistent"], int)
+        assert 0.0 <= info["path_length"] <= env.move_length[1]
+        assert reward == pytest.approx(sum(info["rewards"].values()))
+        # Not initialised <=> infinite area <=> infinite error.
+        assert np.array_equal(np.isinf(info["landmark_area"]), np.isinf(info["landmark_error"]))
+
+
+def test_observation_layout_and_padding() -> None:
+    env = BearingSLAMEnv(scenario="khepera", max_landmarks=6)
+    assert env.observation_space.shape == (observation_size(6),) == (9 + 5 * 4 + 3 * 6,)
+    observation, _ = env.reset(seed=0)
+    blocks = observation_slices(6)
+    landmarks = observation[blocks["landmarks"]].reshape(4, 5)
+    bearings = observation[blocks["bearings"]].reshape(6, 3)
+    np.testing.assert_array_equal(landmarks[:, 0], [1, 1, 0, 0])  # L3, L4 present
+    np.testing.assert_array_equal(landmarks[:2, 1], [1, 1])  # not initialised yet
+    np.testing.assert_array_equal(landmarks[2:], 0)  # padding is all zeros
+    np.testing.assert_array_equal(bearings[:, 0], [1, 1, 1, 1, 0, 0])
+    np.testing.assert_array_equal(bearings[4:], 0)
+    np.testing.assert_allclose(np.hypot(bearings[:4, 1], bearings[:4, 2]), 1, rtol=1e-6)
+    assert observation[3] == 1.0  # robot region unknown before any movement
+    for _ in range(10):
+        observation, _, _, _, info = env.step(np.array([0.7, 1.0], dtype=np.float32))
+        landmarks = observation[blocks["landmarks"]].reshape(4, 5)
+        initialised = np.isfinite(info["landmark_area"])
+        np.testing.assert_array_equal(landmarks[:2, 1], ~initialised)
+        logs = np.log(np.clip(info["landmark_area"], AREA_FLOOR, DEFAULT_AREA_CAP))
+        np.testing.assert_allclose(landmarks[:2, 4], logs, rtol=1e-5)
+        assert observation[7] == float(info["frame_changed"])
+    assert observation[3] == 0.0 and observation[4] ** 2 + observation[5] ** 2 == pytest.approx(1)
+
+
+def test_observation_does_not_depend_on_the_true_layout_beyond_bearings() -> None:
+    # Same bearings, scaled world: the robot cannot tell the difference, nor can the
+    # observation (FL coordinates are scale free and no metric truth leaks in).
+    small = BearingSLAMEnv(
+        landmarks=[[0.4, 0.2], [0.6, 0.2], [0.5, 0.5]], arena=(1.0, 1.0), noise="none"
+    )
+    large = BearingSLAMEnv(
+        landmarks=[[0.8, 0.4], [1.2, 0.4], [1.0, 1.0]], arena=(2.0, 2.0), noise="none"
+    )
+    obs_small, _ = small.reset(seed=5)
+    obs_large, _ = large.reset(seed=5)
+    np.testing.assert_allclose(obs_small, obs_large, atol=1e-5)
+    for action in ([0.3, 0.0], [-0.8, 0.5], [0.5, -0.5], [0.9, 1.0]):
+        obs_small, *_ = small.step(np.array(action, dtype=np.float32))
+        obs_large, *_ = large.step(np.array(action, dtype=np.float32))
+        np.testing.assert_allclose(obs_small, obs_large, atol=1e-4)
+
+
+def test_conservative_regions_contain_the_truth() -> None:
+    env = BearingSLAMEnv(n_landmarks=6)
+    env.action_space.seed(1)
+    for seed in range(3):
+        env.reset(seed=seed)
+        for _ in range(15):
+            _, _, terminated, _, info = env.step(env.action_space.sample())
+            initialised = np.isfinite(info["landmark_area"])
+            assert np.all(info["landmark_contains_truth"][initialised])
+            assert info["inconsistent"] == 0
+            if terminated:
+                break
+
+
+def test_stuck_at_the_wall_does_not_update_the_map() -> None:
+    env = BearingSLAMEnv(scenario="khepera", move_length=5.0)
+    env.reset(seed=0)
+    straight = np.array([0.0, 0.0], dtype=np.float32)
+    observation, *_ , info = env.step(straight)
+    assert observation[8] == 1.0  # stopped by the wall
+    assert info["path_length"] > 0
+    observation, reward, _, _, info = env.step(straight)
+    assert info["path_length"] == 0.0
+    assert info["frame_changed"] is False and reward == 0.0
+    assert observation[7] == 0.0 and observation[8] == 1.0
+
+
+# --------------------------------------------------------------------------------------
+# Rewards and episode end
+# --------------------------------------------------------------------------------------
+
+
+def capped_potential(areas: np.ndarray, cap: float, kind: str) -> float:
+    capped = np.clip(areas, AREA_FLOOR, cap)
+    return float(np.sum(np.log(capped))) if kind == "log_area" else float(np.sum(capped))
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("reward", ["log_area", "area"])
+def test_return_telescopes(env_id: str, reward: str) -> None:
+    env = gym.make(env_id, reward=reward, n_landmarks=5, target_area=1e-6)
+    env.action_space.seed(7)
+    _, info = env.reset(seed=7)
+    total, steps, done = 0.0, 0, False
+    while not done:
+        _, step_reward, terminated, truncated, info = env.step(env.action_space.sample())
+        total += float(step_reward)
+        steps += 1
+        done = terminated or truncated
+    assert steps == DEFAULT_MAX_MOVES
+    initial = capped_potential(np.full(3, np.inf), DEFAULT_AREA_CAP, reward)
+    final = capped_potential(info["landmark_area"], DEFAULT_AREA_CAP, reward)
+    assert initial > final  # something was learnt about the map
+    assert total == pytest.approx(initial - final, rel=1e-9, abs=1e-9)
+
+
+def test_costs_are_named_parts_of_the_reward() -> None:
+    env = BearingSLAMEnv(path_cost=0.5, move_cost=0.1)
+    env.reset(seed=0)
+    for _ in range(5):
+        _, reward, _, _, info = env.step(env.action_space.sample())
+        parts = info["rewards"]
+        assert set(parts) == {"uncertainty", "path_cost", "move_cost"}
+        assert parts["path_cost"] == pytest.approx(-0.5 * info["path_length"])
+        assert parts["move_cost"] == pytest.approx(-0.1)
+        assert reward == pytest.approx(sum(parts.values()))
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_success_terminates(env_id: str) -> None:
+    # Any region at all is below this target: success as soon as all are initialised.
+    env = gym.make(env_id, scenario="khepera", target_area=1e6)
+    env.action_space.seed(0)
+    env.reset(seed=0)
+    for _ in range(DEFAULT_MAX_MOVES):
+        _, _, terminated, truncated, info = env.step(env.action_space.sample())
+        initialised = bool(np.all(np.isfinite(info["landmark_area"])))
+        assert terminated == initialised
+        if terminated:
+            assert not truncated
+            break
+    assert terminated
+
+
+def test_truncation_after_max_moves() -> None:
+    env = BearingSLAMEnv(max_moves=3, target_area=1e-9)
+    env.reset(seed=0)
+    flags = [env.step(env.action_space.sample())[2:4] for _ in range(3)]
+    assert flags == [(False, False), (False, False), (False, True)]
+
+
+# --------------------------------------------------------------------------------------
+# Bad input
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "fragment"),
+    [
+        ({"n_landmarks": 2}, ValueError, "n_landmarks.*2"),
+        ({"n_landmarks": 3.5}, TypeError, "3.5"),
+        ({"epsilon_deg": 0.0}, ValueError, "epsilon_deg.*0.0"),
+        ({"epsilon_deg": -2.0}, ValueError, "-2.0"),
+        ({"epsilon_deg": 45.0}, ValueError, "45.0"),
+        ({"epsilon_deg": math.nan}, ValueError, "nan"),
+        ({"arena": (0.0, 1.0)}, ValueError, "arena width.*0.0"),
+        ({"arena": (1.0, -0.5)}, ValueError, "arena height.*-0.5"),
+        ({"arena": (1.0, 2.0, 3.0)}, ValueError, "3.0"),
+        ({"scenario": "moon"}, ValueError, "'moon'"),
+        ({"reward": "happiness"}, ValueError, "'happiness'"),
+        ({"transfer": "magic"}, ValueError, "'magic'"),
+        ({"noise": {"kind": "laplace"}}, ValueError, "'laplace'"),
+        ({"noise": {"kind": "uniform", "outlier_rate": 2.0}}, ValueError, "2.0"),
+        ({"target_area": 0.0}, ValueError, "target_area.*0.0"),
+        ({"max_moves": 0}, ValueError, "max_moves.*0"),
+        ({"move_length": (0.3, 0.1)}, ValueError, r"\(0.3, 0.1\)"),
+        ({"move_length": -1.0}, ValueError, "-1.0"),
+        ({"path_cost": -1.0}, ValueError, "path_cost.*-1.0"),
+        ({"max_landmarks": 2}, ValueError, "max_landmarks.*2"),
+        ({"render_mode": "ascii"}, ValueError, "'ascii'"),
+        ({"scenario": "khepera", "n_landmarks": 5}, ValueError, "n_landmarks=5"),
+        ({"scenario": "custom"}, ValueError, "landmarks"),
+        ({"landmarks": [[0.1, 0.1], [0.2, 0.1]]}, ValueError, "landmarks.*2"),
+        ({"landmarks": [[0.1, 0.1], [0.2, 0.1], [5.0, 0.3]]}, ValueError, r"\[5.0, 0.3\]"),
+        ({"landmarks": [[0.1, 0.1], [0.1, 0.1], [0.3, 0.3]]}, ValueError, "distinct"),
+        ({"scenario": "khepera", "landmarks": [[0.1, 0.1], [0.2, 0.1], [0.3, 0.3]]},
+         ValueError, "khepera"),
+        ({"colour": "red"}, TypeError, "colour"),
+    ],
+)
+@pytest.mark.parametrize("env_class", [BearingSLAMEnv, BearingSLAMDiscreteEnv])
+def test_invalid_kwargs_raise_naming_the_value(
+    env_class: type[BearingSLAMEnv], kwargs: dict[str, Any], error: type, fragment: str
+) -> None:
+    with pytest.raises(error, match=fragment):
+        env_class(**kwargs)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_invalid_kwargs_through_make(env_id: str) -> None:
+    with pytest.raises(TypeError, match="colour"):
+        gym.make(env_id, colour="red")
+    with pytest.raises(ValueError, match=r"epsilon_deg.*90"):
+        gym.make(env_id, epsilon_deg=90)
+
+
+@pytest.mark.parametrize(
+    "action",
+    [
+        [math.nan, 0.0],
+        [0.0, math.inf],
+        [1.5, 0.0],
+        [0.0, -1.01],
+        [0.1, 0.2, 0.3],
+        "left",
+    ],
+)
+def test_bad_continuous_actions_raise(action: Any) -> None:
+    env = BearingSLAMEnv()
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="action"):
+        env.step(np.array(action, dtype=object) if isinstance(action, str) else action)
+
+
+def test_continuous_action_accepts_lists_and_float64_at_the_bounds() -> None:
+    env = BearingSLAMEnv(move_length=(0.1, 0.2))
+    env.reset(seed=0)
+    env.step([1.0, -1.0])
+    env.step(np.array([-1.0, 1.0]))
+    assert env._decode_action([1.0, -1.0]) == (math.pi, 0.1)
+    assert env._decode_action(np.float32([-1.0, 1.0]))[1] == pytest.approx(0.2)
+
+
+@pytest.mark.parametrize("action", [-1, 24, 2.5, math.nan, True, [1, 2]])
+def test_bad_discrete_actions_raise(action: Any) -> None:
+    env = BearingSLAMDiscreteEnv()
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="action"):
+        env.step(action)
+
+
+def test_discrete_action_table() -> None:
+    env = BearingSLAMDiscreteEnv(move_length=(0.1, 0.3), n_turns=4, n_move_lengths=3)
+    assert env.action_space.n == 12
+    np.testing.assert_allclose(env.turn_angles, [0, np.pi / 2, -np.pi, -np.pi / 2])
+    np.testing.assert_allclose(env.move_lengths, [0.1, 0.2, 0.3])
+    assert env._decode_action(np.int64(7)) == pytest.approx((-np.pi, 0.2))
+    assert BearingSLAMDiscreteEnv(move_length=0.25).action_space.n == 8
+
+
+def test_step_before_reset_raises() -> None:
+    with pytest.raises(RuntimeError, match="reset"):
+        BearingSLAMEnv().step([0.0, 0.0])
+
+
+# --------------------------------------------------------------------------------------
+# Fuzz: observations stay finite and in the space
+# --------------------------------------------------------------------------------------
+
+configurations = st.fixed_dictionaries(
+    {
+        "scenario": st.sampled_from(["random", "khepera", "paper_sim"]),
+        "n_landmarks": st.integers(3, 9),
+        "epsilon_deg": st.floats(0.2, 30.0),
+        "noise": st.fixed_dictionaries(
+            {
+                "kind": st.sampled_from(["uniform", "gaussian", "none"]),
+                "bound_deg": st.none() | st.floats(0.0, 20.0),
+                "outlier_rate": st.sampled_from([0.0, 0.1, 0.5]),
+            }
+        ),
+        "transfer": st.sampled_from(["conservative", "paper"]),
+        "reward": st.sampled_from(["log_area", "area"]),
+        "move_length": st.sampled_from([None, 0.01, (0.001, 1.0), (0.2, 3.0)]),
+        "area_cap": st.sampled_from([0.5, 10.0, 1e4]),
+        "arena": st.sampled_from([None, (0.3, 2.0), (4.0, 4.0)]),
+    }
+)
+unit = st.floats(-1.0, 1.0)
+
+
+@settings(
+    max_examples=20,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+@given(
+    config=configurations,
+    actions=st.lists(st.tuples(unit, unit), min_size=1, max_size=12),
+    seed=st.integers(0, 2**31 - 1),
+)
+def test_fuzz_observations_stay_finite(
+    config: dict[str, Any], actions: list[tuple[float, float]], seed: int
+) -> None:
+    if config["scenario"] != "random":
+        config = {**config, "n_landmarks": None}
+        if config["arena"] is not None:
+            config = {**config, "arena": None}  # fixed layouts need their own arena
+    env = BearingSLAMEnv(**config)
+    observation, _ = env.reset(seed=seed)
+    assert env.observation_space.contains(observation)
+    for action in actions:
+        observation, reward, terminated, truncated, info = env.step(
+            np.array(action, dtype=np.float32)
+        )
+        assert env.observation_space.contains(observation), observation
+        assert math.isfinite(reward)
+        assert set(info) == INFO_KEYS
+        if terminated or truncated:
+            observation, _ = env.reset()
+
+
+# --------------------------------------------------------------------------------------
+# Training smoke test
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_ppo_learns_a_few_hundred_steps(env_id: str) -> None:
+    from stable_baselines3 import PPO
+
+    env = gym.make(env_id, scenario="khepera")
+    model = PPO("MlpPolicy", env, n_steps=64, batch_size=32, n_epochs=2, seed=0, device="cpu")
+    model.learn(total_timesteps=256)
+    assert model.num_timesteps >= 256
+    observation, _ = env.reset(seed=0)
+    action, _ = model.predict(observation, deterministic=True)
+    assert env.action_space.contains(action)
+    env.step(action)
