@@ -114,7 +114,7 @@ class PolygonSLAM:
         n_landmarks: int,
         epsilon: float,
         transfer: str = "conservative",
-        directions: int = 64,
+        directions: int = 32,
         edge_samples: int = 3,
         on_inconsistency: str = "restart",
     ) -> None:

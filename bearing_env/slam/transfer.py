@@ -108,17 +108,15 @@ def make_hypotheses(
         h1, h2 = a1, a2
         delta1 = delta2 = 0.0
     else:
-        delta1 = float(max_edge_length(a1)) / edge_samples
-        delta2 = float(max_edge_length(a2)) / edge_samples
+        delta1 = max_edge_length(a1) / edge_samples
+        delta2 = max_edge_length(a2) / edge_samples
         if max(delta1, delta2) > 2.0 * distance:
             return "l1_l2_too_close"
-        h1 = boundary_samples(a1, edge_samples)
-        h2 = boundary_samples(a2, edge_samples)
+        h1, h2 = boundary_samples(np.stack([a1, a2]), edge_samples)
     h1_pairs = np.repeat(h1, h2.shape[-1])
-    h2_pairs = np.tile(h2, h1.shape[-1])
     return Hypotheses(
         h1=h1_pairs,
-        inv_d=1.0 / (h2_pairs - h1_pairs),
+        inv_d=1.0 / (h2[None, :] - h1[:, None]).reshape(-1),
         a1=a1,
         a2=a2,
         distance=distance,
