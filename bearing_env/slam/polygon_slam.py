@@ -102,7 +102,9 @@ class PolygonSLAM:
         transfer: ``"conservative"`` (regions contain the truth whenever the bearing
             noise is within +-epsilon) or ``"paper"`` (vertex hypotheses + hull).
         directions: number K of normals of the region K-gons (even, >= 8).
-        edge_samples: samples per edge of A_L1 and A_L2 for the conservative transfer.
+        edge_samples: samples per edge of A_L1 and A_L2 for the conservative transfer
+            (more are used, up to 8, when L1's and L2's regions are close relative to
+            their size).
         on_inconsistency: what a landmark's region becomes when a movement's region
             misses it (the observations contradict epsilon): ``"restart"`` replaces it by
             the movement's region (the newest evidence; the old intersection is known to
@@ -141,6 +143,8 @@ class PolygonSLAM:
         self.transfer = transfer
         self.edge_samples = int(edge_samples)
         self.on_inconsistency = on_inconsistency
+        if isinstance(directions, bool) or not isinstance(directions, (int, np.integer)):
+            raise TypeError(f"directions must be an int, got {directions!r}")
         self.kgon = KGon(int(directions))
         self.reset()
 
@@ -154,7 +158,7 @@ class PolygonSLAM:
         self._robot_support: NDArray[np.float64] | None = None
         self._robot_heading = float("nan")
         self._areas = np.full(n, np.inf)
-        self._centroids = np.full(n, np.nan + 0j)
+        self._centroids = np.full(n, complex(np.nan, np.nan))
         self._robot_centroid = complex(np.nan, np.nan)
         self.n_updates = 0
         self.n_frame_changes = 0

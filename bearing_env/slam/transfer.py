@@ -28,15 +28,17 @@ Two transfers are offered:
        the other region. Applying this once per hypothesis, every image lies within
        ``r = (V2 delta1**2 + V1 delta2**2) / (4 D**3)`` of the hull of the sampled images.
 
-    The sagitta bound needs ``delta <= 2 D`` (arcs under a half circle). When L1's and
-    L2's regions are too close for that, relative to their size, a movement cannot bound
-    its transfer usefully and is refused (``"l1_l2_too_close"``). The region is the
-    sampled hull grown by ``r``, which shrinks with the square of the number of samples
-    per edge.
+    The sagitta bound needs ``delta <= 2 D`` (arcs under a half circle). Edges are cut
+    finely enough for that, up to :data:`MAX_EDGE_SAMPLES` pieces; a movement whose L1
+    and L2 regions are closer still, relative to their size, is refused
+    (``"l1_l2_too_close"``): its frame change is too uncertain to be useful. The region
+    is the sampled hull grown by ``r``, which shrinks with the square of the number of
+    samples per edge.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,6 +53,10 @@ from bearing_env.slam.geometry import (
 )
 
 TRANSFERS = ("conservative", "paper")
+
+#: Most samples per edge of A_L1 and A_L2 the conservative transfer uses (it uses more
+#: than ``edge_samples`` only when L1 and L2 are close relative to their regions' size).
+MAX_EDGE_SAMPLES = 8
 
 @dataclass(frozen=True)
 class Hypotheses:
@@ -101,18 +107,23 @@ def make_hypotheses(
     """
     if transfer not in TRANSFERS:
         raise ValueError(f"transfer must be one of {TRANSFERS}, got {transfer!r}")
-    distance = float(polygon_distance(a1, a2))
+    if a1.shape != a2.shape:  # pad the shorter by repeating its last vertex
+        size = max(a1.size, a2.size)
+        a1 = np.concatenate([a1, np.repeat(a1[-1:], size - a1.size)])
+        a2 = np.concatenate([a2, np.repeat(a2[-1:], size - a2.size)])
+    distance = polygon_distance(a1, a2)
     if not distance > 0.0:
         return "l1_l2_overlap"
     if transfer == "paper":
         h1, h2 = a1, a2
         delta1 = delta2 = 0.0
     else:
-        delta1 = max_edge_length(a1) / edge_samples
-        delta2 = max_edge_length(a2) / edge_samples
-        if max(delta1, delta2) > 2.0 * distance:
+        longest1, longest2 = max_edge_length(a1), max_edge_length(a2)
+        per_edge = max(edge_samples, math.ceil(max(longest1, longest2) / (2.0 * distance)))
+        if per_edge > MAX_EDGE_SAMPLES:
             return "l1_l2_too_close"
-        h1, h2 = boundary_samples(np.stack([a1, a2]), edge_samples)
+        delta1, delta2 = longest1 / per_edge, longest2 / per_edge
+        h1, h2 = boundary_samples(np.stack([a1, a2]), per_edge)
     h1_pairs = np.repeat(h1, h2.shape[-1])
     return Hypotheses(
         h1=h1_pairs,
