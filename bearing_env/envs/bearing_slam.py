@@ -533,9 +533,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             result = self._slam.update(start_bearings, end_bearings)
             frame_changed, inconsistent = bool(result.frame_changed), int(result.n_inconsistent)
             if frame_changed:
-                # The robot's region only changes here; its vertices are costly to rebuild.
-                robot_polygon = self._slam.robot_polygon
-                self._robot_area = None if robot_polygon is None else _polygon_area(robot_polygon)
+                self._robot_area = self._slam.robot_area
 
         self._moves += 1
         self._latest_bearings = end_bearings
@@ -730,8 +728,3 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             robot_radius=self.arena.wall_margin,
         )
 
-
-def _polygon_area(vertices: FloatArray) -> float:
-    """Shoelace area of a simple polygon (k, 2)."""
-    x, y = vertices[:, 0], vertices[:, 1]
-    return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))

@@ -160,6 +160,7 @@ class PolygonSLAM:
         self._areas = np.full(n, np.inf)
         self._centroids = np.full(n, complex(np.nan, np.nan))
         self._robot_centroid = complex(np.nan, np.nan)
+        self._robot_area = float("inf")
         self.n_updates = 0
         self.n_frame_changes = 0
         self.n_inconsistent = 0
@@ -231,6 +232,7 @@ class PolygonSLAM:
         self._robot_support = robot
         area, centroid = self.kgon.area_centroid(np.concatenate([robot[None], fused]))
         self._robot_centroid = complex(centroid[0])
+        self._robot_area = float(area[0])
         self._areas[idx] = area[1:]
         self._centroids[idx] = centroid[1:]
         # Heading: the FR x-axis seen through T at the vertex means of A_L1 and A_L2.
@@ -301,6 +303,11 @@ class PolygonSLAM:
     def robot_estimate(self) -> NDArray[np.float64]:
         """Centroid (2,) of the robot's region in FL; ``nan`` before any frame change."""
         return np.array([self._robot_centroid.real, self._robot_centroid.imag])
+
+    @property
+    def robot_area(self) -> float:
+        """Area of the robot's region in FL units squared; ``inf`` before any frame change."""
+        return self._robot_area
 
     @property
     def robot_heading(self) -> float:
