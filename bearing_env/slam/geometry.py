@@ -292,8 +292,13 @@ class KGon:
             ``(h, empty)``: tight supports and a mask of empty intersections (where ``h``
             is undefined).
         """
-        vp, vc = self.vertices(hp), self.vertices(hc)
         owner_p = hp <= hc
+        # Nested K-gons (common: a new movement's region often covers the map's) need no
+        # clipping: the inner one is the intersection, and it is tight.
+        p_inside = owner_p.all(axis=-1)
+        if np.all(p_inside | (~owner_p).all(axis=-1)):
+            return np.where(p_inside[..., None], hp, hc), np.zeros(p_inside.shape, dtype=bool)
+        vp, vc = self.vertices(hp), self.vertices(hc)
         h_own = np.where(owner_p, hp, hc)
         # Edge k runs from vertex k-1 to vertex k of its owner.
         start = np.where(owner_p, vp[..., self._prev], vc[..., self._prev])
