@@ -1,0 +1,540 @@
+"""``bearing-env train``: tiny runs of each algorithm, save/load, resume, Ctrl-C, rl-zoo3.
+
+Runs are a few hundred steps with small networks and in-process envs (``DummyVecEnv``);
+one test runs the real command in a subprocess with ``SubprocVecEnv`` (spawn) and
+interrupts it with Ctrl-C. The rl-zoo3 command starts at the beginning of the module and
+runs in the background (it spends most of its time importing); its test checks it last.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+import zipfile
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import yaml
+
+import train.train as train_module
+from train.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
+from train.train import (
+    EXIT_INTERRUPTED,
+    MAX_EVAL_EPISODES,
+    TRAINING_SEED_LIMIT,
+    VALIDATION_SEED_START,
+    EpisodeSeedCycle,
+    LinearSchedule,
+    TrainResult,
+    TrainSettings,
+    export_run,
+    load_model,
+    load_vecnormalize,
+    make_validation_env,
+    parse_hyperparameters,
+    parse_key_values,
+    read_hyperparameters,
+    train,
+    training_seed_start,
+)
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+ALGOS = ("ppo", "sac", "dqn")
+TINY_NET = "dict(net_arch=[32, 32])"
+#: Small versions of the shipped configs: same files, a few hundred steps.
+TINY_HYPERPARAMS: dict[str, dict[str, Any]] = {
+    "ppo": {"n_steps": 64, "batch_size": 64, "n_epochs": 2, "policy_kwargs": TINY_NET},
+    "sac": {
+        "learning_starts": 64,
+        "batch_size": 32,
+        "buffer_size": 2_000,
+        "gradient_steps": 1,
+        "policy_kwargs": TINY_NET,
+    },
+    "dqn": {
+        "learning_starts": 64,
+        "batch_size": 32,
+        "buffer_size": 2_000,
+        "train_freq": 1,
+        "gradient_steps": 1,
+        "target_update_interval": 64,
+        "policy_kwargs": TINY_NET,
+    },
+}
+TINY_TIMESTEPS = 256
+PYTHON = sys.executable
+
+
+def tiny_settings(algo: str, output: Path, **changes: Any) -> TrainSettings:
+    settings = TrainSettings(
+        algo=algo,
+        env_id=train_module.DEFAULT_ENV_IDS[algo],
+        output=output,
+        hyperparam_overrides=dict(TINY_HYPERPARAMS[algo]),
+        timesteps=TINY_TIMESTEPS,
+        seed=3,
+        n_envs=2,
+        vec_env="dummy",
+        eval_freq=128,
+        eval_episodes=2,
+        checkpoint_freq=128,
+        progress_bar=False,
+        tensorboard=False,
+        verbose=0,
+    )
+    return replace(settings, **changes)
+
+
+@pytest.fixture(scope="module")
+def tiny_runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, TrainResult]:
+    """One tiny finished run per algorithm (PPO also writes TensorBoard logs)."""
+    root = tmp_path_factory.mktemp("runs")
+    return {
+        algo: train(tiny_settings(algo, root / algo, tensorboard=algo == "ppo")) for algo in ALGOS
+    }
+
+
+def _observations(env_id: str, count: int = 16) -> np.ndarray:
+    env = gym.make(env_id, scenario="khepera")
+    observations = []
+    obs, _ = env.reset(seed=VALIDATION_SEED_START)
+    for _ in range(count):
+        observations.append(obs)
+        obs, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if terminated or truncated:
+            obs, _ = env.reset()
+    env.close()
+    return np.asarray(observations, dtype=np.float32)
+
+
+# --------------------------------------------------------------------------------------
+# Tiny runs, save/load
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("algo", ALGOS)
+def test_tiny_run_writes_a_complete_run_folder(
+    tiny_runs: dict[str, TrainResult], algo: str
+) -> None:
+    result = tiny_runs[algo]
+    run = result.run_dir
+    assert result.num_timesteps == TINY_TIMESTEPS and not result.interrupted
+    record = json.loads((run / "run.json").read_text())
+    assert record["status"] == "finished"
+    assert record["num_timesteps"] == TINY_TIMESTEPS
+    assert record["env_kwargs"] == {"scenario": "khepera"}  # from the shipped YAML
+    assert record["seeds"]["validation"] == [VALIDATION_SEED_START, VALIDATION_SEED_START + 2]
+    for name in ("model.zip", "vecnormalize.pkl", "best/best_model.zip", "best/vecnormalize.pkl"):
+        assert (run / name).is_file(), name
+    summary = json.loads((run / "best" / BEST_SUMMARY_NAME).read_text())
+    assert {"mean_reward", "median_total_area_10", "median_total_area_final"} <= summary.keys()
+    latest = CheckpointStore(run / "checkpoints").latest()
+    assert latest is not None and latest.timesteps == TINY_TIMESTEPS
+    assert latest.vecnormalize_path.is_file()
+    assert latest.replay_buffer_path.is_file() == (algo != "ppo")
+    expected_space = gym.spaces.Discrete if algo == "dqn" else gym.spaces.Box
+    assert isinstance(result.model.action_space, expected_space)
+    assert (run / "monitor" / "0.monitor.csv").is_file()
+    assert any((run / "tensorboard").rglob("events.out.tfevents.*")) == (algo == "ppo")
+
+
+@pytest.mark.parametrize("algo", ALGOS)
+def test_saved_model_and_statistics_predict_like_the_trained_model(
+    tiny_runs: dict[str, TrainResult], algo: str
+) -> None:
+    result = tiny_runs[algo]
+    raw = _observations(train_module.DEFAULT_ENV_IDS[algo])
+    trained_normalizer = result.model.get_vec_normalize_env()
+    assert trained_normalizer is not None
+    expected, _ = result.model.predict(trained_normalizer.normalize_obs(raw), deterministic=True)
+
+    loaded = load_model(result.run_dir / "model.zip", algo)
+    eval_venv = make_validation_env(train_module.DEFAULT_ENV_IDS[algo], {"scenario": "khepera"}, 1)
+    loaded_normalizer = load_vecnormalize(result.run_dir / "vecnormalize.pkl", eval_venv)
+    actual, _ = loaded.predict(loaded_normalizer.normalize_obs(raw), deterministic=True)
+    eval_venv.close()
+    np.testing.assert_array_equal(actual, expected)
+    assert loaded.num_timesteps == TINY_TIMESTEPS
+
+
+def test_same_seed_gives_the_same_model(tmp_path: Path) -> None:
+    settings = tiny_settings("ppo", tmp_path / "a", timesteps=128, eval_freq=0)
+    first = train(settings)
+    second = train(replace(settings, output=tmp_path / "b"))
+    for (name, a), (_, b) in zip(
+        first.model.policy.state_dict().items(),
+        second.model.policy.state_dict().items(),
+        strict=True,
+    ):
+        assert np.array_equal(a.numpy(), b.numpy()), name
+
+
+# --------------------------------------------------------------------------------------
+# Resume, interruption
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("algo", ["ppo", "dqn"])
+def test_resume_continues_from_the_latest_checkpoint(
+    tmp_path: Path, algo: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    run = tmp_path / algo
+    first = train(tiny_settings(algo, run, eval_freq=128))
+    assert first.num_timesteps == TINY_TIMESTEPS
+
+    loaded_paths: list[Path] = []
+    real_load_model = train_module.load_model
+
+    def spy_load_model(path: str | Path, *args: Any, **kwargs: Any) -> Any:
+        loaded_paths.append(Path(path))
+        return real_load_model(path, *args, **kwargs)
+
+    monkeypatch.setattr(train_module, "load_model", spy_load_model)
+    resumed = train(tiny_settings(algo, run, timesteps=2 * TINY_TIMESTEPS, resume=True))
+
+    assert loaded_paths == [run / "checkpoints" / f"rl_model_{TINY_TIMESTEPS}_steps.zip"]
+    assert resumed.num_timesteps == 2 * TINY_TIMESTEPS
+    record = json.loads((run / "run.json").read_text())
+    assert [(s["start_timesteps"], s["end_timesteps"]) for s in record["segments"]] == [
+        (0, TINY_TIMESTEPS),
+        (TINY_TIMESTEPS, 2 * TINY_TIMESTEPS),
+    ]
+    evaluations = np.load(run / "best" / "evaluations.npz")
+    assert list(evaluations["timesteps"]) == [128, 256, 384, 512]  # history carried over
+    if algo == "dqn":  # the replay buffer came back with the checkpoint
+        buffer = resumed.model.replay_buffer
+        assert buffer is not None and buffer.size() == 2 * TINY_TIMESTEPS // 2  # per env
+    latest = CheckpointStore(run / "checkpoints").latest()
+    assert latest is not None and latest.timesteps == 2 * TINY_TIMESTEPS
+    # An already finished run: nothing to do, nothing changes.
+    again = train(tiny_settings(algo, run, timesteps=2 * TINY_TIMESTEPS, resume=True))
+    assert again.num_timesteps == 2 * TINY_TIMESTEPS
+
+
+def test_a_new_run_refuses_to_overwrite_an_existing_one(tiny_runs: dict[str, TrainResult]) -> None:
+    with pytest.raises(FileExistsError, match="--resume"):
+        train(tiny_settings("ppo", tiny_runs["ppo"].run_dir))
+
+
+def test_resume_refuses_other_settings(tiny_runs: dict[str, TrainResult], tmp_path: Path) -> None:
+    run = tiny_runs["sac"].run_dir
+    with pytest.raises(ValueError, match="env kwargs"):
+        train(tiny_settings("sac", run, resume=True, env_kwargs={"scenario": "random"}))
+    with pytest.raises(ValueError, match="replay buffer"):
+        train(tiny_settings("sac", run, resume=True, n_envs=3))
+    with pytest.raises(FileNotFoundError, match="no run to resume"):
+        train(tiny_settings("ppo", tmp_path / "nothing", resume=True))
+
+
+def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path: Path) -> None:
+    """The real command, SubprocVecEnv with spawn, Ctrl-C sent to the whole process group."""
+    run = tmp_path / "interrupted"
+    command = [
+        PYTHON, "-m", "train.cli", "train", "--algo", "ppo", "--output", str(run),
+        "--vec-env", "subproc", "--n-envs", "2", "--timesteps", "1000000", "--seed", "5",
+        "--hyperparams", "n_steps=16", "batch_size=32", "n_epochs=1", f"policy_kwargs={TINY_NET}",
+        "--checkpoint-freq", "32", "--eval-freq", "0", "--no-progress", "--no-tensorboard",
+    ]  # fmt: skip
+    process = subprocess.Popen(
+        command,
+        cwd=REPO_ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,  # its own process group, like a terminal job
+    )
+    store = CheckpointStore(run / "checkpoints")
+    try:
+        deadline = time.monotonic() + 90
+        while store.latest() is None:
+            assert process.poll() is None, process.communicate()[0]
+            assert time.monotonic() < deadline, "no checkpoint within 90 s"
+            time.sleep(0.2)
+        periodic = store.latest()
+        assert periodic is not None
+        os.killpg(process.pid, signal.SIGINT)  # what Ctrl-C in a terminal does
+        output, _ = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+    assert process.returncode == EXIT_INTERRUPTED, output
+    assert "--resume" in output
+    record = json.loads((run / "run.json").read_text())
+    latest = store.latest()
+    assert latest is not None and record["status"] == "interrupted"
+    assert latest.timesteps == record["num_timesteps"] > periodic.timesteps
+    assert latest.vecnormalize_path.is_file()
+    assert not (run / "model.zip").exists()  # the budget was not reached
+
+    target = latest.timesteps + 64
+    resumed = train(
+        tiny_settings(
+            "ppo",
+            run,
+            resume=True,
+            timesteps=target,
+            checkpoint_freq=64,
+            eval_freq=0,
+            seed=5,
+            hyperparam_overrides={},
+        )
+    )
+    assert resumed.num_timesteps >= target
+    record = json.loads((run / "run.json").read_text())
+    assert record["status"] == "finished"
+    assert record["segments"][-1]["start_timesteps"] == latest.timesteps
+    assert record["segments"][0]["vec_env"] == "subproc"
+
+
+# --------------------------------------------------------------------------------------
+# Clear errors for missing and corrupt files
+# --------------------------------------------------------------------------------------
+
+
+def test_missing_model_file_names_the_path(tmp_path: Path) -> None:
+    missing = tmp_path / "nowhere" / "model.zip"
+    with pytest.raises(FileNotFoundError, match=re.escape(str(missing))):
+        load_model(missing, "ppo")
+
+
+@pytest.mark.parametrize("damage", ["garbage", "truncated", "not_sb3"])
+def test_corrupt_model_file_names_the_path(
+    tiny_runs: dict[str, TrainResult], tmp_path: Path, damage: str
+) -> None:
+    path = tmp_path / "broken.zip"
+    good = (tiny_runs["ppo"].run_dir / "model.zip").read_bytes()
+    if damage == "garbage":
+        path.write_bytes(b"this is not a model" * 100)
+    elif damage == "truncated":
+        path.write_bytes(good[: len(good) // 2])
+    else:
+        with zipfile.ZipFile(path, "w") as archive:
+            archive.writestr("hello.txt", "a zip, but not a stable-baselines3 model")
+    with pytest.raises(ValueError, match=re.escape(str(path))):
+        load_model(path, "ppo")
+
+
+def test_corrupt_statistics_and_checkpoint_name_the_path(
+    tiny_runs: dict[str, TrainResult], tmp_path: Path
+) -> None:
+    stats = tmp_path / "vecnormalize.pkl"
+    stats.write_bytes(b"\x80\x04 truncated pickle")
+    venv = make_validation_env("BearingSLAM-v0", {"scenario": "khepera"}, 1)
+    with pytest.raises(ValueError, match=re.escape(str(stats))):
+        load_vecnormalize(stats, venv)
+    with pytest.raises(FileNotFoundError, match=re.escape("missing.pkl")):
+        load_vecnormalize(tmp_path / "missing.pkl", venv)
+    venv.close()
+
+    run = tmp_path / "run"
+    train(tiny_settings("ppo", run, timesteps=128, eval_freq=0))
+    latest = CheckpointStore(run / "checkpoints").latest()
+    assert latest is not None
+    latest.model_path.write_bytes(b"damaged on disk")
+    with pytest.raises(ValueError, match=re.escape(latest.model_path.name)):
+        train(tiny_settings("ppo", run, timesteps=256, eval_freq=0, resume=True))
+
+
+def test_cli_reports_errors_without_a_traceback(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        train_module.main(["--algo", "ppo", "--output", str(tmp_path / "none"), "--resume"])
+    assert exit_info.value.code == 2
+    assert "no run to resume" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------------------
+# Export for agents/pretrained
+# --------------------------------------------------------------------------------------
+
+
+def test_export_writes_the_pretrained_layout(
+    tiny_runs: dict[str, TrainResult], tmp_path: Path
+) -> None:
+    run = tiny_runs["ppo"].run_dir
+    exported = export_run(run, tmp_path / "pretrained" / "ppo_tiny")
+    folder = tmp_path / "pretrained"
+    assert sorted(p.name for p in folder.iterdir()) == [
+        "ppo_tiny.json",
+        "ppo_tiny.zip",
+        "ppo_tiny_vecnormalize.pkl",
+    ]
+    assert exported.source == "best"
+    assert (folder / "ppo_tiny.zip").read_bytes() == (run / "best" / BEST_MODEL_NAME).read_bytes()
+    metadata = json.loads((folder / "ppo_tiny.json").read_text())
+    assert metadata["algo"] == "ppo" and metadata["env_id"] == "BearingSLAM-v0"
+    assert metadata["env_kwargs"] == {"scenario": "khepera"}
+    assert metadata["files"] == {
+        "model": "ppo_tiny.zip",
+        "vecnormalize": "ppo_tiny_vecnormalize.pkl",
+    }
+
+    # The exported files act like the run's best model, through agents.SB3Policy.
+    sb3_module = pytest.importorskip("agents.sb3")
+    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    policy = sb3_module.SB3Policy(env, folder / "ppo_tiny.zip")
+    best = load_model(run / "best" / BEST_MODEL_NAME, "ppo")
+    venv = make_validation_env("BearingSLAM-v0", {"scenario": "khepera"}, 1)
+    stats = load_vecnormalize(run / "best" / "vecnormalize.pkl", venv)
+    observation, info = env.reset(seed=VALIDATION_SEED_START)
+    expected, _ = best.predict(stats.normalize_obs(observation), deterministic=True)
+    np.testing.assert_array_equal(policy.act(observation, info), expected)
+    env.close()
+    venv.close()
+
+
+# --------------------------------------------------------------------------------------
+# Hyperparameter files, seeds, rl-zoo3
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("algo", "env_id"),
+    [("ppo", "BearingSLAM-v0"), ("ppo", "BearingSLAMDiscrete-v0"), ("sac", "BearingSLAM-v0"),
+     ("dqn", "BearingSLAMDiscrete-v0")],
+)  # fmt: skip
+def test_shipped_hyperparameters_parse(algo: str, env_id: str) -> None:
+    raw = read_hyperparameters(algo, env_id)
+    parsed = parse_hyperparameters(raw)
+    assert parsed.n_envs >= 1 and parsed.n_timesteps >= 1
+    assert parsed.env_kwargs == {"scenario": "khepera"}
+    assert parsed.normalize is not None and parsed.normalize["gamma"] == raw["gamma"]
+    assert isinstance(parsed.algorithm_kwargs["policy_kwargs"], dict)
+    gym.make(env_id, **parsed.env_kwargs).close()
+    constructor_kwargs = {k: v for k, v in parsed.algorithm_kwargs.items() if k != "policy"}
+    if algo != "ppo":
+        constructor_kwargs["buffer_size"] = 10  # the model builds, without a big buffer
+    algorithm_class = train_module.ALGORITHMS[algo]
+    algorithm_class(parsed.algorithm_kwargs["policy"], env_id, device="cpu", **constructor_kwargs)
+
+
+def test_hyperparameter_parsing_follows_rl_zoo3() -> None:
+    parsed = parse_hyperparameters(
+        {
+            "n_timesteps": 1e5,
+            "policy": "MlpPolicy",
+            "learning_rate": "lin_0.001",
+            "normalize": "dict(norm_obs=True, norm_reward=False)",
+            "gamma": 0.9,
+            "policy_kwargs": "dict(net_arch=[64, 64], activation_fn=nn.ReLU)",
+            "train_freq": [4, "step"],
+        }
+    )
+    schedule = parsed.algorithm_kwargs["learning_rate"]
+    assert isinstance(schedule, LinearSchedule) and schedule(0.5) == pytest.approx(5e-4)
+    assert parsed.normalize == {"norm_obs": True, "norm_reward": False, "gamma": 0.9}
+    assert parsed.algorithm_kwargs["train_freq"] == (4, "step")
+    assert parsed.n_envs == 1 and parsed.n_timesteps == 100_000
+    with pytest.raises(ValueError, match="frame_stack"):
+        parse_hyperparameters({"n_timesteps": 10, "frame_stack": 4})
+    with pytest.raises(ValueError, match="policy_kwargs"):
+        parse_hyperparameters({"n_timesteps": 10, "policy_kwargs": "__import__('os')"})
+    assert parse_key_values(["scenario=khepera", "move_length=(0.1, 0.3)", "n=4"], "x") == {
+        "scenario": "khepera",
+        "move_length": (0.1, 0.3),
+        "n": 4,
+    }
+    with pytest.raises(ValueError, match="key=value"):
+        parse_key_values(["scenario"], "--env-kwargs")
+
+
+def test_seed_ranges_are_disjoint_and_validation_episodes_repeat() -> None:
+    compare = pytest.importorskip("train.compare")
+    assert TRAINING_SEED_LIMIT <= VALIDATION_SEED_START
+    assert VALIDATION_SEED_START + MAX_EVAL_EPISODES <= compare.EVAL_SEED_START
+    assert training_seed_start(7, 10**9, 8) + 8 <= TRAINING_SEED_LIMIT
+    with pytest.raises(ValueError):
+        training_seed_start(TRAINING_SEED_LIMIT, 0, 1)
+
+    env = EpisodeSeedCycle(gym.make("BearingSLAM-v0"), [VALIDATION_SEED_START, 900_001])
+    first = [env.reset()[0] for _ in range(3)]
+    env.rewind_episode_seeds()
+    again = env.reset()[0]
+    np.testing.assert_array_equal(first[0], again)
+    np.testing.assert_array_equal(first[0], first[2])  # cycles
+    assert not np.array_equal(first[0], first[1])
+    env.close()
+
+
+@dataclass
+class BackgroundCommand:
+    """A command started early (it mostly waits on imports) and checked by a later test."""
+
+    process: subprocess.Popen[str]
+    folder: Path
+
+    def finish(self, timeout: float = 180) -> str:
+        output, _ = self.process.communicate(timeout=timeout)
+        return output
+
+
+@pytest.fixture(scope="module", autouse=True)
+def rl_zoo3_run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[BackgroundCommand | None]:
+    """``python -m rl_zoo3.train`` on the shipped PPO file, running while the other tests do."""
+    if importlib.util.find_spec("rl_zoo3") is None:
+        yield None
+        return
+    folder = tmp_path_factory.mktemp("rl_zoo3")
+    command = [
+        PYTHON, "-m", "rl_zoo3.train", "--gym-packages", "bearing_env", "--algo", "ppo",
+        "--env", "BearingSLAM-v0", "--conf-file", "train/hyperparams/ppo.yml", "-n", "300",
+        "-f", str(folder), "--device", "cpu", "--seed", "0",
+        "--hyperparams", "n_envs:2", "n_steps:64", f"policy_kwargs:'{TINY_NET}'",
+    ]  # fmt: skip
+    process = subprocess.Popen(
+        command, cwd=REPO_ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+    )
+    background = BackgroundCommand(process, folder)
+    yield background
+    if process.poll() is None:
+        process.kill()
+        process.communicate()
+
+
+def test_rl_zoo3_trains_with_the_shipped_yaml(rl_zoo3_run: BackgroundCommand | None) -> None:
+    if rl_zoo3_run is None:
+        pytest.skip("rl_zoo3 is not installed")
+    output = rl_zoo3_run.finish()
+    assert rl_zoo3_run.process.returncode == 0, output[-5000:]
+    run = rl_zoo3_run.folder / "ppo" / "BearingSLAM-v0_1"
+    assert (run / "BearingSLAM-v0.zip").is_file()
+    assert (run / "BearingSLAM-v0" / "vecnormalize.pkl").is_file()
+    # rl-zoo3 writes its config with Python tags (an OrderedDict of pairs).
+    saved_text = (run / "BearingSLAM-v0" / "config.yml").read_text()
+    saved = dict(yaml.load(saved_text, Loader=yaml.UnsafeLoader))
+    assert saved["env_kwargs"] == {"scenario": "khepera"}
+    assert saved["normalize"] is True
+    model = load_model(run / "BearingSLAM-v0.zip", "ppo")
+    assert model.num_timesteps >= 300
+
+
+def test_env_factory_raises_the_time_limit_with_max_moves() -> None:
+    env = train_module.EnvFactory("BearingSLAM-v0", {"scenario": "khepera", "max_moves": 23})()
+    assert env.spec is not None and env.spec.max_episode_steps == 23
+    env.reset(seed=1)
+    moves, done = 0, False
+    while not done:
+        _, _, terminated, truncated, info = env.step(np.array([0.5, 1.0], dtype=np.float32))
+        moves += 1
+        done = terminated or truncated
+    assert moves == 23 or info["is_success"]
+    env.close()
+
+
+def test_train_is_a_bearing_env_subcommand() -> None:
+    from train.cli import SUBCOMMANDS
+
+    assert SUBCOMMANDS["train"][0] == "train.train"

@@ -1,0 +1,294 @@
+"""stable-baselines3 callbacks and file helpers for ``bearing-env train``.
+
+- :class:`CheckpointStore`: the run's ``checkpoints/`` folder. A checkpoint is the model
+  (``rl_model_<N>_steps.zip``), its VecNormalize statistics
+  (``rl_model_vecnormalize_<N>_steps.pkl``) and, for off-policy algorithms, the replay
+  buffer (``rl_model_replay_buffer_<N>_steps.pkl``), the names SB3's own
+  ``CheckpointCallback`` uses. Every file is written to a temporary name and renamed, and
+  the model ``.zip`` is written last, so a checkpoint whose ``.zip`` exists is complete.
+- :class:`PeriodicCheckpointCallback`: a checkpoint every ``save_freq`` env steps.
+- :class:`StopOnRequestCallback`: ends ``learn()`` cleanly at the next env step once a
+  :class:`StopRequest` is set (by the Ctrl-C handler).
+- :class:`FixedSeedEvalCallback`: SB3's ``EvalCallback`` that plays the same validation
+  episodes (fixed reset seeds) at every evaluation, logs the total uncertainty area, saves
+  the VecNormalize statistics beside the best model, and carries its history over a
+  resume.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from stable_baselines3.common.base_class import BaseAlgorithm
+from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
+from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
+from stable_baselines3.common.vec_env import VecEnv, VecNormalize
+
+CHECKPOINT_PREFIX = "rl_model"
+_CHECKPOINT_MODEL_PATTERN = re.compile(rf"^{CHECKPOINT_PREFIX}_(\d+)_steps\.zip$")
+#: Files beside the best model (``best/``).
+BEST_MODEL_NAME = "best_model.zip"
+BEST_VECNORMALIZE_NAME = "vecnormalize.pkl"
+BEST_SUMMARY_NAME = "best.json"
+#: Validation metrics are reported at this move count (and at the end of the episode).
+AREA_REPORT_MOVE = 10
+
+
+@contextmanager
+def atomic_path(final_path: Path) -> Iterator[Path]:
+    """A temporary path in the same folder, renamed to ``final_path`` if the block succeeds."""
+    final_path.parent.mkdir(parents=True, exist_ok=True)
+    temporary = final_path.with_name(f".{final_path.name}.{os.getpid()}.tmp")
+    try:
+        yield temporary
+        os.replace(temporary, final_path)
+    finally:
+        if temporary.exists():
+            temporary.unlink()
+
+
+def write_json_atomically(path: Path, payload: dict[str, Any]) -> None:
+    with atomic_path(path) as temporary:
+        temporary.write_text(json.dumps(payload, indent=2, sort_keys=True) + "\n")
+
+
+def save_model_atomically(model: BaseAlgorithm, path: Path) -> None:
+    with atomic_path(path) as temporary, open(temporary, "wb") as handle:
+        model.save(handle)
+
+
+def save_vecnormalize_atomically(normalizer: VecNormalize, path: Path) -> None:
+    with atomic_path(path) as temporary:
+        normalizer.save(str(temporary))
+
+
+@dataclass(frozen=True)
+class Checkpoint:
+    """The files of one checkpoint (the optional ones may not exist)."""
+
+    timesteps: int
+    model_path: Path
+    vecnormalize_path: Path
+    replay_buffer_path: Path
+
+
+class CheckpointStore:
+    """Writes, lists and prunes the checkpoints of one run folder.
+
+    Args:
+        folder: the ``checkpoints/`` folder.
+        keep: model checkpoints to keep (older ones are deleted); at least 1. Replay
+            buffers are large, so only the newest one is kept.
+    """
+
+    def __init__(self, folder: Path, keep: int = 3) -> None:
+        if keep < 1:
+            raise ValueError(f"keep must be >= 1, got {keep}")
+        self.folder = folder
+        self.keep = keep
+
+    def checkpoint_at(self, timesteps: int) -> Checkpoint:
+        return Checkpoint(
+            timesteps=timesteps,
+            model_path=self.folder / f"{CHECKPOINT_PREFIX}_{timesteps}_steps.zip",
+            vecnormalize_path=self.folder
+            / f"{CHECKPOINT_PREFIX}_vecnormalize_{timesteps}_steps.pkl",
+            replay_buffer_path=self.folder
+            / f"{CHECKPOINT_PREFIX}_replay_buffer_{timesteps}_steps.pkl",
+        )
+
+    def list(self) -> list[Checkpoint]:
+        """The complete checkpoints, oldest first."""
+        if not self.folder.is_dir():
+            return []
+        found = []
+        for path in self.folder.iterdir():
+            match = _CHECKPOINT_MODEL_PATTERN.match(path.name)
+            if match:
+                found.append(self.checkpoint_at(int(match.group(1))))
+        return sorted(found, key=lambda checkpoint: checkpoint.timesteps)
+
+    def latest(self) -> Checkpoint | None:
+        checkpoints = self.list()
+        return checkpoints[-1] if checkpoints else None
+
+    def save(self, model: BaseAlgorithm) -> Checkpoint:
+        """Save the model's current state (model, VecNormalize, replay buffer) and prune."""
+        checkpoint = self.checkpoint_at(int(model.num_timesteps))
+        normalizer = model.get_vec_normalize_env()
+        if normalizer is not None:
+            save_vecnormalize_atomically(normalizer, checkpoint.vecnormalize_path)
+        if isinstance(model, OffPolicyAlgorithm) and model.replay_buffer is not None:
+            with atomic_path(checkpoint.replay_buffer_path) as temporary:
+                with open(temporary, "wb") as handle:
+                    model.save_replay_buffer(handle)
+        save_model_atomically(model, checkpoint.model_path)  # last: marks it complete
+        self._prune(newest=checkpoint)
+        return checkpoint
+
+    def _prune(self, newest: Checkpoint) -> None:
+        checkpoints = self.list()
+        for old in checkpoints[: max(len(checkpoints) - self.keep, 0)]:
+            for path in (old.model_path, old.vecnormalize_path, old.replay_buffer_path):
+                path.unlink(missing_ok=True)
+        for old in checkpoints:
+            if old.timesteps != newest.timesteps:
+                old.replay_buffer_path.unlink(missing_ok=True)
+
+
+class PeriodicCheckpointCallback(BaseCallback):
+    """Saves a checkpoint each time the run passes a multiple of ``save_freq`` env steps."""
+
+    def __init__(self, store: CheckpointStore, save_freq: int, verbose: int = 0) -> None:
+        super().__init__(verbose)
+        if save_freq < 1:
+            raise ValueError(f"save_freq must be >= 1 env steps, got {save_freq}")
+        self.store = store
+        self.save_freq = save_freq
+        self._next_save = save_freq
+
+    def _on_training_start(self) -> None:
+        done = int(self.model.num_timesteps)
+        self._next_save = (done // self.save_freq + 1) * self.save_freq
+
+    def _on_step(self) -> bool:
+        if self.num_timesteps >= self._next_save:
+            checkpoint = self.store.save(self.model)
+            self._next_save = (self.num_timesteps // self.save_freq + 1) * self.save_freq
+            if self.verbose >= 1:
+                print(f"checkpoint: {checkpoint.model_path}")
+        return True
+
+
+class StopRequest:
+    """A flag the signal handler sets and :class:`StopOnRequestCallback` reads."""
+
+    def __init__(self) -> None:
+        self.reason: str | None = None
+
+    def set(self, reason: str) -> None:
+        self.reason = reason
+
+    def __bool__(self) -> bool:
+        return self.reason is not None
+
+
+class StopOnRequestCallback(BaseCallback):
+    """Stops ``learn()`` at the next env step once ``request`` is set."""
+
+    def __init__(self, request: StopRequest) -> None:
+        super().__init__(verbose=0)
+        self.request = request
+
+    def _on_step(self) -> bool:
+        return not self.request
+
+
+class FixedSeedEvalCallback(EvalCallback):
+    """``EvalCallback`` on fixed validation episodes, with area metrics and resumable history.
+
+    The eval env's sub-envs must expose ``rewind_episode_seeds()`` (see
+    ``train.train.EpisodeSeedCycle``): it is called before every evaluation, so every
+    evaluation plays the same episodes and the best model is chosen on a fixed set.
+
+    Besides SB3's ``eval/mean_reward``, it logs ``eval/median_total_area_10`` (total area
+    of landmarks L3, L4, ..., each capped at ``area_cap``, after 10 moves; an episode that
+    ended earlier counts with its final map) and ``eval/median_total_area_final``, and
+    records them in ``best/best.json`` when the model is the best so far. The VecNormalize
+    statistics the evaluation used are saved as ``best/vecnormalize.pkl`` beside
+    ``best/best_model.zip``.
+    """
+
+    def __init__(self, eval_env: VecEnv, best_folder: Path, area_cap: float, **kwargs: Any) -> None:
+        super().__init__(
+            eval_env, best_model_save_path=str(best_folder), log_path=str(best_folder), **kwargs
+        )
+        self.best_folder = best_folder
+        self.area_cap = float(area_cap)
+        self._areas_at_report_move: list[float] = []
+        self._final_areas: list[float] = []
+        self._moves: dict[int, int] = {}
+        self.last_metrics: dict[str, float] = {}
+
+    def restore_history(self) -> None:
+        """Continue the best score and ``evaluations.npz`` of an earlier segment of the run."""
+        summary_path = self.best_folder / BEST_SUMMARY_NAME
+        if summary_path.is_file():
+            summary = json.loads(summary_path.read_text())
+            self.best_mean_reward = float(summary["mean_reward"])
+        history_path = self.best_folder / "evaluations.npz"
+        if history_path.is_file():
+            with np.load(history_path) as history:
+                self.evaluations_timesteps = [int(t) for t in history["timesteps"]]
+                self.evaluations_results = [list(map(float, r)) for r in history["results"]]
+                self.evaluations_length = [list(map(int, n)) for n in history["ep_lengths"]]
+
+    def _capped_total_area(self, info: dict[str, Any]) -> float:
+        areas = np.minimum(np.asarray(info["landmark_area"], dtype=np.float64), self.area_cap)
+        return float(areas.sum())
+
+    def _log_success_callback(self, locals_: dict[str, Any], globals_: dict[str, Any]) -> None:
+        """Called by ``evaluate_policy`` after every step of every eval sub-env."""
+        super()._log_success_callback(locals_, globals_)
+        info = locals_["info"]
+        env_index = int(locals_.get("i", 0))
+        moves = self._moves.get(env_index, 0) + 1
+        done = bool(locals_["done"])
+        if moves == AREA_REPORT_MOVE or (done and moves < AREA_REPORT_MOVE):
+            self._areas_at_report_move.append(self._capped_total_area(info))
+        if done:
+            self._final_areas.append(self._capped_total_area(info))
+        self._moves[env_index] = 0 if done else moves
+
+    def _on_step(self) -> bool:
+        evaluating = self.eval_freq > 0 and self.n_calls % self.eval_freq == 0
+        if not evaluating:
+            return super()._on_step()
+        self.eval_env.env_method("rewind_episode_seeds")
+        self._areas_at_report_move = []
+        self._final_areas = []
+        self._moves = {}
+        previous_best = self.best_mean_reward
+        continue_training = super()._on_step()
+        self.last_metrics = {
+            "mean_reward": float(self.last_mean_reward),
+            f"median_total_area_{AREA_REPORT_MOVE}": _median(self._areas_at_report_move),
+            "median_total_area_final": _median(self._final_areas),
+        }
+        for key, value in self.last_metrics.items():
+            if key != "mean_reward":
+                self.logger.record(f"eval/{key}", value)
+        if self.best_mean_reward > previous_best:
+            self._save_best_extras()
+        return continue_training
+
+    def _save_best_extras(self) -> None:
+        normalizer = self.model.get_vec_normalize_env()
+        if normalizer is not None:
+            save_vecnormalize_atomically(normalizer, self.best_folder / BEST_VECNORMALIZE_NAME)
+        write_json_atomically(
+            self.best_folder / BEST_SUMMARY_NAME,
+            {
+                "timesteps": int(self.num_timesteps),
+                "n_eval_episodes": int(self.n_eval_episodes),
+                "deterministic": bool(self.deterministic),
+                **self.last_metrics,
+            },
+        )
+
+
+def _median(values: list[float]) -> float:
+    return float(np.median(values)) if values else float("nan")
+
+
+def callback_calls(every_timesteps: int, n_envs: int) -> int:
+    """SB3 callbacks count vec-env steps (``n_envs`` env steps each): the call period."""
+    return max(every_timesteps // n_envs, 1)

@@ -1,0 +1,1059 @@
+"""``bearing-env train``: train PPO, SAC or DQN agents with stable-baselines3.
+
+    bearing-env train --algo ppo                                   # PPO, Khepera scenario
+    bearing-env train --algo sac --env BearingSLAM-v0 --timesteps 200000
+    bearing-env train --algo dqn --env BearingSLAMDiscrete-v0 --env-kwargs scenario=random
+    bearing-env train --algo ppo --output runs/ppo_khepera --resume --timesteps 2000000
+    bearing-env train --algo ppo --output runs/ppo_khepera --export-only \
+        --export agents/pretrained/ppo_khepera
+
+**Hyperparameters** come from ``train/hyperparams/<algo>.yml`` in rl-zoo3's format: one
+entry per env id holding ``n_envs``, ``n_timesteps``, ``policy``, ``normalize``,
+``env_kwargs``, ``policy_kwargs`` (a Python expression string) and the algorithm's
+constructor arguments (``lin_<x>`` is a schedule decaying linearly from ``x`` to 0). The
+same files run under rl-zoo3::
+
+    python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 \\
+        --conf-file train/hyperparams/ppo.yml
+
+``--env-kwargs k=v ...`` is merged over the entry's ``env_kwargs`` (rl-zoo3 replaces them
+instead), and ``--hyperparams k=v ...`` over the entry itself. Values are Python literals
+when they parse as one, strings otherwise.
+
+**Seeds.** Training env ``i`` first resets with seed ``s + i`` and then runs on from its
+own random stream, where ``s = --seed`` for a new run and ``(seed + t) mod (900000 -
+n_envs)`` for a segment resumed at timestep ``t``: every training seed is below
+``VALIDATION_SEED_START = 900000``. The periodic evaluation that picks the best model
+plays validation episode ``k`` with seed ``900000 + k`` (``k < --eval-episodes``), the
+same episodes at every evaluation. Both ranges lie below ``train.compare``'s test seeds
+(1000000 and up), so neither training nor model selection ever sees a test episode.
+
+**Run folder** (``--output``, default ``runs/<algo>_<env>_seed<seed>``)::
+
+    run.json                 settings, seeds, status, timesteps, per-segment timing
+    model.zip                final model (written when the run reaches its budget)
+    vecnormalize.pkl         its VecNormalize statistics (when the config normalises)
+    best/best_model.zip      best model on the validation episodes
+    best/vecnormalize.pkl    the statistics that evaluation used
+    best/best.json           its score: mean reward, median total area after 10 moves, ...
+    best/evaluations.npz     every evaluation (SB3's format)
+    checkpoints/             rl_model_<N>_steps.zip (+ _vecnormalize_, _replay_buffer_)
+    monitor/                 per-env episode logs (SB3 Monitor CSV)
+    tensorboard/             TensorBoard logs (``tensorboard --logdir runs``)
+
+**Interruptions.** Ctrl-C (or SIGTERM) stops at the next env step and saves a checkpoint
+(a second Ctrl-C stops at once, and still saves); the command then exits with status 130.
+``--resume`` continues from the newest checkpoint with the replay buffer (SAC, DQN) and
+the VecNormalize statistics, keeping the timestep count (``--timesteps`` is the total).
+
+**Export.** ``--export DIR/NAME`` copies the best model (else the final one) of the run to
+``DIR/NAME.zip``, its statistics to ``DIR/NAME_vecnormalize.pkl`` and a description to
+``DIR/NAME.json``, the layout ``agents/pretrained/`` uses.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import contextlib
+import json
+import math
+import shutil
+import signal
+import sys
+import threading
+import time
+import zipfile
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, SupportsFloat
+
+import gymnasium as gym
+import numpy as np
+import torch
+import yaml
+from stable_baselines3 import DQN, PPO, SAC
+from stable_baselines3.common.base_class import BaseAlgorithm
+from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.monitor import Monitor
+from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
+from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecEnv, VecNormalize
+
+import bearing_env
+from train.callbacks import (
+    BEST_MODEL_NAME,
+    BEST_SUMMARY_NAME,
+    BEST_VECNORMALIZE_NAME,
+    Checkpoint,
+    CheckpointStore,
+    FixedSeedEvalCallback,
+    PeriodicCheckpointCallback,
+    StopOnRequestCallback,
+    StopRequest,
+    atomic_path,
+    callback_calls,
+    save_model_atomically,
+    save_vecnormalize_atomically,
+    write_json_atomically,
+)
+
+ALGORITHMS: dict[str, type[BaseAlgorithm]] = {"ppo": PPO, "sac": SAC, "dqn": DQN}
+DEFAULT_ENV_IDS: dict[str, str] = {
+    "ppo": "BearingSLAM-v0",
+    "sac": "BearingSLAM-v0",
+    "dqn": "BearingSLAMDiscrete-v0",
+}
+HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
+
+#: Validation episode k (periodic evaluation, best-model selection) resets with seed
+#: VALIDATION_SEED_START + k; training seeds stay below it.
+VALIDATION_SEED_START = 900_000
+TRAINING_SEED_LIMIT = VALIDATION_SEED_START
+#: Validation seeds stay below this (``train.compare``'s test episodes start here).
+TEST_SEED_START = 1_000_000
+MAX_EVAL_EPISODES = TEST_SEED_START - VALIDATION_SEED_START
+
+DEFAULT_EVAL_FREQ = 25_000
+DEFAULT_EVAL_EPISODES = 50
+DEFAULT_CHECKPOINT_FREQ = 50_000
+DEFAULT_KEEP_CHECKPOINTS = 3
+DEFAULT_RUNS_DIR = Path("runs")
+
+RUN_RECORD_NAME = "run.json"
+FINAL_MODEL_NAME = "model.zip"
+FINAL_VECNORMALIZE_NAME = "vecnormalize.pkl"
+EXPORT_VECNORMALIZE_SUFFIX = "_vecnormalize.pkl"
+RUN_FORMAT_VERSION = 1
+EXIT_INTERRUPTED = 130
+
+VEC_ENV_KINDS: tuple[str, ...] = ("subproc", "dummy")
+
+#: rl-zoo3 keys that this trainer does not implement (rl-zoo3 itself does).
+UNSUPPORTED_ZOO_KEYS: frozenset[str] = frozenset(
+    {
+        "env_wrapper",
+        "vec_env_wrapper",
+        "frame_stack",
+        "callback",
+        "monitor_kwargs",
+        "noise_type",
+        "noise_std",
+        "replay_buffer_class",
+    }
+)
+SCHEDULE_KEYS: tuple[str, ...] = ("learning_rate", "clip_range", "clip_range_vf")
+EXPRESSION_KEYS: tuple[str, ...] = ("policy_kwargs", "replay_buffer_kwargs")
+
+
+# --------------------------------------------------------------------------------------
+# Hyperparameters (rl-zoo3 format)
+# --------------------------------------------------------------------------------------
+
+
+class LinearSchedule:
+    """rl-zoo3's ``lin_<x>``: ``x`` at the start of training, decaying linearly to 0."""
+
+    def __init__(self, initial_value: float) -> None:
+        self.initial_value = float(initial_value)
+
+    def __call__(self, progress_remaining: float) -> float:
+        return float(progress_remaining * self.initial_value)
+
+    def __repr__(self) -> str:
+        return f"LinearSchedule({self.initial_value})"
+
+
+@dataclass(frozen=True)
+class Hyperparameters:
+    """One parsed entry of a hyperparameter file."""
+
+    n_envs: int
+    n_timesteps: int
+    env_kwargs: dict[str, Any]
+    #: VecNormalize keyword arguments, or None to train without VecNormalize.
+    normalize: dict[str, Any] | None
+    #: Keyword arguments of the SB3 algorithm's constructor (``policy`` included).
+    algorithm_kwargs: dict[str, Any]
+
+
+def hyperparams_key(env_id: str) -> str:
+    """The file key of an env id: ``bearing_env:BearingSLAM-v0`` -> ``BearingSLAM-v0``."""
+    return env_id.split(":")[-1]
+
+
+def default_conf_file(algo: str) -> Path:
+    return HYPERPARAMS_DIR / f"{algo}.yml"
+
+
+def read_hyperparameters(algo: str, env_id: str, conf_file: Path | None = None) -> dict[str, Any]:
+    """The raw entry for ``env_id`` in ``conf_file`` (default ``train/hyperparams/<algo>.yml``)."""
+    path = conf_file if conf_file is not None else default_conf_file(algo)
+    if not path.is_file():
+        raise FileNotFoundError(f"hyperparameter file not found: {path}")
+    try:
+        entries = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as error:
+        raise ValueError(f"cannot parse hyperparameter file {path}: {error}") from error
+    key = hyperparams_key(env_id)
+    if not isinstance(entries, dict) or key not in entries:
+        known = sorted(entries) if isinstance(entries, dict) else []
+        raise ValueError(f"no entry {key!r} in {path} (entries: {known})")
+    entry = entries[key]
+    if not isinstance(entry, dict):
+        raise ValueError(f"entry {key!r} in {path} must be a mapping, got {entry!r}")
+    return dict(entry)
+
+
+def _evaluate_expression(text: str, key: str) -> Any:
+    """rl-zoo3 evaluates ``policy_kwargs`` strings; allow its usual names and nothing else."""
+    namespace = {"__builtins__": {}, "dict": dict, "list": list, "tuple": tuple, "nn": torch.nn}
+    namespace["th"] = torch
+    try:
+        return eval(text, namespace)
+    except Exception as error:
+        raise ValueError(
+            f"cannot evaluate {key}={text!r}: {type(error).__name__}: {error}"
+        ) from error
+
+
+def _schedule(value: Any, key: str) -> Any:
+    if isinstance(value, str):
+        kind, _, initial = value.partition("_")
+        if kind != "lin":
+            raise ValueError(f"{key}={value!r}: only 'lin_<value>' schedules are supported")
+        try:
+            return LinearSchedule(float(initial))
+        except ValueError as error:
+            raise ValueError(f"{key}={value!r}: bad initial value") from error
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"{key} must be a number or 'lin_<value>', got {value!r}")
+    return float(value)
+
+
+def _normalize_kwargs(value: Any, gamma: Any) -> dict[str, Any] | None:
+    if value is False or value is None:
+        return None
+    if value is True:
+        kwargs: dict[str, Any] = {}
+    elif isinstance(value, str):
+        kwargs = dict(_evaluate_expression(value, "normalize"))
+    elif isinstance(value, dict):
+        kwargs = dict(value)
+    else:
+        raise ValueError(f"normalize must be a bool, a dict or a dict expression, got {value!r}")
+    if gamma is not None:  # as rl-zoo3: the return statistics use the algorithm's gamma
+        kwargs["gamma"] = float(gamma)
+    return kwargs
+
+
+def parse_hyperparameters(raw: Mapping[str, Any]) -> Hyperparameters:
+    """Turn a raw rl-zoo3 entry into environment settings and constructor arguments."""
+    entry = dict(raw)
+    unsupported = sorted(UNSUPPORTED_ZOO_KEYS & entry.keys())
+    if unsupported:
+        raise ValueError(
+            f"hyperparameters {unsupported} are rl-zoo3 features that bearing-env train does "
+            "not implement; train this config with rl_zoo3.train instead"
+        )
+    if "n_timesteps" not in entry:
+        raise ValueError("the hyperparameter entry needs n_timesteps")
+    n_timesteps = int(float(entry.pop("n_timesteps")))
+    n_envs = int(entry.pop("n_envs", 1))
+    env_kwargs = entry.pop("env_kwargs", None) or {}
+    if not isinstance(env_kwargs, dict):
+        raise ValueError(f"env_kwargs must be a mapping, got {env_kwargs!r}")
+    normalize = _normalize_kwargs(entry.pop("normalize", False), entry.get("gamma"))
+    for key in SCHEDULE_KEYS:
+        if key in entry:
+            entry[key] = _schedule(entry[key], key)
+    for key in EXPRESSION_KEYS:
+        if isinstance(entry.get(key), str):
+            entry[key] = _evaluate_expression(entry[key], key)
+    if isinstance(entry.get("train_freq"), list):
+        entry["train_freq"] = tuple(entry["train_freq"])
+    entry.setdefault("policy", "MlpPolicy")
+    if n_envs < 1 or n_timesteps < 1:
+        raise ValueError(f"n_envs and n_timesteps must be >= 1, got {n_envs}, {n_timesteps}")
+    return Hyperparameters(
+        n_envs=n_envs,
+        n_timesteps=n_timesteps,
+        env_kwargs=dict(env_kwargs),
+        normalize=normalize,
+        algorithm_kwargs=entry,
+    )
+
+
+def parse_literal(text: str) -> Any:
+    """A Python literal when ``text`` is one (``4``, ``0.25``, ``(0.1, 0.3)``), else ``text``."""
+    try:
+        return ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        return text
+
+
+def parse_key_values(pairs: Sequence[str], option: str) -> dict[str, Any]:
+    """``["k=v", ...]`` -> ``{"k": literal(v)}``."""
+    parsed: dict[str, Any] = {}
+    for pair in pairs:
+        key, separator, value = pair.partition("=")
+        if not separator or not key.strip():
+            raise ValueError(f"{option} expects key=value items, got {pair!r}")
+        parsed[key.strip()] = parse_literal(value.strip())
+    return parsed
+
+
+# --------------------------------------------------------------------------------------
+# Environments
+# --------------------------------------------------------------------------------------
+
+
+class EpisodeSeedCycle(gym.Wrapper[Any, Any, Any, Any]):
+    """Resets with the next seed of a fixed list whenever no seed is given.
+
+    ``rewind_episode_seeds()`` starts the list again, so every evaluation plays the same
+    episodes. An explicit ``reset(seed=...)`` is honoured and does not advance the list.
+    """
+
+    def __init__(self, env: gym.Env[Any, Any], seeds: Sequence[int]) -> None:
+        super().__init__(env)
+        if not seeds:
+            raise ValueError("EpisodeSeedCycle needs at least one seed")
+        self.episode_seeds = [int(seed) for seed in seeds]
+        self._next_index = 0
+
+    def rewind_episode_seeds(self) -> None:
+        self._next_index = 0
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        if seed is None:
+            seed = self.episode_seeds[self._next_index % len(self.episode_seeds)]
+            self._next_index += 1
+        return self.env.reset(seed=seed, options=options)
+
+
+class SuccessInfo(gym.Wrapper[Any, Any, Any, Any]):
+    """Adds ``info["is_success"]`` at the end of an episode (the env's termination is success),
+    so SB3 logs ``rollout/success_rate`` and ``eval/success_rate``."""
+
+    def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        observation, reward, terminated, truncated, info = self.env.step(action)
+        if terminated or truncated:
+            info["is_success"] = bool(terminated)
+        return observation, reward, terminated, truncated, info
+
+
+def gym_make_kwargs(env_kwargs: Mapping[str, Any]) -> dict[str, Any]:
+    """``env_kwargs`` for ``gym.make``: a ``max_moves`` also sets the spec's time limit
+    (``max_episode_steps``, 20 by default), unless that is given too."""
+    kwargs = dict(env_kwargs)
+    if "max_moves" in kwargs:
+        kwargs.setdefault("max_episode_steps", kwargs["max_moves"])
+    return kwargs
+
+
+@dataclass(frozen=True, eq=False)
+class EnvFactory:
+    """Builds one wrapped env; picklable, so ``SubprocVecEnv`` (spawn) can call it in a worker."""
+
+    env_id: str
+    env_kwargs: dict[str, Any] = field(default_factory=dict)
+    monitor_path: str | None = None
+    episode_seeds: tuple[int, ...] | None = None
+    #: In worker processes: leave Ctrl-C to the trainer, which stops and checkpoints.
+    ignore_interrupts: bool = False
+
+    def __call__(self) -> gym.Env[Any, Any]:
+        if self.ignore_interrupts:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+        bearing_env.registration.register_envs()
+        env: gym.Env[Any, Any] = gym.make(self.env_id, **gym_make_kwargs(self.env_kwargs))
+        env = SuccessInfo(env)
+        env = Monitor(
+            env,
+            filename=self.monitor_path,
+            info_keywords=("is_success",),
+            override_existing=False,
+        )
+        if self.episode_seeds is not None:
+            env = EpisodeSeedCycle(env, self.episode_seeds)
+        return env
+
+
+def make_training_env(
+    env_id: str,
+    env_kwargs: dict[str, Any],
+    n_envs: int,
+    vec_env_kind: str,
+    monitor_dir: Path | None,
+) -> VecEnv:
+    """``n_envs`` training envs in a ``SubprocVecEnv`` (spawn) or a ``DummyVecEnv``."""
+    if vec_env_kind not in VEC_ENV_KINDS:
+        raise ValueError(f"unknown vec env {vec_env_kind!r}; expected one of {VEC_ENV_KINDS}")
+    if monitor_dir is not None:
+        monitor_dir.mkdir(parents=True, exist_ok=True)
+    factories = [
+        EnvFactory(
+            env_id=env_id,
+            env_kwargs=dict(env_kwargs),
+            monitor_path=None if monitor_dir is None else str(monitor_dir / str(rank)),
+            ignore_interrupts=vec_env_kind == "subproc",
+        )
+        for rank in range(n_envs)
+    ]
+    if vec_env_kind == "subproc":
+        return SubprocVecEnv(factories, start_method="spawn")
+    return DummyVecEnv(factories)
+
+
+def validation_seeds(n_episodes: int) -> tuple[int, ...]:
+    if not 1 <= n_episodes <= MAX_EVAL_EPISODES:
+        raise ValueError(f"eval episodes must be in [1, {MAX_EVAL_EPISODES}], got {n_episodes}")
+    return tuple(range(VALIDATION_SEED_START, VALIDATION_SEED_START + n_episodes))
+
+
+def make_validation_env(env_id: str, env_kwargs: dict[str, Any], n_episodes: int) -> VecEnv:
+    """One in-process env cycling through the validation seeds."""
+    factory = EnvFactory(env_id, dict(env_kwargs), episode_seeds=validation_seeds(n_episodes))
+    return DummyVecEnv([factory])
+
+
+def training_seed_start(seed: int, start_timesteps: int, n_envs: int) -> int:
+    """The reset seed of training env 0 in a segment starting at ``start_timesteps``."""
+    if not 0 <= seed < TRAINING_SEED_LIMIT - n_envs:
+        raise ValueError(f"--seed must be in [0, {TRAINING_SEED_LIMIT - n_envs}), got {seed}")
+    return (seed + start_timesteps) % (TRAINING_SEED_LIMIT - n_envs)
+
+
+# --------------------------------------------------------------------------------------
+# Loading with clear errors
+# --------------------------------------------------------------------------------------
+
+
+def _existing_file(path: Path, what: str) -> Path:
+    if path.is_file():
+        return path
+    if path.suffix != ".zip" and path.with_name(path.name + ".zip").is_file():
+        return path.with_name(path.name + ".zip")
+    raise FileNotFoundError(f"{what} not found: {path}")
+
+
+def load_model(
+    path: str | Path,
+    algo: str,
+    env: VecEnv | None = None,
+    device: str = "cpu",
+    **kwargs: Any,
+) -> BaseAlgorithm:
+    """Load a saved SB3 model.
+
+    Raises:
+        FileNotFoundError: no file at ``path`` (nor at ``path.zip``).
+        ValueError: the file is not a loadable ``algo`` model (corrupt, truncated, another
+            algorithm, or spaces that do not fit ``env``); the message names the path.
+    """
+    algorithm_class = algorithm_class_for(algo)
+    model_path = _existing_file(Path(path), "model file")
+    if not zipfile.is_zipfile(model_path):
+        raise ValueError(f"model file {model_path} is corrupt: not a zip archive")
+    try:
+        return algorithm_class.load(model_path, env=env, device=device, **kwargs)
+    except Exception as error:  # SB3 raises many kinds on damaged or foreign archives
+        raise ValueError(
+            f"cannot load {algo.upper()} model {model_path}: {type(error).__name__}: {error}"
+        ) from error
+
+
+def load_vecnormalize(path: str | Path, venv: VecEnv) -> VecNormalize:
+    """``VecNormalize.load`` with errors that name the file (see :func:`load_model`)."""
+    stats_path = _existing_file(Path(path), "VecNormalize statistics")
+    try:
+        normalizer = VecNormalize.load(str(stats_path), venv)
+    except Exception as error:  # a truncated or foreign pickle raises many kinds
+        raise ValueError(
+            f"cannot load VecNormalize statistics {stats_path}: {type(error).__name__}: {error}"
+        ) from error
+    return normalizer
+
+
+def algorithm_class_for(algo: str) -> type[BaseAlgorithm]:
+    try:
+        return ALGORITHMS[algo.lower()]
+    except KeyError:
+        raise ValueError(
+            f"unknown algorithm {algo!r}; expected one of {sorted(ALGORITHMS)}"
+        ) from None
+
+
+# --------------------------------------------------------------------------------------
+# Training
+# --------------------------------------------------------------------------------------
+
+
+@dataclass
+class TrainSettings:
+    """Everything one ``bearing-env train`` invocation needs."""
+
+    algo: str
+    env_id: str
+    output: Path
+    env_kwargs: dict[str, Any] = field(default_factory=dict)
+    hyperparam_overrides: dict[str, Any] = field(default_factory=dict)
+    conf_file: Path | None = None
+    timesteps: int | None = None
+    seed: int = 0
+    n_envs: int | None = None
+    vec_env: str = "subproc"
+    resume: bool = False
+    eval_freq: int = DEFAULT_EVAL_FREQ
+    eval_episodes: int = DEFAULT_EVAL_EPISODES
+    checkpoint_freq: int = DEFAULT_CHECKPOINT_FREQ
+    keep_checkpoints: int = DEFAULT_KEEP_CHECKPOINTS
+    progress_bar: bool = True
+    tensorboard: bool = True
+    device: str = "cpu"
+    torch_threads: int | None = 1
+    verbose: int = 0
+
+
+@dataclass(frozen=True)
+class TrainResult:
+    """What one invocation did; ``model`` is the trained model (its envs are closed)."""
+
+    model: BaseAlgorithm
+    run_dir: Path
+    num_timesteps: int
+    target_timesteps: int
+    interrupted: bool
+    checkpoint: Checkpoint | None
+    #: Env steps per second of wall time in this invocation (``learn()`` only).
+    steps_per_second: float
+    wall_seconds: float
+
+
+@dataclass(frozen=True)
+class RunFiles:
+    """Paths inside a run folder."""
+
+    root: Path
+
+    @property
+    def record(self) -> Path:
+        return self.root / RUN_RECORD_NAME
+
+    @property
+    def final_model(self) -> Path:
+        return self.root / FINAL_MODEL_NAME
+
+    @property
+    def final_vecnormalize(self) -> Path:
+        return self.root / FINAL_VECNORMALIZE_NAME
+
+    @property
+    def best(self) -> Path:
+        return self.root / "best"
+
+    @property
+    def checkpoints(self) -> Path:
+        return self.root / "checkpoints"
+
+    @property
+    def monitor(self) -> Path:
+        return self.root / "monitor"
+
+    @property
+    def tensorboard(self) -> Path:
+        return self.root / "tensorboard"
+
+
+def read_run_record(run_dir: Path) -> dict[str, Any]:
+    path = RunFiles(run_dir).record
+    if not path.is_file():
+        raise FileNotFoundError(f"no run to resume: {path} does not exist")
+    try:
+        record = json.loads(path.read_text())
+    except json.JSONDecodeError as error:
+        raise ValueError(f"run record {path} is corrupt: {error}") from error
+    if not isinstance(record, dict):
+        raise ValueError(f"run record {path} is corrupt: not a JSON object")
+    return record
+
+
+def _versions() -> dict[str, str]:
+    import stable_baselines3
+
+    return {
+        "bearing_env": bearing_env.__version__,
+        "stable_baselines3": stable_baselines3.__version__,
+        "torch": torch.__version__,
+        "gymnasium": gym.__version__,
+        "numpy": np.__version__,
+        "python": sys.version.split()[0],
+    }
+
+
+def _json_safe(value: Any) -> Any:
+    """YAML/CLI values as JSON (tuples become lists; anything else unusual becomes repr)."""
+    if isinstance(value, dict):
+        return {str(key): _json_safe(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(item) for item in value]
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    return repr(value)
+
+
+@contextlib.contextmanager
+def stop_on_signals(request: StopRequest) -> Iterator[None]:
+    """While active, Ctrl-C and SIGTERM set ``request`` (the trainer stops at the next step);
+    a second Ctrl-C raises ``KeyboardInterrupt`` at once."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handle(signum: int, frame: Any) -> None:
+        if request:
+            raise KeyboardInterrupt
+        request.set(signal.Signals(signum).name)
+        print(
+            f"\n{signal.Signals(signum).name}: stopping at the next step and saving a checkpoint "
+            "(Ctrl-C again to stop at once)",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    previous = {sig: signal.signal(sig, handle) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _close_quietly(venv: VecEnv) -> None:
+    with contextlib.suppress(EOFError, BrokenPipeError, ConnectionError, OSError):
+        venv.close()
+
+
+def _resolve_run(settings: TrainSettings) -> tuple[dict[str, Any], Checkpoint | None]:
+    """The raw hyperparameter entry and, when resuming, the checkpoint to start from."""
+    files = RunFiles(settings.output)
+    if not settings.resume:
+        if files.record.exists():
+            record = read_run_record(settings.output)
+            raise FileExistsError(
+                f"{settings.output} already holds a run ({record.get('num_timesteps', 0)} "
+                "timesteps): pass --resume to continue it, or choose another --output"
+            )
+        raw = read_hyperparameters(settings.algo, settings.env_id, settings.conf_file)
+        raw.update(settings.hyperparam_overrides)
+        raw["env_kwargs"] = {**(raw.get("env_kwargs") or {}), **settings.env_kwargs}
+        return raw, None
+
+    record = read_run_record(settings.output)
+    for key, given in (("algo", settings.algo), ("env_id", settings.env_id)):
+        if record.get(key) != given:
+            raise ValueError(
+                f"cannot resume {settings.output}: it was trained with {key}={record.get(key)!r}, "
+                f"not {given!r}"
+            )
+    raw = dict(record["hyperparams"])
+    saved_env_kwargs = raw.get("env_kwargs") or {}
+    changed = {
+        key: value
+        for key, value in settings.env_kwargs.items()
+        if _json_safe(saved_env_kwargs.get(key)) != _json_safe(value)
+    }
+    if changed:
+        raise ValueError(
+            f"cannot resume {settings.output} with different env kwargs {changed}; "
+            f"it was trained with {saved_env_kwargs}"
+        )
+    different = {
+        key: value
+        for key, value in settings.hyperparam_overrides.items()
+        if _json_safe(raw.get(key)) != _json_safe(value)
+    }
+    if different:
+        raise ValueError(
+            f"cannot resume {settings.output} with different hyperparameters {different}; "
+            "a resumed run keeps its own"
+        )
+    checkpoint = CheckpointStore(files.checkpoints).latest()
+    if checkpoint is None:
+        print(f"{settings.output}: no checkpoint yet, starting the run from scratch")
+    return raw, checkpoint
+
+
+def train(settings: TrainSettings) -> TrainResult:
+    """Train (or resume) a run; see the module docstring for the files it writes."""
+    algorithm_class = algorithm_class_for(settings.algo)
+    raw, checkpoint = _resolve_run(settings)
+    hyperparams = parse_hyperparameters(raw)
+    env_kwargs = hyperparams.env_kwargs
+    n_envs = settings.n_envs if settings.n_envs is not None else hyperparams.n_envs
+    target = settings.timesteps if settings.timesteps is not None else hyperparams.n_timesteps
+    if n_envs < 1 or target < 1:
+        raise ValueError(f"n_envs and timesteps must be >= 1, got {n_envs} and {target}")
+    files = RunFiles(settings.output)
+    previous_record = read_run_record(settings.output) if settings.resume else {}
+    if (
+        checkpoint is not None
+        and issubclass(algorithm_class, OffPolicyAlgorithm)
+        and previous_record.get("n_envs") not in (None, n_envs)
+    ):
+        raise ValueError(
+            f"cannot resume {settings.algo.upper()} with n_envs={n_envs}: its replay buffer was "
+            f"collected with n_envs={previous_record['n_envs']}"
+        )
+    if settings.torch_threads is not None:
+        torch.set_num_threads(settings.torch_threads)
+
+    # The validation env is built first, in this process: bad env kwargs fail here, fast.
+    eval_venv: VecEnv = make_validation_env(settings.env_id, env_kwargs, settings.eval_episodes)
+    area_cap = float(eval_venv.get_attr("area_cap")[0])
+    settings.output.mkdir(parents=True, exist_ok=True)
+    start_timesteps = checkpoint.timesteps if checkpoint is not None else 0
+    seed_start = training_seed_start(settings.seed, start_timesteps, n_envs)
+    venv: VecEnv = make_training_env(
+        settings.env_id, env_kwargs, n_envs, settings.vec_env, files.monitor
+    )
+    try:
+        if hyperparams.normalize is not None:
+            if checkpoint is not None and checkpoint.vecnormalize_path.is_file():
+                venv = load_vecnormalize(checkpoint.vecnormalize_path, venv)
+                venv.training = True
+            else:
+                venv = VecNormalize(venv, **hyperparams.normalize)
+            eval_normalize = {**hyperparams.normalize, "training": False, "norm_reward": False}
+            eval_venv = VecNormalize(eval_venv, **eval_normalize)
+        tensorboard_log = str(files.tensorboard) if settings.tensorboard else None
+        if checkpoint is not None:
+            model = load_model(
+                checkpoint.model_path,
+                settings.algo,
+                env=venv,
+                device=settings.device,
+                tensorboard_log=tensorboard_log,
+                verbose=settings.verbose,
+            )
+            if isinstance(model, OffPolicyAlgorithm):
+                if checkpoint.replay_buffer_path.is_file():
+                    model.load_replay_buffer(checkpoint.replay_buffer_path)
+                else:
+                    print(f"warning: {checkpoint.replay_buffer_path} missing; empty replay buffer")
+        else:
+            model = algorithm_class(
+                env=venv,
+                seed=settings.seed,
+                device=settings.device,
+                tensorboard_log=tensorboard_log,
+                verbose=settings.verbose,
+                **hyperparams.algorithm_kwargs,
+            )
+        model.set_random_seed(seed_start)  # torch/numpy/action space, and env i: seed_start + i
+
+        raw = {**raw, "n_envs": n_envs, "n_timesteps": target}  # the entry actually used
+        record = {
+            "format": RUN_FORMAT_VERSION,
+            "algo": settings.algo,
+            "env_id": settings.env_id,
+            "env_kwargs": _json_safe(env_kwargs),
+            "hyperparams": _json_safe(raw),
+            "n_envs": n_envs,
+            "seed": settings.seed,
+            "vec_env": settings.vec_env,
+            "target_timesteps": target,
+            "num_timesteps": int(model.num_timesteps),
+            "status": "running",
+            "seeds": {
+                "training_first_reset": "env i of a segment starting at timestep t: "
+                f"(seed + t) mod {TRAINING_SEED_LIMIT - n_envs} + i",
+                "validation": [
+                    VALIDATION_SEED_START,
+                    VALIDATION_SEED_START + settings.eval_episodes,
+                ],
+            },
+            "segments": list(previous_record.get("segments", [])),
+            "versions": _versions(),
+        }
+        write_json_atomically(files.record, record)
+
+        store = CheckpointStore(files.checkpoints, keep=settings.keep_checkpoints)
+        stop_request = StopRequest()
+        eval_callback = FixedSeedEvalCallback(
+            eval_venv,
+            best_folder=files.best,
+            area_cap=area_cap,
+            n_eval_episodes=settings.eval_episodes,
+            eval_freq=callback_calls(settings.eval_freq, n_envs) if settings.eval_freq > 0 else 0,
+            deterministic=True,
+            verbose=1 if settings.verbose >= 0 else 0,
+        )
+        if checkpoint is not None:
+            eval_callback.restore_history()
+        callbacks: list[BaseCallback] = [
+            StopOnRequestCallback(stop_request),
+            PeriodicCheckpointCallback(store, settings.checkpoint_freq, verbose=settings.verbose),
+            eval_callback,
+        ]
+
+        remaining = target - int(model.num_timesteps)
+        interrupted = False
+        learn_start = time.perf_counter()
+        if remaining <= 0:
+            print(f"{settings.output}: already at {model.num_timesteps} >= {target} timesteps")
+        else:
+            with stop_on_signals(stop_request):
+                try:
+                    model.learn(
+                        total_timesteps=remaining,
+                        callback=callbacks,
+                        reset_num_timesteps=checkpoint is None,
+                        progress_bar=settings.progress_bar,
+                        tb_log_name=settings.algo.upper(),
+                    )
+                except KeyboardInterrupt:
+                    interrupted = True
+        interrupted = interrupted or bool(stop_request)
+        wall_seconds = time.perf_counter() - learn_start
+        steps_done = int(model.num_timesteps) - start_timesteps
+        saved = store.save(model) if remaining > 0 else checkpoint
+        if not interrupted:
+            save_model_atomically(model, files.final_model)
+            normalizer = model.get_vec_normalize_env()
+            if normalizer is not None:
+                save_vecnormalize_atomically(normalizer, files.final_vecnormalize)
+        steps_per_second = steps_done / wall_seconds if wall_seconds > 0 else math.nan
+        if remaining > 0:
+            record["segments"].append(
+                {
+                    "start_timesteps": start_timesteps,
+                    "end_timesteps": int(model.num_timesteps),
+                    "n_envs": n_envs,
+                    "vec_env": settings.vec_env,
+                    "wall_seconds": round(wall_seconds, 3),
+                    "steps_per_second": round(steps_per_second, 1),
+                }
+            )
+        record["num_timesteps"] = int(model.num_timesteps)
+        record["status"] = "interrupted" if interrupted else "finished"
+        write_json_atomically(files.record, record)
+    finally:
+        _close_quietly(venv)
+        _close_quietly(eval_venv)
+    return TrainResult(
+        model=model,
+        run_dir=settings.output,
+        num_timesteps=int(model.num_timesteps),
+        target_timesteps=target,
+        interrupted=interrupted,
+        checkpoint=saved,
+        steps_per_second=steps_per_second,
+        wall_seconds=wall_seconds,
+    )
+
+
+# --------------------------------------------------------------------------------------
+# Export
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ExportedModel:
+    model_path: Path
+    vecnormalize_path: Path | None
+    metadata_path: Path
+    source: str
+
+
+def export_run(run_dir: Path, destination: Path) -> ExportedModel:
+    """Copy a run's best model (or its final model) to ``destination``: ``<dest>.zip``,
+    ``<dest>_vecnormalize.pkl`` (when the run normalised) and ``<dest>.json``."""
+    record = read_run_record(run_dir)
+    files = RunFiles(run_dir)
+    best_model = files.best / BEST_MODEL_NAME
+    if best_model.is_file():
+        source, model_path = "best", best_model
+        stats_path: Path | None = files.best / BEST_VECNORMALIZE_NAME
+        summary_path = files.best / BEST_SUMMARY_NAME
+        validation = json.loads(summary_path.read_text()) if summary_path.is_file() else None
+    elif files.final_model.is_file():
+        source, model_path, stats_path, validation = (
+            "final",
+            files.final_model,
+            files.final_vecnormalize,
+            None,
+        )
+    else:
+        raise FileNotFoundError(
+            f"{run_dir} has neither {best_model} nor {files.final_model}: train it further first"
+        )
+    model = load_model(model_path, record["algo"])  # refuses a corrupt file before copying
+    normalizes = record["hyperparams"].get("normalize") not in (None, False)
+    if normalizes and (stats_path is None or not stats_path.is_file()):
+        raise FileNotFoundError(f"the run normalises observations but {stats_path} is missing")
+    if not normalizes:
+        stats_path = None
+
+    name = destination.name.removesuffix(".zip")
+    folder = destination.parent
+    folder.mkdir(parents=True, exist_ok=True)
+    exported_model = folder / f"{name}.zip"
+    exported_stats = folder / f"{name}{EXPORT_VECNORMALIZE_SUFFIX}"
+    with atomic_path(exported_model) as temporary:
+        shutil.copyfile(model_path, temporary)
+    if stats_path is not None:
+        with atomic_path(exported_stats) as temporary:
+            shutil.copyfile(stats_path, temporary)
+    else:
+        exported_stats.unlink(missing_ok=True)
+    metadata = {
+        "name": name,
+        "algo": record["algo"],
+        "env_id": record["env_id"],
+        "env_kwargs": record["env_kwargs"],
+        "source": source,
+        "num_timesteps": int(model.num_timesteps),
+        "run_timesteps": record.get("num_timesteps"),
+        "seed": record.get("seed"),
+        "validation": validation,
+        "validation_seeds": record.get("seeds", {}).get("validation"),
+        "hyperparams": record["hyperparams"],
+        "versions": record.get("versions"),
+        "files": {
+            "model": exported_model.name,
+            "vecnormalize": exported_stats.name if stats_path is not None else None,
+        },
+    }
+    metadata_path = folder / f"{name}.json"
+    write_json_atomically(metadata_path, metadata)
+    return ExportedModel(
+        model_path=exported_model,
+        vecnormalize_path=exported_stats if stats_path is not None else None,
+        metadata_path=metadata_path,
+        source=source,
+    )
+
+
+# --------------------------------------------------------------------------------------
+# Command line
+# --------------------------------------------------------------------------------------
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="bearing-env train",
+        description="Train PPO/SAC (BearingSLAM-v0) or DQN (BearingSLAMDiscrete-v0) with "
+        "stable-baselines3; hyperparameters from train/hyperparams/<algo>.yml (rl-zoo3 format). "
+        "Ctrl-C saves a checkpoint; --resume continues from it.",
+    )
+    add = parser.add_argument
+    add("--algo", required=True, choices=sorted(ALGORITHMS))
+    add("--env", help="env id (default BearingSLAM-v0; for dqn BearingSLAMDiscrete-v0)")
+    add("--env-kwargs", nargs="*", default=[], metavar="K=V", help="merged over the YAML's")
+    add("--hyperparams", nargs="*", default=[], metavar="K=V", help="override YAML entries")
+    add("--conf-file", type=Path, help="hyperparameter file (default train/hyperparams/<algo>.yml)")
+    add("--timesteps", type=int, help="total env steps of the run (default the YAML's n_timesteps)")
+    add("--seed", type=int, default=0, help="default %(default)s")
+    add("--n-envs", type=int, help="parallel envs (default the YAML's n_envs)")
+    add("--vec-env", choices=VEC_ENV_KINDS, default="subproc", help="default %(default)s (spawn)")
+    add("--output", type=Path, help="run folder (default runs/<algo>_<env>_seed<seed>)")
+    add("--resume", action="store_true", help="continue the run in --output from its checkpoint")
+    add(
+        "--eval-freq", type=int, default=DEFAULT_EVAL_FREQ, help="env steps (0: never; %(default)s)"
+    )
+    add("--eval-episodes", type=int, default=DEFAULT_EVAL_EPISODES, help="default %(default)s")
+    add(
+        "--checkpoint-freq",
+        type=int,
+        default=DEFAULT_CHECKPOINT_FREQ,
+        help="env steps (%(default)s)",
+    )
+    add(
+        "--keep-checkpoints", type=int, default=DEFAULT_KEEP_CHECKPOINTS, help="default %(default)s"
+    )
+    add("--no-progress", action="store_true", help="no progress bar")
+    add("--no-tensorboard", action="store_true", help="no TensorBoard logs")
+    add("--device", default="cpu", help="torch device (default %(default)s)")
+    add("--torch-threads", type=int, default=1, help="0: torch's default (default %(default)s)")
+    add("--verbose", type=int, default=0, help="1: SB3 training tables; -1: no evaluation lines")
+    add(
+        "--export",
+        type=Path,
+        metavar="DIR/NAME",
+        help="after training, copy the best model to DIR/NAME.zip (+ _vecnormalize.pkl, .json)",
+    )
+    add("--export-only", action="store_true", help="export the run in --output without training")
+    return parser
+
+
+def default_output(algo: str, env_id: str, seed: int) -> Path:
+    return DEFAULT_RUNS_DIR / f"{algo}_{hyperparams_key(env_id)}_seed{seed}"
+
+
+def settings_from_args(args: argparse.Namespace) -> TrainSettings:
+    env_id = args.env or DEFAULT_ENV_IDS[args.algo]
+    return TrainSettings(
+        algo=args.algo,
+        env_id=env_id,
+        output=args.output or default_output(args.algo, env_id, args.seed),
+        env_kwargs=parse_key_values(args.env_kwargs, "--env-kwargs"),
+        hyperparam_overrides=parse_key_values(args.hyperparams, "--hyperparams"),
+        conf_file=args.conf_file,
+        timesteps=args.timesteps,
+        seed=args.seed,
+        n_envs=args.n_envs,
+        vec_env=args.vec_env,
+        resume=args.resume,
+        eval_freq=args.eval_freq,
+        eval_episodes=args.eval_episodes,
+        checkpoint_freq=args.checkpoint_freq,
+        keep_checkpoints=args.keep_checkpoints,
+        progress_bar=not args.no_progress,
+        tensorboard=not args.no_tensorboard,
+        device=args.device,
+        torch_threads=args.torch_threads or None,
+        verbose=args.verbose,
+    )
+
+
+def _print_export(exported: ExportedModel) -> None:
+    print(f"exported the {exported.source} model to {exported.model_path}")
+    if exported.vecnormalize_path is not None:
+        print(f"  VecNormalize statistics: {exported.vecnormalize_path}")
+    print(f"  description: {exported.metadata_path}")
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    parser = build_parser()
+    args = parser.parse_args(sys.argv[1:] if argv is None else list(argv))
+    try:
+        settings = settings_from_args(args)
+        if args.export_only:
+            if args.export is None:
+                parser.error("--export-only needs --export DIR/NAME")
+            _print_export(export_run(settings.output, args.export))
+            return
+        result = train(settings)
+    except (FileNotFoundError, FileExistsError, ValueError, TypeError) as error:
+        print(f"bearing-env train: error: {error}", file=sys.stderr)
+        raise SystemExit(2) from error
+    speed = (
+        f", {result.steps_per_second:.0f} env steps/s over {result.wall_seconds:.1f} s"
+        if math.isfinite(result.steps_per_second) and result.wall_seconds > 0.01
+        else ""
+    )
+    print(f"{result.run_dir}: {result.num_timesteps}/{result.target_timesteps} timesteps{speed}")
+    if result.interrupted:
+        where = result.checkpoint.model_path if result.checkpoint is not None else "?"
+        print(f"interrupted: checkpoint {where}; continue with --resume", file=sys.stderr)
+        raise SystemExit(EXIT_INTERRUPTED)
+    if args.export is not None:
+        _print_export(export_run(settings.output, args.export))
+
+
+if __name__ == "__main__":
+    main()
