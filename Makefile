@@ -20,6 +20,7 @@ test: $(STAMP)
 
 demo: $(STAMP)
 	SDL_VIDEODRIVER=dummy $(PY) -m train.demo
+	SDL_VIDEODRIVER=dummy $(PY) -m train.compare --quick
 
 bench: $(STAMP)
 	$(PY) benchmarks/bench_slam.py

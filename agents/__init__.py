@@ -1,18 +1,35 @@
 """Exploration policies for the bearing-only SLAM envs.
 
 Every policy is built from the env it acts in, ``Policy(env, **options)``, and driven with
-``reset(seed)`` and ``act(observation, info) -> action``; see :class:`agents.base.Policy`.
+``reset(seed)`` at the start of an episode and ``act(observation, info) -> action`` at
+every step (see :class:`agents.base.Policy`). All work on both registered ids:
+
+- :class:`RandomPolygonal`: the paper's random rotation then straight line;
+- :class:`Parallax`: move across the line of sight of the most uncertain landmark;
+- :class:`GreedyOneStep`: one-step look-ahead on the robot's own map (no ground truth);
+- :class:`GreedyOracle`: the same on the true map (privileged upper reference);
+- :class:`SB3Policy`: a saved stable-baselines3 model.
+
+:func:`make_policy` builds one from a spec string such as ``"greedy:n_turns=16"``.
 """
 
 from agents.base import ActionCodec, Movement, Policy
 from agents.heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
+from agents.registry import POLICY_CLASSES, PolicySpec, make_policy, parse_policy_spec
+from agents.sb3 import ModelLoadError, SB3Policy
 
 __all__ = [
+    "POLICY_CLASSES",
     "ActionCodec",
     "GreedyOneStep",
     "GreedyOracle",
+    "ModelLoadError",
     "Movement",
     "Parallax",
     "Policy",
+    "PolicySpec",
     "RandomPolygonal",
+    "SB3Policy",
+    "make_policy",
+    "parse_policy_spec",
 ]

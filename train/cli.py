@@ -2,6 +2,9 @@
 
     bearing-env demo [...]    the random polygonal demo in the Khepera scenario (make demo)
     bearing-env bench [...]   world-model throughput against CartPole-v1
+    bearing-env compare [...] exploration policies on the same evaluation episodes
+    bearing-env figures [...] the paper's Figs. 7, 10 and 11 in simulation
+    bearing-env train [...]   PPO/SAC/DQN with stable-baselines3 (train/hyperparams/*.yml)
 
 Each subcommand forwards its remaining arguments to the module that implements it, so
 ``bearing-env demo --help`` shows that module's options.
@@ -16,6 +19,9 @@ import sys
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "demo": ("train.demo", "random polygonal exploration in the Khepera scenario"),
     "bench": ("benchmarks.bench_slam", "world-model update() throughput vs CartPole-v1"),
+    "train": ("train.train", "train PPO/SAC/DQN agents with stable-baselines3 (train/hyperparams)"),
+    "compare": ("train.compare", "compare exploration policies on fixed evaluation episodes"),
+    "figures": ("train.figures", "reproduce the paper's Figs. 7, 10 and 11 in simulation"),
 }
 
 

@@ -1,0 +1,212 @@
+"""What the robot knows about its own pose, beyond the map: tracked from its commands.
+
+The map (``PolygonSLAM``) gives, after every movement that could change frames, the
+robot's region at the end of that movement (its centroid is the position estimate) and
+the movement's direction in FL (``robot_heading``). Between such movements the robot
+still knows what it *commanded*: the turns (exact: it turns on the spot) and the lengths
+(in metres, exact unless a wall stopped it, which it senses). :class:`RobotBelief` adds
+those commands to the map's last fix:
+
+- heading in FL = ``slam.robot_heading`` + the turns commanded since the last movement
+  that changed frames;
+- position in FL = ``slam.robot_estimate`` + the legs driven since then, each converted
+  to FL units with the scale below. A leg stopped by the wall counts as 0: the robot
+  does not know how far it got.
+
+**The FL scale** (metres per FL unit, i.e. the unknown |L1 - L2| in metres) is needed to
+turn a commanded length into FL units. It is estimated from the robot's own bearings:
+for every movement that changed frames, L1 and L2 are triangulated in the robot frame FR
+(R1 = 0, R2 = 1) from the bearings before and after the move; |L1 - L2| in FR units
+times the commanded length is one sample, and the scale is the median of the samples.
+The reading before the move is the previous observation's bearings rotated by the
+commanded turn (the env takes a fresh reading after the turn that the policy does not
+see; both are within +-epsilon of the truth). Samples from bearing pairs with too little
+parallax (< 4 epsilon) are dropped: their range error is large. A move stopped by the
+wall travelled less than commanded, so its sample overestimates the scale; such samples
+are only used while there is no other. Nothing here reads ground truth.
+
+Why not the distance between successive robot estimates? Both are centroids of large
+regions (the robot's region is as uncertain as a landmark's), and two successive
+movements that both change frames are needed; the triangulation needs one movement and
+has a relative error of about epsilon / parallax.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import gymnasium as gym
+import numpy as np
+from numpy.typing import NDArray
+
+from agents.base import Movement, wrap_angle
+from agents.env_access import bearing_env_of
+from bearing_env.envs.bearing_slam import BEARING_FEATURES, ROBOT_FEATURES, observation_slices
+from bearing_env.slam import PolygonSLAM
+
+#: Minimum bearing change (in units of epsilon) for a triangulation to give a scale sample.
+MIN_PARALLAX_EPSILONS = 4.0
+
+_PROGRESS = ROBOT_FEATURES.index("progress")
+_FRAME_CHANGED = ROBOT_FEATURES.index("last_frame_changed")
+_BLOCKED = ROBOT_FEATURES.index("last_move_blocked")
+_BEARING_COS = BEARING_FEATURES.index("cos")
+_BEARING_SIN = BEARING_FEATURES.index("sin")
+
+
+@dataclass(frozen=True)
+class ObservationView:
+    """The parts of an observation that the heuristics use (all robot-knowable)."""
+
+    progress: float
+    frame_changed: bool
+    blocked: bool
+    #: Latest bearings (n_landmarks,), radians, relative to the current heading.
+    bearings: NDArray[np.float64]
+
+
+class ObservationReader:
+    """Parses the env's observation vector (layout: ``BearingSLAMEnv`` docstring)."""
+
+    def __init__(self, env: gym.Env) -> None:
+        base = bearing_env_of(env)
+        self.n_landmarks = int(base.n_landmarks)
+        self.bearing_block = observation_slices(int(base.max_landmarks))["bearings"]
+
+    def read(self, observation: NDArray[np.float32]) -> ObservationView:
+        obs = np.asarray(observation, dtype=np.float64)
+        bearings = obs[self.bearing_block].reshape(-1, len(BEARING_FEATURES))[: self.n_landmarks]
+        return ObservationView(
+            progress=float(obs[_PROGRESS]),
+            frame_changed=bool(obs[_FRAME_CHANGED] > 0.5),
+            blocked=bool(obs[_BLOCKED] > 0.5),
+            bearings=np.arctan2(bearings[:, _BEARING_SIN], bearings[:, _BEARING_COS]),
+        )
+
+
+@dataclass(frozen=True)
+class PoseBelief:
+    """The robot's believed pose in FL (before its next turn)."""
+
+    position: complex
+    heading: float
+    #: Metres per FL unit; None until a movement gave a usable triangulation.
+    metres_per_unit: float | None
+
+
+def triangulate_fr(bearing_start: float, bearing_end: float) -> complex | None:
+    """Position in FR (R1 = 0, R2 = 1) of a point seen at these bearings from R1 and R2.
+
+    None if the rays do not meet in front of both observation points.
+    """
+    denominator = math.sin(bearing_end - bearing_start)
+    if abs(denominator) < 1e-12:
+        return None
+    range_from_start = math.sin(bearing_end) / denominator
+    range_from_end = math.sin(bearing_start) / denominator
+    if range_from_start <= 0.0 or range_from_end <= 0.0:
+        return None
+    return range_from_start * complex(math.cos(bearing_start), math.sin(bearing_start))
+
+
+def scale_sample(
+    bearings_start: NDArray[np.float64],
+    bearings_end: NDArray[np.float64],
+    length: float,
+    epsilon: float,
+) -> float | None:
+    """Metres per FL unit from one movement of ``length`` metres (None if ill-conditioned)."""
+    points = []
+    for index in (0, 1):
+        parallax = abs(wrap_angle(float(bearings_end[index] - bearings_start[index])))
+        if parallax < MIN_PARALLAX_EPSILONS * epsilon:
+            return None
+        point = triangulate_fr(float(bearings_start[index]), float(bearings_end[index]))
+        if point is None:
+            return None
+        points.append(point)
+    return length * abs(points[1] - points[0])
+
+
+class RobotBelief:
+    """Tracks the robot's FL pose and the FL scale between map fixes (see module doc)."""
+
+    def __init__(self, epsilon: float) -> None:
+        self.epsilon = float(epsilon)
+        self.reset()
+
+    def reset(self) -> None:
+        self._pending: tuple[Movement, NDArray[np.float64]] | None = None
+        # Turns commanded since the last movement that changed frames (radians).
+        self._turn_since_fix = 0.0
+        # Legs driven since that movement: (heading offset from the fix, metres).
+        self._legs: list[tuple[float, float]] = []
+        self._scale_samples: list[float] = []
+        self._blocked_samples: list[float] = []
+
+    @property
+    def scale_samples(self) -> list[float]:
+        return list(self._scale_samples)
+
+    def observe(self, view: ObservationView) -> None:
+        """Account for the outcome of the last commanded movement."""
+        if view.progress == 0.0:
+            # A fresh episode (even if the caller forgot reset()): nothing carries over.
+            self.reset()
+            return
+        if self._pending is None:
+            return
+        movement, bearings_before = self._pending
+        self._pending = None
+        if view.frame_changed:
+            # The map now holds this movement's end point and direction.
+            self._turn_since_fix = 0.0
+            self._legs = []
+            start = np.array([wrap_angle(float(b) - movement.turn) for b in bearings_before])
+            sample = scale_sample(start, view.bearings, movement.length, self.epsilon)
+            if sample is not None:
+                # A move stopped by the wall travelled less than commanded, so its sample
+                # overestimates the scale: kept apart, used only while there is no other.
+                (self._blocked_samples if view.blocked else self._scale_samples).append(sample)
+        else:
+            self._turn_since_fix = wrap_angle(self._turn_since_fix + movement.turn)
+            if not view.blocked:
+                self._legs.append((self._turn_since_fix, movement.length))
+
+    def commanded(self, movement: Movement, view: ObservationView) -> None:
+        """Remember the movement about to be sent, with the reading it started from."""
+        self._pending = (movement, view.bearings.copy())
+
+    def metres_per_unit(self) -> float | None:
+        samples = self._scale_samples or self._blocked_samples
+        if not samples:
+            return None
+        return float(np.median(samples))
+
+    def pose(self, slam: PolygonSLAM) -> PoseBelief | None:
+        """The believed pose, or None before the first movement that changed frames."""
+        fix_heading = slam.robot_heading
+        fix = slam.robot_estimate
+        if not (math.isfinite(fix_heading) and np.all(np.isfinite(fix))):
+            return None
+        scale = self.metres_per_unit()
+        position = complex(fix[0], fix[1])
+        if self._legs and scale is not None:
+            for offset, length in self._legs:
+                position += (length / scale) * complex(
+                    math.cos(fix_heading + offset), math.sin(fix_heading + offset)
+                )
+        heading = wrap_angle(fix_heading + self._turn_since_fix)
+        return PoseBelief(position=position, heading=heading, metres_per_unit=scale)
+
+
+def spread_turn(bearings: NDArray[np.float64], turns: NDArray[np.float64]) -> int:
+    """Index of the turn after which every landmark is farthest from the line of motion.
+
+    A landmark near the line of motion (bearing near 0 or pi) gets near-parallel cones
+    and no bounded region; the first movement, made before there is any map, maximises
+    the smallest ``|sin(bearing - turn)|`` over all landmarks instead.
+    """
+    clearance = np.min(np.abs(np.sin(bearings[None, :] - turns[:, None])), axis=1)
+    return int(np.argmax(clearance))

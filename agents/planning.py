@@ -1,0 +1,89 @@
+"""One-step look-ahead on a map: score candidate movements by simulated SLAM updates.
+
+Everything happens in the landmark frame FL (L1 = 0, L2 = 1). Bearings are invariant
+under the similarity between FL and the world (no reflection), so noise-free bearings
+computed from FL positions are exactly the bearings the robot would read in the world,
+provided the move length is converted to FL units.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from bearing_env.envs.bearing_slam import AREA_FLOOR
+from bearing_env.slam import PolygonSLAM
+
+
+def uncertainty_potential(areas: NDArray[np.float64], area_cap: float) -> float:
+    """The env's default potential: sum of log areas, capped (uninitialised = cap)."""
+    return float(np.sum(np.log(np.clip(areas, AREA_FLOOR, area_cap))))
+
+
+def bearings_from(
+    position: complex, heading: float, points: NDArray[np.complex128]
+) -> NDArray[np.float64]:
+    """Noise-free bearings of ``points`` (FL) from ``position`` facing ``heading``."""
+    angles = np.angle(points - position) - heading
+    return (angles + np.pi) % (2.0 * np.pi) - np.pi
+
+
+@dataclass(frozen=True)
+class SimulatedMove:
+    """A candidate in FL: the new heading and the distance actually travelled (FL units)."""
+
+    heading: float
+    distance: float
+
+
+def simulate_potentials(
+    slam: PolygonSLAM,
+    start: complex,
+    landmarks: NDArray[np.complex128],
+    moves: Sequence[SimulatedMove],
+    area_cap: float,
+    min_distance: float = 1e-9,
+) -> NDArray[np.float64]:
+    """The uncertainty potential after each candidate move, simulated on a copy of ``slam``.
+
+    Args:
+        slam: the map to start from (left untouched).
+        start: the robot's position in FL.
+        landmarks: all landmark positions in FL (n,), L1 = 0 and L2 = 1 first; NaN for a
+            landmark whose position is unknown: it is given the same bearing at both
+            ends (parallel cones, so no region), i.e. no predicted progress.
+        moves: the candidates.
+        area_cap: the cap (and the value of an uninitialised landmark) of the potential.
+        min_distance: a move shorter than this (FL units) does not update the map.
+
+    The PolygonSLAM API fuses one movement per ``update``, and the landmark frame of
+    every candidate differs, so the candidates are scored with one copy and one update
+    each (a batch across candidates would need the internals of the world model).
+    """
+    current = uncertainty_potential(slam.areas, area_cap)
+    known = np.isfinite(landmarks)
+    targets = np.where(known, landmarks, 0.0)
+    potentials = np.empty(len(moves))
+    for index, move in enumerate(moves):
+        if move.distance < min_distance:
+            potentials[index] = current
+            continue
+        end = start + move.distance * complex(math.cos(move.heading), math.sin(move.heading))
+        bearings_start = bearings_from(start, move.heading, targets)
+        bearings_end = np.where(known, bearings_from(end, move.heading, targets), bearings_start)
+        trial = slam.copy()
+        trial.update(bearings_start, bearings_end)
+        potentials[index] = uncertainty_potential(trial.areas, area_cap)
+    return potentials
+
+
+def landmark_positions_fl(slam: PolygonSLAM) -> NDArray[np.complex128]:
+    """The map's landmark positions in FL (n,): L1 = 0, L2 = 1, then the estimates (NaN
+    where not initialised)."""
+    estimates = slam.estimates
+    mapped = estimates[:, 0] + 1j * estimates[:, 1]
+    return np.concatenate([[0.0 + 0.0j, 1.0 + 0.0j], mapped])

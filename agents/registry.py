@@ -1,0 +1,140 @@
+"""Policies by name, for command lines and configs.
+
+A *policy spec* is a string ``NAME[:KEY=VALUE[,KEY=VALUE...]]``:
+
+    random                          RandomPolygonal with its defaults
+    random:length=0.25              fixed 25 cm moves
+    greedy:n_turns=16,lengths=1     GreedyOneStep with 16 turns at the longest length
+    sb3:path=runs/ppo/best_model.zip
+    sb3:runs/ppo/best_model.zip     (sb3 only: a bare value is the path)
+    parallax:label=my_parallax      ``label`` renames the policy in reports
+
+Values are Python literals when they parse as one (``16``, ``0.25``, ``(0.1, 0.2)``,
+``True``, ``None``) and strings otherwise.
+"""
+
+from __future__ import annotations
+
+import ast
+from dataclasses import dataclass, field
+from typing import Any
+
+import gymnasium as gym
+
+from agents.base import Policy
+from agents.heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
+from agents.sb3 import SB3Policy
+
+#: Policy classes by spec name (the first name of each class is its canonical one).
+POLICY_CLASSES: dict[str, type] = {
+    "random": RandomPolygonal,
+    "random_polygonal": RandomPolygonal,
+    "parallax": Parallax,
+    "greedy": GreedyOneStep,
+    "greedy_one_step": GreedyOneStep,
+    "oracle": GreedyOracle,
+    "greedy_oracle": GreedyOracle,
+    "sb3": SB3Policy,
+}
+
+
+@dataclass(frozen=True)
+class PolicySpec:
+    """A parsed policy spec: the class name, its options and the label to report it as."""
+
+    kind: str
+    options: dict[str, Any] = field(default_factory=dict)
+    label: str | None = None
+
+    def display_name(self) -> str:
+        """The label, or one derived from the kind and options (without building it)."""
+        if self.label:
+            return self.label
+        cls = POLICY_CLASSES[self.kind]
+        if self.kind == "sb3":
+            from pathlib import Path
+
+            return f"sb3_{Path(str(self.options.get('path', 'model'))).stem}"
+        base = str(getattr(cls, "name", self.kind))
+        if not self.options:
+            return base
+        details = ",".join(f"{key}={value}" for key, value in sorted(self.options.items()))
+        return f"{base}[{details}]"
+
+    def to_string(self) -> str:
+        """The canonical spec string (parses back to an equal spec)."""
+        parts = [f"{key}={value!r}" for key, value in sorted(self.options.items())]
+        if self.label:
+            parts.append(f"label={self.label!r}")
+        return self.kind if not parts else f"{self.kind}:{','.join(parts)}"
+
+
+def _literal(text: str) -> Any:
+    try:
+        return ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        return text
+
+
+def _string(text: str) -> str:
+    """A string option (path, label): quoted or bare."""
+    value = _literal(text)
+    return value if isinstance(value, str) else text
+
+
+def _split_options(text: str) -> list[str]:
+    """Split on commas that are not inside brackets (so ``lengths=(0.1,0.2)`` survives)."""
+    items, depth, current = [], 0, []
+    for char in text:
+        if char in "([{":
+            depth += 1
+        elif char in ")]}":
+            depth -= 1
+        if char == "," and depth == 0:
+            items.append("".join(current))
+            current = []
+        else:
+            current.append(char)
+    items.append("".join(current))
+    return [item.strip() for item in items if item.strip()]
+
+
+def parse_policy_spec(spec: str) -> PolicySpec:
+    """Parse ``NAME[:KEY=VALUE,...]`` (see the module doc). ValueError on a bad spec."""
+    kind, _, rest = spec.strip().partition(":")
+    kind = kind.strip().lower()
+    if kind not in POLICY_CLASSES:
+        raise ValueError(
+            f"unknown policy {kind!r} in spec {spec!r}; expected one of {sorted(POLICY_CLASSES)}"
+        )
+    options: dict[str, Any] = {}
+    label = None
+    for item in _split_options(rest):
+        key, sep, value = item.partition("=")
+        if not sep:
+            if kind == "sb3" and "path" not in options:
+                options["path"] = item
+                continue
+            raise ValueError(f"policy option {item!r} in {spec!r} is not KEY=VALUE")
+        key = key.strip()
+        if key == "label":
+            label = _string(value.strip())
+        else:
+            options[key] = _string(value.strip()) if key == "path" else _literal(value.strip())
+    if kind == "sb3" and "path" not in options:
+        raise ValueError(f"policy spec {spec!r}: sb3 needs a model path (sb3:path=...)")
+    # Aliases collapse to one canonical kind so equal policies get equal specs.
+    canonical = next(name for name, cls in POLICY_CLASSES.items() if cls is POLICY_CLASSES[kind])
+    return PolicySpec(kind=canonical, options=options, label=label)
+
+
+def make_policy(spec: str | PolicySpec, env: gym.Env) -> Policy:
+    """Build the policy a spec describes for ``env`` (its ``name`` is the spec's label)."""
+    parsed = parse_policy_spec(spec) if isinstance(spec, str) else spec
+    cls = POLICY_CLASSES[parsed.kind]
+    try:
+        policy = cls(env, **parsed.options)
+    except TypeError as error:
+        raise ValueError(f"bad options for policy {parsed.kind!r}: {error}") from error
+    policy.name = parsed.display_name()
+    return policy

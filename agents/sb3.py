@@ -1,0 +1,245 @@
+"""Trained stable-baselines3 agents as policies.
+
+:class:`SB3Policy` loads a saved model (``model.save(path)``, a ``.zip``) and, if there is
+one, the ``VecNormalize`` statistics saved beside it, and applies them to observations
+exactly as training did (``training=False``: the statistics are frozen).
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import pickle
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from numpy.typing import NDArray
+
+from agents.base import Action
+
+#: File names tried, in order, when ``path`` is a directory.
+MODEL_FILE_NAMES = ("best_model.zip", "model.zip", "final_model.zip")
+#: VecNormalize statistics looked for beside a model ``<dir>/<stem>.zip`` (first found wins).
+VECNORMALIZE_FILE_NAMES = ("{stem}_vecnormalize.pkl", "{stem}.vecnormalize.pkl", "vecnormalize.pkl")
+
+#: Algorithms by the module of the saved policy class (all that ``predict`` needs).
+_ALGORITHM_BY_POLICY_MODULE = {
+    "stable_baselines3.sac.policies": "SAC",
+    "stable_baselines3.dqn.policies": "DQN",
+    "stable_baselines3.td3.policies": "TD3",
+    "sb3_contrib.tqc.policies": "TQC",
+    "sb3_contrib.qrdqn.policies": "QRDQN",
+}
+_ALGORITHM_MODULES = {
+    "PPO": "stable_baselines3",
+    "A2C": "stable_baselines3",
+    "SAC": "stable_baselines3",
+    "TD3": "stable_baselines3",
+    "DDPG": "stable_baselines3",
+    "DQN": "stable_baselines3",
+    "TQC": "sb3_contrib",
+    "QRDQN": "sb3_contrib",
+    "RecurrentPPO": "sb3_contrib",
+}
+
+
+class ModelLoadError(ValueError):
+    """A model or VecNormalize file exists but cannot be used."""
+
+
+def resolve_model_path(path: str | Path) -> Path:
+    """The ``.zip`` a path designates: the file itself (``.zip`` optional, as SB3 allows),
+    or in a directory the first of :data:`MODEL_FILE_NAMES`.
+
+    Raises:
+        FileNotFoundError: nothing to load there.
+    """
+    candidate = Path(path).expanduser()
+    if candidate.is_dir():
+        for name in MODEL_FILE_NAMES:
+            if (candidate / name).is_file():
+                return candidate / name
+        zips = sorted(candidate.glob("*.zip"))
+        if len(zips) == 1:
+            return zips[0]
+        raise FileNotFoundError(
+            f"no SB3 model in directory {candidate}: expected one of {MODEL_FILE_NAMES} "
+            f"(or a single .zip), found {[z.name for z in zips]}"
+        )
+    if candidate.is_file():
+        return candidate
+    with_suffix = candidate.with_name(candidate.name + ".zip")
+    if candidate.suffix != ".zip" and with_suffix.is_file():
+        return with_suffix
+    raise FileNotFoundError(f"SB3 model file not found: {candidate}")
+
+
+def find_vecnormalize(model_path: Path) -> Path | None:
+    """The VecNormalize statistics saved beside ``model_path``, if any."""
+    for pattern in VECNORMALIZE_FILE_NAMES:
+        candidate = model_path.parent / pattern.format(stem=model_path.stem)
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def infer_algorithm(model_path: Path) -> str:
+    """The algorithm name (``"PPO"``, ``"SAC"``, ...) of a saved model, from its metadata."""
+    try:
+        with zipfile.ZipFile(model_path) as archive:
+            data = json.loads(archive.read("data"))
+    except (zipfile.BadZipFile, KeyError, json.JSONDecodeError, UnicodeDecodeError) as error:
+        raise ModelLoadError(
+            f"{model_path} is not a stable-baselines3 model archive ({error})"
+        ) from error
+    module = str(data.get("policy_class", {}).get("__module__", ""))
+    if module in _ALGORITHM_BY_POLICY_MODULE:
+        return _ALGORITHM_BY_POLICY_MODULE[module]
+    if module.startswith("sb3_contrib.common.recurrent"):
+        return "RecurrentPPO"
+    if module == "stable_baselines3.common.policies":
+        # Actor-critic: PPO and A2C share the policy; PPO alone saves n_epochs.
+        return "PPO" if "n_epochs" in data else "A2C"
+    raise ModelLoadError(
+        f"cannot tell the algorithm of {model_path} (policy module {module!r}); "
+        "pass algo='PPO' (or SAC, DQN, ...) explicitly"
+    )
+
+
+def _algorithm_class(name: str) -> Any:
+    key = {k.lower(): k for k in _ALGORITHM_MODULES}.get(name.lower())
+    if key is None:
+        raise ValueError(
+            f"unknown algorithm {name!r}; expected one of {sorted(_ALGORITHM_MODULES)}"
+        )
+    try:
+        module = importlib.import_module(_ALGORITHM_MODULES[key])
+    except ImportError as error:
+        raise ImportError(
+            f"{key} needs the package {_ALGORITHM_MODULES[key]!r}: pip install it"
+        ) from error
+    return getattr(module, key)
+
+
+def _spaces_match(model_space: spaces.Space[Any], env_space: spaces.Space[Any]) -> bool:
+    if isinstance(env_space, spaces.Discrete):
+        return isinstance(model_space, spaces.Discrete) and model_space.n == env_space.n
+    if isinstance(env_space, spaces.Box):
+        return isinstance(model_space, spaces.Box) and model_space.shape == env_space.shape
+    return type(model_space) is type(env_space)
+
+
+class SB3Policy:
+    """A saved stable-baselines3 model, acting greedily (``deterministic=True``) by default.
+
+    Args:
+        env: the env it acts in; its observation and action spaces must match the model's.
+        path: the model ``.zip`` (the suffix may be left out), or a directory holding
+            ``best_model.zip`` / ``model.zip`` / a single ``.zip``.
+        vecnormalize: the ``VecNormalize`` statistics: ``"auto"`` (default) uses
+            ``<stem>_vecnormalize.pkl``, ``<stem>.vecnormalize.pkl`` or ``vecnormalize.pkl``
+            beside the model if present; a path uses that file (it must exist); None
+            uses none.
+        algo: the algorithm (``"PPO"``, ``"SAC"``, ``"DQN"``, ...); default inferred from
+            the saved policy class.
+        deterministic: act with the mode of the policy rather than sampling.
+        device: torch device.
+        name: label in reports; default ``sb3_<algo>_<model stem>``.
+
+    Raises:
+        FileNotFoundError: the model, or an explicitly given VecNormalize file, is missing.
+        ModelLoadError (a ValueError): a file is corrupt, or does not fit the env.
+    """
+
+    privileged = False
+
+    def __init__(
+        self,
+        env: gym.Env,
+        path: str | Path,
+        vecnormalize: str | Path | None = "auto",
+        algo: str | None = None,
+        deterministic: bool = True,
+        device: str = "cpu",
+        name: str | None = None,
+    ) -> None:
+        self.model_path = resolve_model_path(path)
+        self.algo = algo if algo is not None else infer_algorithm(self.model_path)
+        algorithm_class = _algorithm_class(self.algo)
+        try:
+            self.model = algorithm_class.load(str(self.model_path), device=device)
+        except Exception as error:  # SB3 raises many kinds on a damaged archive.
+            raise ModelLoadError(
+                f"could not load {self.algo} model {self.model_path}: "
+                f"{type(error).__name__}: {error}"
+            ) from error
+        if not _spaces_match(self.model.observation_space, env.observation_space):
+            raise ModelLoadError(
+                f"model {self.model_path} expects observations {self.model.observation_space}, "
+                f"but the env gives {env.observation_space} (different max_landmarks?)"
+            )
+        if not _spaces_match(self.model.action_space, env.action_space):
+            raise ModelLoadError(
+                f"model {self.model_path} outputs actions {self.model.action_space}, but the "
+                f"env takes {env.action_space} (continuous vs discrete id?)"
+            )
+        self.vecnormalize_path = self._resolve_vecnormalize(vecnormalize)
+        self.obs_normalizer = (
+            None if self.vecnormalize_path is None else _load_vecnormalize(self.vecnormalize_path)
+        )
+        self.deterministic = bool(deterministic)
+        self.discrete = isinstance(env.action_space, spaces.Discrete)
+        self.name = name or f"sb3_{self.algo.lower()}_{self.model_path.stem}"
+
+    def _resolve_vecnormalize(self, vecnormalize: str | Path | None) -> Path | None:
+        if vecnormalize is None:
+            return None
+        if isinstance(vecnormalize, str) and vecnormalize == "auto":
+            return find_vecnormalize(self.model_path)
+        explicit = Path(vecnormalize).expanduser()
+        if not explicit.is_file():
+            raise FileNotFoundError(f"VecNormalize statistics not found: {explicit}")
+        return explicit
+
+    def reset(self, seed: int | None = None) -> None:
+        if seed is not None:
+            # Only matters with deterministic=False: sampling goes through torch.
+            import torch
+
+            torch.manual_seed(int(seed))
+
+    def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
+        obs = np.asarray(observation, dtype=np.float32)
+        if self.obs_normalizer is not None:
+            obs = np.asarray(self.obs_normalizer.normalize_obs(obs), dtype=np.float32)
+        action, _ = self.model.predict(obs, deterministic=self.deterministic)
+        if self.discrete:
+            return int(np.asarray(action).reshape(-1)[0])
+        return np.asarray(action, dtype=np.float32).reshape(-1)
+
+    def __repr__(self) -> str:
+        return f"SB3Policy(name={self.name!r}, path={str(self.model_path)!r})"
+
+
+def _load_vecnormalize(path: Path) -> Any:
+    """Unpickle VecNormalize statistics (as ``VecNormalize.load`` does, without a venv)."""
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    try:
+        with open(path, "rb") as handle:
+            normalizer = pickle.load(handle)
+    except Exception as error:  # a truncated or foreign pickle raises many kinds
+        raise ModelLoadError(
+            f"could not load VecNormalize statistics {path}: {type(error).__name__}: {error}"
+        ) from error
+    if not isinstance(normalizer, VecNormalize):
+        raise ModelLoadError(
+            f"{path} holds a {type(normalizer).__name__}, not VecNormalize statistics"
+        )
+    normalizer.training = False
+    normalizer.norm_reward = False
+    return normalizer

@@ -1,0 +1,319 @@
+"""The comparison harness: determinism, resume, atomic outputs, statistics, command line."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from train import cli
+from train.compare import (
+    EVAL_SEED_START,
+    LOG_NAME,
+    CompareConfig,
+    EpisodeLog,
+    RunMismatchError,
+    bootstrap_mean_ci,
+    main,
+    parse_env_kwargs,
+    policies_from_specs,
+    run_comparison,
+)
+
+SMALL_ENV = {"scenario": "khepera", "max_moves": 4}
+OUTPUT_FILES = (
+    "config.json",
+    LOG_NAME,
+    "episodes.csv",
+    "summary.json",
+    "summary.csv",
+    "report.md",
+    "timing.json",
+    "area_vs_moves.png",
+    "error_vs_moves.png",
+)
+
+
+def small_config(episodes: int = 4, **overrides: Any) -> CompareConfig:
+    settings: dict[str, Any] = {
+        "policies": policies_from_specs(["random", "greedy"]),
+        "env_id": "BearingSLAM-v0",
+        "env_kwargs": dict(SMALL_ENV),
+        "episodes": episodes,
+        "bootstrap": 200,
+    }
+    settings.update(overrides)
+    return CompareConfig(**settings)
+
+
+def run(config: CompareConfig, out: Path, **kwargs: Any) -> Any:
+    kwargs.setdefault("progress", False)
+    kwargs.setdefault("plots", False)
+    return run_comparison(config, out, **kwargs)
+
+
+def episode_results(out: Path) -> list[dict[str, Any]]:
+    """The logged episodes without their timings, in a canonical order."""
+    records = EpisodeLog(out / LOG_NAME).load()
+    for record in records:
+        record.pop("policy_seconds")
+    return sorted(records, key=lambda r: (r["policy"], r["seed"]))
+
+
+def test_seeds_are_the_documented_evaluation_range() -> None:
+    config = small_config(episodes=3)
+    assert config.seeds == [EVAL_SEED_START, EVAL_SEED_START + 1, EVAL_SEED_START + 2]
+    assert EVAL_SEED_START == 1_000_000
+
+
+def test_a_run_writes_every_output(tmp_path: Path) -> None:
+    result = run(small_config(), tmp_path, plots=True, command="bearing-env compare ...")
+    assert result.complete
+    for name in OUTPUT_FILES:
+        assert (tmp_path / name).stat().st_size > 0, name
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp") or ".tmp." in p.name]
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert set(summary["policies"]) == {"random_polygonal", "greedy_one_step"}
+    greedy = summary["policies"]["greedy_one_step"]
+    assert greedy["episodes"] == 4
+    assert set(greedy["area_after"]) == {"1", "3"}  # only counts <= max_moves = 4
+    assert len(greedy["curves"]["area_mean"]) == 5
+    report = (tmp_path / "report.md").read_text()
+    assert "greedy_one_step" in report and "bearing-env compare ..." in report
+    csv_lines = (tmp_path / "episodes.csv").read_text().strip().splitlines()
+    assert len(csv_lines) == 1 + 2 * 4
+
+
+def test_the_harness_is_deterministic(tmp_path: Path) -> None:
+    config = small_config()
+    run(config, tmp_path / "a")
+    run(config, tmp_path / "b")
+    assert (tmp_path / "a/summary.json").read_text() == (tmp_path / "b/summary.json").read_text()
+    assert episode_results(tmp_path / "a") == episode_results(tmp_path / "b")
+
+
+def test_parallel_workers_give_the_same_results(tmp_path: Path) -> None:
+    config = small_config(episodes=3)
+    run(config, tmp_path / "serial", workers=1)
+    run(config, tmp_path / "parallel", workers=2)
+    assert (tmp_path / "serial/summary.json").read_text() == (
+        tmp_path / "parallel/summary.json"
+    ).read_text()
+
+
+def test_a_resumed_run_reproduces_the_uninterrupted_one(tmp_path: Path) -> None:
+    config = small_config(episodes=5)
+    run(config, tmp_path / "whole")
+    partial = run(config, tmp_path / "resumed", stop_after=3)
+    assert not partial.complete
+    assert len(EpisodeLog(tmp_path / "resumed" / LOG_NAME).load()) == 3
+    resumed = run(config, tmp_path / "resumed", resume=True)
+    assert resumed.complete
+    assert (tmp_path / "whole/summary.json").read_text() == (
+        tmp_path / "resumed/summary.json"
+    ).read_text()
+    assert episode_results(tmp_path / "whole") == episode_results(tmp_path / "resumed")
+
+
+def test_a_torn_last_line_is_dropped_and_rerun(tmp_path: Path) -> None:
+    config = small_config(episodes=3)
+    run(config, tmp_path / "whole")
+    out = tmp_path / "killed"
+    run(config, out, stop_after=4)
+    log = out / LOG_NAME
+    text = log.read_text()
+    log.write_text(text + text.splitlines()[0][:40])  # killed in the middle of a write
+    run(config, out, resume=True)
+    assert len(EpisodeLog(log).load()) == 6
+    assert log.read_text().endswith("\n")
+    assert (tmp_path / "whole/summary.json").read_text() == (out / "summary.json").read_text()
+
+
+def test_a_finished_run_is_not_overwritten_by_accident(tmp_path: Path) -> None:
+    config = small_config(episodes=2)
+    run(config, tmp_path)
+    with pytest.raises(FileExistsError, match="--resume"):
+        run(config, tmp_path)
+    other_env = small_config(episodes=2, env_kwargs={"scenario": "khepera", "max_moves": 3})
+    with pytest.raises(RunMismatchError, match="env_kwargs"):
+        run(other_env, tmp_path, resume=True)
+    renamed = small_config(episodes=2, policies={"random_polygonal": "parallax"})
+    with pytest.raises(RunMismatchError, match="random_polygonal"):
+        run(renamed, tmp_path, resume=True)
+    run(other_env, tmp_path, overwrite=True)
+    assert json.loads((tmp_path / "config.json").read_text())["env_kwargs"]["max_moves"] == 3
+
+
+def test_resume_can_add_episodes_and_policies(tmp_path: Path) -> None:
+    run(small_config(episodes=2), tmp_path)
+    bigger = small_config(
+        episodes=3, policies=policies_from_specs(["random", "greedy", "parallax"])
+    )
+    result = run(bigger, tmp_path, resume=True)
+    assert result.complete and len(result.records) == 9
+    assert run(bigger, tmp_path / "fresh").summary == result.summary
+
+
+def test_bootstrap_ci_is_seeded_and_sensible() -> None:
+    values = np.random.default_rng(0).exponential(size=200)
+    low, high = bootstrap_mean_ci(values, np.random.default_rng(1), 2000)
+    assert low < values.mean() < high
+    assert (low, high) == bootstrap_mean_ci(values, np.random.default_rng(1), 2000)
+    assert 0.1 < high - low < 0.5  # ~ 2 * 1.96 / sqrt(200) for a unit exponential
+
+
+def test_env_kwargs_and_policy_labels_parse() -> None:
+    assert parse_env_kwargs(["scenario=khepera", "move_length=0.25", "noise=gaussian"]) == {
+        "scenario": "khepera",
+        "move_length": 0.25,
+        "noise": "gaussian",
+    }
+    assert parse_env_kwargs(["move_length=0.05,0.3"]) == {"move_length": (0.05, 0.3)}
+    with pytest.raises(ValueError, match="KEY=VALUE"):
+        parse_env_kwargs(["khepera"])
+    labels = policies_from_specs(["random", "random", "random:length=0.25"])
+    assert list(labels) == [
+        "random_polygonal",
+        "random_polygonal#2",
+        "random_polygonal[length=0.25]",
+    ]
+
+
+def test_command_line_runs_and_resumes(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    args = [
+        "--policies",
+        "random",
+        "parallax",
+        "--env",
+        "BearingSLAMDiscrete-v0",
+        "--env-kwargs",
+        "scenario=khepera",
+        "max_moves=3",
+        "--episodes",
+        "2",
+        "--out",
+        str(tmp_path),
+        "--no-progress",
+        "--no-plots",
+        "--bootstrap",
+        "100",
+        "--stop-after",
+        "1",
+    ]
+    main(args)
+    assert "INCOMPLETE" in capsys.readouterr().out
+    main([*args[:-2], "--resume"])
+    printed = capsys.readouterr().out
+    assert "complete" in printed and "parallax" in printed
+    with pytest.raises(SystemExit):
+        main(["--policies", "nonsense", "--out", str(tmp_path / "x"), "--no-progress"])
+    assert "unknown policy" in capsys.readouterr().err
+
+
+def test_the_report_quotes_the_command_that_reproduces_the_results() -> None:
+    from train.compare import reproducing_command
+
+    argv = ["--episodes", "9", "--resume", "--stop-after", "3", "--no-progress", "--out", "o"]
+    assert reproducing_command(argv) == "bearing-env compare --episodes 9 --out o"
+
+
+def test_bearing_env_dispatches_compare(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    cli.main(
+        [
+            "compare",
+            "--quick",
+            "--episodes",
+            "2",
+            "--policies",
+            "random",
+            "greedy",
+            "--no-progress",
+            "--bootstrap",
+            "50",
+        ]
+    )
+    out = tmp_path / "outputs" / "compare_quick"
+    assert (out / "report.md").exists() and (out / "area_vs_moves.png").exists()
+    config = json.loads((out / "config.json").read_text())
+    assert config["env_kwargs"] == {"scenario": "khepera", "max_moves": 10}
+    assert "Median total area" in capsys.readouterr().out
+    # --quick starts afresh each time (make demo reruns it).
+    cli.main(
+        [
+            "compare",
+            "--quick",
+            "--episodes",
+            "2",
+            "--policies",
+            "random",
+            "--no-progress",
+            "--no-plots",
+            "--bootstrap",
+            "50",
+        ]
+    )
+    assert list(json.loads((out / "config.json").read_text())["policies"]) == ["random_polygonal"]
+
+
+def test_atomic_outputs_leave_no_partial_files(tmp_path: Path) -> None:
+    from train.compare import atomic_write_text
+
+    target = tmp_path / "deep" / "file.json"
+    atomic_write_text(target, "{}\n")
+    atomic_write_text(target, '{"a": 1}\n')
+    assert target.read_text() == '{"a": 1}\n'
+    assert os.listdir(target.parent) == ["file.json"]
+
+
+@pytest.mark.slow
+def test_ctrl_c_then_resume_reproduces_the_uninterrupted_run(tmp_path: Path) -> None:
+    """A real SIGINT to a parallel run: finished episodes survive, --resume finishes."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    args = [
+        "--policies", "random", "greedy", "--env-kwargs", "scenario=khepera", "max_moves=5",
+        "--episodes", "16", "--workers", "2", "--no-progress", "--no-plots",
+        "--bootstrap", "100",
+    ]  # fmt: skip
+    root = Path(__file__).resolve().parents[1]
+
+    def command(out: Path, *extra: str) -> list[str]:
+        return [sys.executable, "-m", "train.compare", *args, "--out", str(out), *extra]
+
+    interrupted = tmp_path / "interrupted"
+    process = subprocess.Popen(
+        command(interrupted),
+        cwd=root,
+        start_new_session=True,  # its own process group, like a terminal's Ctrl-C
+        # A shell's background jobs ignore SIGINT; a terminal's foreground job does not.
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    log = interrupted / LOG_NAME
+    deadline = time.monotonic() + 60
+    while not (log.exists() and len(log.read_text().splitlines()) >= 6):
+        assert time.monotonic() < deadline and process.poll() is None
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGINT)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr
+    assert "--resume" in stderr
+    finished = len(EpisodeLog(log).load())
+    assert 6 <= finished < 32
+    subprocess.run(command(interrupted, "--resume"), cwd=root, check=True, capture_output=True)
+    subprocess.run(command(tmp_path / "whole"), cwd=root, check=True, capture_output=True)
+    assert (interrupted / "summary.json").read_text() == (
+        tmp_path / "whole" / "summary.json"
+    ).read_text()
