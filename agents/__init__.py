@@ -8,7 +8,8 @@ every step (see :class:`agents.base.Policy`). All work on both registered ids:
 - :class:`Parallax`: move across the line of sight of the most uncertain landmark;
 - :class:`GreedyOneStep`: one-step look-ahead on the robot's own map (no ground truth);
 - :class:`GreedyOracle`: the same on the true map (privileged upper reference);
-- :class:`SB3Policy`: a saved stable-baselines3 model.
+- :class:`SB3Policy`: a saved stable-baselines3 model; ``SB3Policy.pretrained(name, env)``
+  loads one shipped under ``agents/pretrained/`` (:func:`pretrained_names` lists them).
 
 :func:`make_policy` builds one from a spec string such as ``"greedy:n_turns=16"``.
 """
@@ -16,7 +17,7 @@ every step (see :class:`agents.base.Policy`). All work on both registered ids:
 from agents.base import ActionCodec, Movement, Policy
 from agents.heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
 from agents.registry import POLICY_CLASSES, PolicySpec, make_policy, parse_policy_spec
-from agents.sb3 import ModelLoadError, SB3Policy
+from agents.sb3 import ModelLoadError, SB3Policy, pretrained_names, pretrained_record
 
 __all__ = [
     "POLICY_CLASSES",
@@ -32,4 +33,6 @@ __all__ = [
     "SB3Policy",
     "make_policy",
     "parse_policy_spec",
+    "pretrained_names",
+    "pretrained_record",
 ]

@@ -7,6 +7,7 @@ A *policy spec* is a string ``NAME[:KEY=VALUE[,KEY=VALUE...]]``:
     greedy:n_turns=16,lengths=1     GreedyOneStep with 16 turns at the longest length
     sb3:path=runs/ppo/best_model.zip
     sb3:runs/ppo/best_model.zip     (sb3 only: a bare value is the path)
+    pretrained:ppo_khepera          a model shipped under agents/pretrained/, by name
     parallax:label=my_parallax      ``label`` renames the policy in reports
 
 Values are Python literals when they parse as one (``16``, ``0.25``, ``(0.1, 0.2)``,
@@ -25,8 +26,14 @@ from agents.base import Policy
 from agents.heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
 from agents.sb3 import SB3Policy
 
+
+def pretrained_policy(env: gym.Env, name: str, **options: Any) -> SB3Policy:
+    """A shipped model by name (``SB3Policy.pretrained``), as a spec-buildable factory."""
+    return SB3Policy.pretrained(name, env, **options)
+
+
 #: Policy classes by spec name (the first name of each class is its canonical one).
-POLICY_CLASSES: dict[str, type] = {
+POLICY_CLASSES: dict[str, Any] = {
     "random": RandomPolygonal,
     "random_polygonal": RandomPolygonal,
     "parallax": Parallax,
@@ -35,6 +42,7 @@ POLICY_CLASSES: dict[str, type] = {
     "oracle": GreedyOracle,
     "greedy_oracle": GreedyOracle,
     "sb3": SB3Policy,
+    "pretrained": pretrained_policy,
 }
 
 
@@ -55,6 +63,8 @@ class PolicySpec:
             from pathlib import Path
 
             return f"sb3_{Path(str(self.options.get('path', 'model'))).stem}"
+        if self.kind == "pretrained":
+            return str(self.options.get("name", "pretrained"))
         base = str(getattr(cls, "name", self.kind))
         if not self.options:
             return base
@@ -115,14 +125,20 @@ def parse_policy_spec(spec: str) -> PolicySpec:
             if kind == "sb3" and "path" not in options:
                 options["path"] = item
                 continue
+            if kind == "pretrained" and "name" not in options:
+                options["name"] = item
+                continue
             raise ValueError(f"policy option {item!r} in {spec!r} is not KEY=VALUE")
         key = key.strip()
         if key == "label":
             label = _string(value.strip())
         else:
-            options[key] = _string(value.strip()) if key == "path" else _literal(value.strip())
+            is_text = key == "path" or (kind == "pretrained" and key == "name")
+            options[key] = _string(value.strip()) if is_text else _literal(value.strip())
     if kind == "sb3" and "path" not in options:
         raise ValueError(f"policy spec {spec!r}: sb3 needs a model path (sb3:path=...)")
+    if kind == "pretrained" and "name" not in options:
+        raise ValueError(f"policy spec {spec!r}: pretrained needs a model name (pretrained:NAME)")
     # Aliases collapse to one canonical kind so equal policies get equal specs.
     canonical = next(name for name, cls in POLICY_CLASSES.items() if cls is POLICY_CLASSES[kind])
     return PolicySpec(kind=canonical, options=options, label=label)

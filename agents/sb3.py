@@ -47,6 +47,26 @@ _ALGORITHM_MODULES = {
 }
 
 
+#: Where shipped models live: ``<name>.zip``, ``<name>_vecnormalize.pkl`` and a
+#: ``<name>.json`` record of how the model was trained (env id and kwargs, timesteps).
+PRETRAINED_DIR = Path(__file__).resolve().parent / "pretrained"
+
+
+def pretrained_names() -> list[str]:
+    """Names of the models shipped under ``agents/pretrained/``, sorted."""
+    if not PRETRAINED_DIR.is_dir():
+        return []
+    return sorted(path.stem for path in PRETRAINED_DIR.glob("*.zip"))
+
+
+def pretrained_record(name: str) -> dict[str, Any]:
+    """The training record of a shipped model (env id, env kwargs, timesteps, ...)."""
+    record = PRETRAINED_DIR / f"{name}.json"
+    if not record.is_file():
+        raise FileNotFoundError(f"no training record for pretrained model {name!r}: {record}")
+    return dict(json.loads(record.read_text()))
+
+
 class ModelLoadError(ValueError):
     """A model or VecNormalize file exists but cannot be used."""
 
@@ -194,6 +214,22 @@ class SB3Policy:
         self.deterministic = bool(deterministic)
         self.discrete = isinstance(env.action_space, spaces.Discrete)
         self.name = name or f"sb3_{self.algo.lower()}_{self.model_path.stem}"
+
+    @classmethod
+    def pretrained(cls, name: str, env: gym.Env, **options: Any) -> SB3Policy:
+        """A model shipped with the package under ``agents/pretrained/``, by name.
+
+        See :func:`pretrained_names` for what is available; ``options`` go to the
+        constructor (e.g. ``deterministic=False``).
+
+        Raises:
+            ValueError: no shipped model has this name (the message lists them).
+        """
+        names = pretrained_names()
+        if name not in names:
+            raise ValueError(f"no pretrained model named {name!r}; available: {names}")
+        options.setdefault("name", name)
+        return cls(env, PRETRAINED_DIR / f"{name}.zip", **options)
 
     def _resolve_vecnormalize(self, vecnormalize: str | Path | None) -> Path | None:
         if vecnormalize is None:

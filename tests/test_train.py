@@ -28,6 +28,7 @@ import pytest
 import yaml
 
 import train.train as train_module
+from agents import SB3Policy
 from train.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
 from train.train import (
     EXIT_INTERRUPTED,
@@ -383,9 +384,8 @@ def test_export_writes_the_pretrained_layout(
     }
 
     # The exported files act like the run's best model, through agents.SB3Policy.
-    sb3_module = pytest.importorskip("agents.sb3")
     env = gym.make("BearingSLAM-v0", scenario="khepera")
-    policy = sb3_module.SB3Policy(env, folder / "ppo_tiny.zip")
+    policy = SB3Policy(env, folder / "ppo_tiny.zip")
     best = load_model(run / "best" / BEST_MODEL_NAME, "ppo")
     venv = make_validation_env("BearingSLAM-v0", {"scenario": "khepera"}, 1)
     stats = load_vecnormalize(run / "best" / "vecnormalize.pkl", venv)
@@ -394,6 +394,42 @@ def test_export_writes_the_pretrained_layout(
     np.testing.assert_array_equal(policy.act(observation, info), expected)
     env.close()
     venv.close()
+
+
+def test_exported_models_load_by_name_and_join_the_comparison(
+    tiny_runs: dict[str, TrainResult], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import agents.sb3
+    from agents import make_policy, pretrained_names
+    from train.compare import matching_pretrained
+
+    folder = tmp_path / "pretrained"
+    monkeypatch.setattr(agents.sb3, "PRETRAINED_DIR", folder)
+    assert pretrained_names() == []
+    export_run(tiny_runs["ppo"].run_dir, folder / "ppo_tiny")
+    assert pretrained_names() == ["ppo_tiny"]
+
+    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    by_name = SB3Policy.pretrained("ppo_tiny", env)
+    by_spec = make_policy("pretrained:ppo_tiny", env)
+    by_path = SB3Policy(env, folder / "ppo_tiny.zip")
+    assert by_name.name == by_spec.name == "ppo_tiny"
+    observation, info = env.reset(seed=3)
+    np.testing.assert_array_equal(by_name.act(observation, info), by_path.act(observation, info))
+    np.testing.assert_array_equal(by_spec.act(observation, info), by_path.act(observation, info))
+    with pytest.raises(ValueError, match=r"'ppo_nope'.*ppo_tiny"):
+        SB3Policy.pretrained("ppo_nope", env)
+    env.close()
+
+    # Compared by default only where it was trained: same id and env kwargs.
+    assert matching_pretrained("bearing_env:BearingSLAM-v0", {"scenario": "khepera"}) == [
+        "pretrained:ppo_tiny"
+    ]
+    assert matching_pretrained("BearingSLAM-v0", {"scenario": "khepera", "max_moves": 10}) == [
+        "pretrained:ppo_tiny"
+    ]
+    assert matching_pretrained("BearingSLAM-v0", {"scenario": "random"}) == []
+    assert matching_pretrained("BearingSLAMDiscrete-v0", {"scenario": "khepera"}) == []
 
 
 # --------------------------------------------------------------------------------------
@@ -452,7 +488,7 @@ def test_hyperparameter_parsing_follows_rl_zoo3() -> None:
 
 
 def test_seed_ranges_are_disjoint_and_validation_episodes_repeat() -> None:
-    compare = pytest.importorskip("train.compare")
+    import train.compare as compare
     assert TRAINING_SEED_LIMIT <= VALIDATION_SEED_START
     assert VALIDATION_SEED_START + MAX_EVAL_EPISODES <= compare.EVAL_SEED_START
     assert training_seed_start(7, 10**9, 8) + 8 <= TRAINING_SEED_LIMIT

@@ -977,7 +977,8 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="+",
         default=None,
         metavar="SPEC",
-        help=f"policy specs (default: {' '.join(DEFAULT_POLICIES)})",
+        help=f"policy specs (default: {' '.join(DEFAULT_POLICIES)}, and every model shipped "
+        "in agents/pretrained/ that was trained on this env id and env kwargs)",
     )
     parser.add_argument("--env", default=DEFAULT_ENV_ID, help="env id (default %(default)s)")
     parser.add_argument(
@@ -1039,13 +1040,36 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
+    """Specs of the shipped models trained on this env id and these env kwargs.
+
+    ``max_moves`` is ignored: it only sets how long an episode runs.
+    """
+    from agents import pretrained_names, pretrained_record
+
+    def plain(kwargs: dict[str, Any]) -> dict[str, Any]:
+        return {key: value for key, value in kwargs.items() if key != "max_moves"}
+
+    wanted = env_id.split(":")[-1]
+    specs = []
+    for name in pretrained_names():
+        record = pretrained_record(name)
+        trained_on = str(record.get("env_id", "")).split(":")[-1]
+        if trained_on == wanted and plain(dict(record.get("env_kwargs", {}))) == plain(env_kwargs):
+            specs.append(f"pretrained:{name}")
+    return specs
+
+
 def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
     env_kwargs = dict(DEFAULT_ENV_KWARGS)
     if args.env_kwargs is not None:
         env_kwargs = parse_env_kwargs(args.env_kwargs)
     if args.quick:
         env_kwargs.setdefault("max_moves", QUICK_MAX_MOVES)
-    policies = args.policies or list(QUICK_POLICIES if args.quick else DEFAULT_POLICIES)
+    policies = args.policies or [
+        *(QUICK_POLICIES if args.quick else DEFAULT_POLICIES),
+        *matching_pretrained(args.env, env_kwargs),
+    ]
     episodes = args.episodes or (QUICK_EPISODES if args.quick else 200)
     if episodes < 1:
         raise ValueError(f"--episodes must be >= 1, got {episodes}")
