@@ -317,7 +317,7 @@ def test_stuck_at_the_wall_does_not_update_the_map() -> None:
     env = BearingSLAMEnv(scenario="khepera", move_length=5.0)
     env.reset(seed=0)
     straight = np.array([0.0, 0.0], dtype=np.float32)
-    observation, *_ , info = env.step(straight)
+    observation, *_, info = env.step(straight)
     assert observation[8] == 1.0  # stopped by the wall
     assert info["path_length"] > 0
     observation, reward, _, _, info = env.step(straight)
@@ -424,8 +424,11 @@ def test_truncation_after_max_moves() -> None:
         ({"landmarks": [[0.1, 0.1], [0.2, 0.1]]}, ValueError, "landmarks.*2"),
         ({"landmarks": [[0.1, 0.1], [0.2, 0.1], [5.0, 0.3]]}, ValueError, r"\[5.0, 0.3\]"),
         ({"landmarks": [[0.1, 0.1], [0.1, 0.1], [0.3, 0.3]]}, ValueError, "distinct"),
-        ({"scenario": "khepera", "landmarks": [[0.1, 0.1], [0.2, 0.1], [0.3, 0.3]]},
-         ValueError, "khepera"),
+        (
+            {"scenario": "khepera", "landmarks": [[0.1, 0.1], [0.2, 0.1], [0.3, 0.3]]},
+            ValueError,
+            "khepera",
+        ),
         ({"colour": "red"}, TypeError, "colour"),
     ],
 )
@@ -569,3 +572,29 @@ def test_ppo_learns_a_few_hundred_steps(env_id: str) -> None:
     action, _ = model.predict(observation, deterministic=True)
     assert env.action_space.contains(action)
     env.step(action)
+
+
+def test_a_landmark_count_range_draws_a_count_per_episode() -> None:
+    env = gym.make("BearingSLAM-v0", n_landmarks=(4, 8))
+    assert (
+        env.observation_space.shape
+        == gym.make("BearingSLAM-v0", n_landmarks=8).observation_space.shape
+    )
+    counts = set()
+    for seed in range(30):
+        observation, info = env.reset(seed=seed)
+        n = env.unwrapped.n_landmarks
+        counts.add(n)
+        assert len(info["landmark_area"]) == n - 2
+        observation, _, _, _, info = env.step(env.action_space.sample())
+        assert len(info["landmark_area"]) == n - 2
+        assert env.observation_space.contains(observation)
+    assert counts == {4, 5, 6, 7, 8}
+    # The same seed gives the same count and layout.
+    first, _ = env.reset(seed=11)
+    again, _ = env.reset(seed=11)
+    np.testing.assert_array_equal(first, again)
+    with pytest.raises(ValueError, match="fixed landmark positions"):
+        gym.make("BearingSLAM-v0", scenario="khepera", n_landmarks=(4, 6))
+    with pytest.raises(ValueError, match="n_landmarks"):
+        gym.make("BearingSLAM-v0", n_landmarks=(6, 4))

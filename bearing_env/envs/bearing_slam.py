@@ -246,7 +246,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
       `n_landmarks` every episode), `"khepera"` (the paper's real arena, 4 landmarks),
       `"paper_sim"` (the paper's simulation: 4 landmarks around the centre of a 2 x 2 m
       square) or `"custom"` (default when `landmarks` is given).
-    - `n_landmarks`: number of landmarks (>= 3) for `"random"`; default 4.
+    - `n_landmarks`: number of landmarks (>= 3) for `"random"`; default 4. A range
+      `(lo, hi)` draws the count anew every episode (for policies that must generalise
+      across landmark counts); `max_landmarks` then defaults to `max(8, hi)`.
     - `landmarks`: explicit landmark positions `(n, 2)` in metres (L1 first, then L2).
     - `arena`: `(width, height)` in metres; default the scenario's (Khepera 1.05 x 0.68).
     - `epsilon_deg`: the SLAM's bearing error bound in degrees, in (0, 45); default 2.
@@ -275,7 +277,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     def __init__(
         self,
         scenario: str | None = None,
-        n_landmarks: int | None = None,
+        n_landmarks: int | tuple[int, int] | None = None,
         landmarks: ArrayLike | None = None,
         arena: tuple[float, float] | Arena | None = None,
         epsilon_deg: float = 2.0,
@@ -296,7 +298,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         scenario_spec = SCENARIOS[self.scenario]
         self.arena = self._resolve_arena(arena, scenario_spec.arena_size)
         self.fixed_landmarks = self._resolve_landmarks(landmarks, scenario_spec.landmarks)
-        self.n_landmarks = self._resolve_n_landmarks(n_landmarks, self.fixed_landmarks)
+        self.landmark_counts = self._resolve_landmark_counts(n_landmarks, self.fixed_landmarks)
+        #: Landmarks in the current episode (drawn from ``landmark_counts`` at each reset).
+        self.n_landmarks = self.landmark_counts[1]
 
         if not _is_number(epsilon_deg):
             raise TypeError(f"epsilon_deg must be a number, got {epsilon_deg!r}")
@@ -416,6 +420,24 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             raise ValueError(f"landmarks must be distinct points, got {points.tolist()}")
         return points
 
+    def _resolve_landmark_counts(
+        self, n_landmarks: int | tuple[int, int] | None, fixed: FloatArray | None
+    ) -> tuple[int, int]:
+        """``(lo, hi)``: each episode has between lo and hi landmarks (both included)."""
+        if isinstance(n_landmarks, (tuple, list)):
+            if fixed is not None:
+                raise ValueError(
+                    f"n_landmarks={n_landmarks!r}: a range needs random layouts, but scenario "
+                    f"{self.scenario!r} has fixed landmark positions"
+                )
+            if len(n_landmarks) != 2:
+                raise ValueError(f"n_landmarks range must be (lo, hi), got {n_landmarks!r}")
+            lo = _int_at_least(n_landmarks[0], 3, "n_landmarks")
+            hi = _int_at_least(n_landmarks[1], lo, "n_landmarks")
+            return lo, hi
+        n = self._resolve_n_landmarks(n_landmarks, fixed)
+        return n, n
+
     def _resolve_n_landmarks(self, n_landmarks: int | None, fixed: FloatArray | None) -> int:
         if fixed is not None:
             n_fixed = int(fixed.shape[0])
@@ -489,6 +511,12 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     ) -> tuple[NDArray[np.float32], dict[str, Any]]:
         super().reset(seed=seed)
         rng = self.np_random
+        lo, hi = self.landmark_counts
+        if hi > lo:
+            count = int(rng.integers(lo, hi + 1))
+            if count != self.n_landmarks:
+                self.n_landmarks = count
+                self._slam = PolygonSLAM(count, self.epsilon, transfer=self.transfer)
         if self.fixed_landmarks is not None:
             landmarks = self.fixed_landmarks.copy()
         else:

@@ -81,7 +81,7 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
     def __init__(
         self,
         scenario: str | None = None,
-        n_landmarks: int | None = None,
+        n_landmarks: int | tuple[int, int] | None = None,
         landmarks: ArrayLike | None = None,
         arena: tuple[float, float] | Arena | None = None,
         epsilon_deg: float = 2.0,
