@@ -1,0 +1,100 @@
+"""How a policy trained on random layouts generalises across landmark counts.
+
+Runs ``bearing-env compare`` on random layouts (evaluation seeds, unseen in training) for
+each landmark count, including counts the policy never saw, and prints one table of the
+median total area after 10 moves per policy and count.
+
+    python -m train.generalisation --model ppo_random --counts 3 4 6 8 10 --episodes 50
+
+The total area is summed over the mapped landmarks (L3, L4, ...), so it grows with the
+count; compare policies within a column. ``--max-landmarks`` must equal the observation
+slots the model was trained with.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from rich.console import Console
+from rich.table import Table
+
+DEFAULT_BASELINES = ("random", "parallax", "greedy")
+
+
+def run_counts(
+    model: str,
+    counts: list[int],
+    episodes: int,
+    max_landmarks: int,
+    workers: int,
+    out: Path,
+    resume: bool,
+) -> dict[int, dict[str, float]]:
+    """Median total area after 10 moves, per landmark count and policy label."""
+    medians: dict[int, dict[str, float]] = {}
+    for count in counts:
+        folder = out / f"n{count}"
+        command = [
+            sys.executable,
+            "-m",
+            "train.compare",
+            "--env-kwargs",
+            "scenario=random",
+            f"n_landmarks={count}",
+            f"max_landmarks={max_landmarks}",
+            "--policies",
+            *DEFAULT_BASELINES,
+            f"pretrained:{model}",
+            "--episodes",
+            str(episodes),
+            "--workers",
+            str(workers),
+            "--out",
+            str(folder),
+            "--no-progress",
+        ]
+        if resume and (folder / "config.json").exists():
+            command.append("--resume")
+        subprocess.run(command, check=True)
+        summary = json.loads((folder / "summary.json").read_text())
+        medians[count] = {
+            label: float(stats["area_after"]["10"]["median"])
+            for label, stats in summary["policies"].items()
+        }
+    return medians
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--model", default="ppo_random", help="shipped model name")
+    parser.add_argument("--counts", type=int, nargs="+", default=[3, 4, 6, 8, 10])
+    parser.add_argument("--episodes", type=int, default=50)
+    parser.add_argument("--max-landmarks", type=int, default=10)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=Path("outputs/generalisation"))
+    parser.add_argument("--resume", action="store_true", help="continue interrupted counts")
+    args = parser.parse_args()
+    if min(args.counts) < 3 or max(args.counts) > args.max_landmarks:
+        parser.error(f"--counts must lie in [3, --max-landmarks={args.max_landmarks}]")
+
+    medians = run_counts(
+        args.model, args.counts, args.episodes, args.max_landmarks, args.workers, args.out,
+        args.resume,
+    )  # fmt: skip
+    labels = list(next(iter(medians.values())))
+    table = Table(title="median total area after 10 moves, random layouts (evaluation seeds)")
+    table.add_column("landmarks")
+    for label in labels:
+        table.add_column(label, justify="right")
+    for count, row in medians.items():
+        table.add_row(str(count), *(f"{row[label]:.3g}" for label in labels))
+    Console().print(table)
+    (args.out / "generalisation.json").write_text(json.dumps(medians, indent=1))
+
+
+if __name__ == "__main__":
+    main()
