@@ -1,0 +1,35 @@
+"""The bearing-env command line: every subcommand resolves to a module with a main()."""
+
+import importlib
+import subprocess
+import sys
+
+import pytest
+
+from train.cli import SUBCOMMANDS
+
+
+@pytest.mark.parametrize("command", sorted(SUBCOMMANDS))
+def test_every_subcommand_has_a_main(command: str) -> None:
+    module_name, _ = SUBCOMMANDS[command]
+    assert callable(importlib.import_module(module_name).main)
+
+
+@pytest.mark.parametrize("command", sorted(SUBCOMMANDS))
+def test_subcommand_help_runs(command: str) -> None:
+    result = subprocess.run(
+        [sys.executable, "-m", "train.cli", command, "--help"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert result.returncode == 0, result.stderr
+    assert "usage:" in result.stdout
+
+
+def test_unknown_subcommand_is_rejected() -> None:
+    result = subprocess.run(
+        [sys.executable, "-m", "train.cli", "fly"], capture_output=True, text=True, timeout=60
+    )
+    assert result.returncode != 0
+    assert "invalid choice" in result.stderr
