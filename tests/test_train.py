@@ -429,6 +429,14 @@ def test_exported_models_load_by_name_and_join_the_comparison(
         "pretrained:ppo_tiny"
     ]
     assert matching_pretrained("BearingSLAM-v0", {"scenario": "random"}) == []
+    # Records are JSON: a tuple-valued kwarg must still match its JSON list.
+    record = folder / "ppo_tiny.json"
+    metadata = json.loads(record.read_text())
+    metadata["env_kwargs"]["n_landmarks"] = [4, 8]
+    record.write_text(json.dumps(metadata))
+    assert matching_pretrained(
+        "BearingSLAM-v0", {"scenario": "khepera", "n_landmarks": (4, 8)}
+    ) == ["pretrained:ppo_tiny"]
     assert matching_pretrained("BearingSLAMDiscrete-v0", {"scenario": "khepera"}) == []
 
 

@@ -1048,7 +1048,9 @@ def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
     from agents import pretrained_names, pretrained_record
 
     def plain(kwargs: dict[str, Any]) -> dict[str, Any]:
-        return {key: value for key, value in kwargs.items() if key != "max_moves"}
+        # Through JSON, as the record was written: tuples and lists compare equal.
+        kept = {key: value for key, value in kwargs.items() if key != "max_moves"}
+        return dict(json.loads(json.dumps(kept)))
 
     wanted = env_id.split(":")[-1]
     specs = []
