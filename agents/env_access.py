@@ -1,8 +1,7 @@
 """The one place where policies reach into the env, split by what the robot may know.
 
-The env exposes its state only through private attributes (``_slam``, ``_world``), so
-this module is the single reader of them; when the env grows public accessors, only this
-file changes.
+The env exposes the robot's map as ``env.unwrapped.slam`` and the ground truth as
+``env.unwrapped.world``; this module keeps the two apart for policies.
 
 - :func:`slam_of` is the robot's own knowledge: its map (landmark regions and estimates
   in FL, its own region and heading estimate). Any policy may read it.
@@ -32,12 +31,12 @@ def bearing_env_of(env: gym.Env) -> BearingSLAMEnv:
 
 def slam_of(env: gym.Env) -> PolygonSLAM:
     """The robot's map (what the robot knows)."""
-    return bearing_env_of(env)._slam
+    return bearing_env_of(env).slam
 
 
 def world_of(env: gym.Env) -> World:
     """Ground truth: privileged policies only. RuntimeError before the first reset."""
-    world = bearing_env_of(env)._world
+    world = bearing_env_of(env).world
     if world is None:
         raise RuntimeError("the env has no world yet: call env.reset() first")
     return world

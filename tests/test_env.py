@@ -598,3 +598,13 @@ def test_a_landmark_count_range_draws_a_count_per_episode() -> None:
         gym.make("BearingSLAM-v0", scenario="khepera", n_landmarks=(4, 6))
     with pytest.raises(ValueError, match="n_landmarks"):
         gym.make("BearingSLAM-v0", n_landmarks=(6, 4))
+
+
+def test_the_map_and_the_ground_truth_are_public_and_apart() -> None:
+    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    assert env.unwrapped.world is None  # no ground truth before the first reset
+    env.reset(seed=0)
+    world, slam = env.unwrapped.world, env.unwrapped.slam
+    assert world.landmarks.shape == (4, 2) and slam.n_landmarks == 4
+    env.step(np.array([0.5, 1.0], dtype=np.float32))
+    assert env.unwrapped.slam is slam  # the same map, updated in place

@@ -506,6 +506,19 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     # Gymnasium API
     # ------------------------------------------------------------------------------------
 
+    @property
+    def slam(self) -> PolygonSLAM:
+        """The robot's map: everything the robot knows (regions, estimates, its pose)."""
+        return self._slam
+
+    @property
+    def world(self) -> World | None:
+        """Ground truth (true landmarks, the robot's true pose); None before the first reset.
+
+        For evaluation and privileged policies only: a policy that reads it cheats.
+        """
+        return self._world
+
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[NDArray[np.float32], dict[str, Any]]:
