@@ -92,7 +92,7 @@ def random_polygonal_trace(
     bearing_block = observation_slices(base.max_landmarks)["bearings"]
     observation, info = env.reset(seed=seed)
     policy.reset(seed=seed)
-    world = base._world
+    world = base.world
     l1, l2 = world.landmarks[0], world.landmarks[1]
     areas, errors, bearings, polygons, estimates, trajectory = [], [], [], [], [], []
 
@@ -101,12 +101,12 @@ def random_polygonal_trace(
         errors.append(np.asarray(step_info["landmark_error"], dtype=float).copy())
         block = obs[bearing_block].reshape(-1, len(BEARING_FEATURES))[: base.n_landmarks]
         bearings.append(np.arctan2(block[:, 2], block[:, 1]).astype(float))
-        slam = base._slam
+        slam = base.slam
         polygons.append(
             [None if p is None else p.copy() for p in slam.polygons] if keep_polygons else []
         )
         estimates.append(slam.estimates.copy())
-        trajectory.append(world_to_fl(base._world.position, l1, l2))
+        trajectory.append(world_to_fl(base.world.position, l1, l2))
 
     record(observation, info)
     for _ in range(moves):
