@@ -21,6 +21,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from bearing_env.slam.geometry import wrap_angle
+
 FloatArray = NDArray[np.float64]
 
 #: The Khepera robot-soccer field of the paper's real-robot experiment (metres).
@@ -44,11 +46,6 @@ REFERENCE_WALL_MARGIN: float = 0.025
 REFERENCE_MIN_BASELINE: float = 1e-4
 
 NOISE_KINDS: tuple[str, ...] = ("uniform", "gaussian", "none")
-
-
-def wrap_angle(angle: ArrayLike) -> FloatArray:
-    """Wrap angles to [-pi, pi)."""
-    return (np.asarray(angle, dtype=np.float64) + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def _check_finite_positive(value: Any, name: str) -> float:

@@ -338,6 +338,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
         self._slam = PolygonSLAM(self.n_landmarks, self.epsilon, transfer=self.transfer)
         self._world: World | None = None
+        self._landmarks_fl = np.zeros((0, 2))
         self._moves = 0
         self._potential = 0.0
         self._latest_bearings = np.zeros(self.n_landmarks)
@@ -536,6 +537,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             landmarks = random_layout(rng, self.arena, self.n_landmarks)
         position, heading = random_start(rng, self.arena, landmarks)
         self._world = World(self.arena, landmarks, position, heading, self.noise, self.epsilon)
+        # Landmarks do not move: their true FL positions (for info) are fixed per episode.
+        self._landmarks_fl = world_to_fl(landmarks[2:], landmarks[0], landmarks[1])
         self._slam.reset()
         self._robot_area = None
         self._moves = 0
@@ -709,7 +712,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         world, slam = self._world, self._slam
         assert world is not None
         l1, l2 = world.landmarks[0], world.landmarks[1]
-        truth_fl = world_to_fl(world.landmarks[2:], l1, l2)
+        truth_fl = self._landmarks_fl
         initialised = slam.initialised
         areas = slam.areas
         errors = np.full(self.n_landmarks - 2, np.inf)

@@ -199,11 +199,6 @@ def _point_segment_distance(z: complex, a: complex, b: complex) -> float:
     return abs(z - (a + t * d))
 
 
-def polygons_overlap(p: ComplexArray, q: ComplexArray) -> bool:
-    """Whether two convex polygons (vertex arrays, CCW) touch or overlap."""
-    return polygon_distance(p, q) == 0.0
-
-
 def boundary_samples(poly: ComplexArray, per_edge: int) -> ComplexArray:
     """``per_edge`` evenly spaced points on each edge (vertex included): (..., V*per_edge)."""
     t = np.arange(per_edge) / per_edge
