@@ -1,0 +1,61 @@
+"""The models shipped under agents/pretrained/ still fit the envs they were trained on."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import bearing_env  # noqa: F401  (registers the ids)
+from agents import SB3Policy, pretrained_names, pretrained_record
+
+SHIPPED = ("ppo_khepera", "ppo_random")
+
+
+def test_the_shipped_models_are_listed() -> None:
+    assert set(SHIPPED) <= set(pretrained_names())
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_a_shipped_model_acts_on_the_env_of_its_record(name: str) -> None:
+    # A change to the observation or action layout would break the shipped models: the
+    # spaces are checked on load, and the policy must drive a whole episode.
+    record = pretrained_record(name)
+    env = gym.make(record["env_id"], **record["env_kwargs"])
+    policy = SB3Policy.pretrained(name, env)
+    policy.reset(seed=0)
+    observation, info = env.reset(seed=1_000_000)
+    done, moves = False, 0
+    while not done:
+        action = policy.act(observation, info)
+        assert env.action_space.contains(action)
+        observation, _, terminated, truncated, info = env.step(action)
+        done, moves = terminated or truncated, moves + 1
+    assert moves >= 1 and np.isfinite(info["total_area"])
+    env.close()
+
+
+def test_generalisation_table_covers_every_policy_and_count(tmp_path: Path) -> None:
+    out = tmp_path / "generalisation"
+    command = [sys.executable, "-m", "train.generalisation", "--model", "ppo_random",
+               "--counts", "3", "--episodes", "1", "--workers", "1", "--out", str(out)]  # fmt: skip
+    result = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    medians = json.loads((out / "generalisation.json").read_text())
+    assert set(medians) == {"3"}
+    assert set(medians["3"]) == {"random_polygonal", "parallax", "greedy_one_step", "ppo_random"}
+    assert all(np.isfinite(v) and v > 0 for v in medians["3"].values())
+
+
+def test_generalisation_rejects_counts_beyond_the_observation_slots() -> None:
+    result = subprocess.run(
+        [sys.executable, "-m", "train.generalisation", "--counts", "12"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert result.returncode == 2
+    assert "--counts" in result.stderr
