@@ -153,50 +153,47 @@ def _general_cone_vertices(
 # --------------------------------------------------------------------------------------
 
 
-def polygon_distance(p: ComplexArray, q: ComplexArray) -> float:
-    """Distance between two small convex polygons (vertex arrays, CCW); 0 when they touch.
+def polygon_distance(p: ComplexArray, q: ComplexArray) -> FloatArray:
+    """Distances between small convex polygons (vertex arrays (..., V), CCW); 0 if they touch.
 
-    Overlap is decided by the separating-axis test; the distance of disjoint polygons is
-    the smallest vertex-to-edge distance either way. Degenerate polygons (a point, a
-    segment, padded by repeated vertices) are handled. Plain Python: for the two
-    4-vertex regions of L1 and L2 it is several times faster than numpy.
+    Batched over leading axes (``p`` and ``q`` broadcast). Overlap is decided by the
+    separating-axis test; the distance of disjoint polygons is the smallest
+    vertex-to-edge distance either way. Degenerate polygons (a point, a segment, padded by
+    repeated vertices) are handled: the directions between vertices are candidate axes too.
     """
-    pts_p = [complex(z) for z in p]
-    pts_q = [complex(z) for z in q]
-    # Candidate separating axes: the edge normals of both polygons, and the directions
-    # between their vertices, which separate degenerate regions (points, segments).
-    axes = [
-        -1j * (poly[(i + 1) % len(poly)] - poly[i])
-        for poly in (pts_p, pts_q)
-        for i in range(len(poly))
-    ]
-    axes += [zq - zp for zp in pts_p for zq in pts_q]
-    separated = False
-    for axis in axes:
-        if axis == 0:
-            continue
-        proj_p = [(axis.conjugate() * z).real for z in pts_p]
-        proj_q = [(axis.conjugate() * z).real for z in pts_q]
-        if min(proj_q) > max(proj_p) or min(proj_p) > max(proj_q):
-            separated = True
-            break
-    if not separated:
-        return 0.0
-    return min(
-        _point_segment_distance(z, poly[i], poly[(i + 1) % len(poly)])
-        for points, poly in ((pts_p, pts_q), (pts_q, pts_p))
-        for z in points
-        for i in range(len(poly))
+    p, q = np.broadcast_arrays(np.asarray(p, complex), np.asarray(q, complex))
+    axes = np.concatenate(
+        [
+            -1j * (_next_vertex(p) - p),
+            -1j * (_next_vertex(q) - q),
+            (q[..., None, :] - p[..., :, None]).reshape(*p.shape[:-1], p.shape[-1] * q.shape[-1]),
+        ],
+        axis=-1,
     )
+    conj_axes = np.conj(axes)[..., :, None]
+    proj_p = (conj_axes * p[..., None, :]).real
+    proj_q = (conj_axes * q[..., None, :]).real
+    # A zero axis projects both polygons to 0: never separating, no special case needed.
+    separated = (
+        (proj_q.min(axis=-1) > proj_p.max(axis=-1)) | (proj_p.min(axis=-1) > proj_q.max(axis=-1))
+    ).any(axis=-1)
+    gaps = np.minimum(
+        _point_edge_distances(p, q).min(axis=(-1, -2)),
+        _point_edge_distances(q, p).min(axis=(-1, -2)),
+    )
+    return np.where(separated, gaps, 0.0)
 
 
-def _point_segment_distance(z: complex, a: complex, b: complex) -> float:
-    d = b - a
+def _point_edge_distances(points: ComplexArray, poly: ComplexArray) -> FloatArray:
+    """Distance from every point to every edge of ``poly``: (..., n_points, n_edges)."""
+    a = poly[..., None, :]
+    d = _next_vertex(poly)[..., None, :] - a
+    z = points[..., :, None]
     len2 = d.real * d.real + d.imag * d.imag
-    if len2 == 0.0:
-        return abs(z - a)
-    t = min(1.0, max(0.0, ((z - a) * d.conjugate()).real / len2))
-    return abs(z - (a + t * d))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.clip(((z - a) * np.conj(d)).real / len2, 0.0, 1.0)
+    t = np.where(len2 > 0.0, t, 0.0)
+    return np.abs(z - (a + t * d))
 
 
 def boundary_samples(poly: ComplexArray, per_edge: int) -> ComplexArray:
@@ -207,10 +204,9 @@ def boundary_samples(poly: ComplexArray, per_edge: int) -> ComplexArray:
     return pts.reshape(*poly.shape[:-1], poly.shape[-1] * per_edge)
 
 
-def max_edge_length(poly: ComplexArray) -> float:
-    """Longest edge of one small polygon (vertex array)."""
-    pts = [complex(z) for z in poly]
-    return max(abs(pts[(i + 1) % len(pts)] - pts[i]) for i in range(len(pts)))
+def max_edge_length(poly: ComplexArray) -> FloatArray:
+    """Longest edge of small polygons (vertex arrays (..., V)): shape (...)."""
+    return np.abs(_next_vertex(poly) - poly).max(axis=-1)
 
 
 def _next_vertex(poly: ComplexArray) -> ComplexArray:

@@ -2,33 +2,43 @@
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
 
-from bearing_env.slam.geometry import (
-    FR_BOUNDED,
-    FR_EMPTY,
-    KGon,
-    cone_intersections,
+from bearing_env.slam.batch import (
+    FRAME_STATUSES,
+    INCONSISTENCY_POLICIES,
+    LANDMARK_STATUSES,
+    STATE_ARRAYS,
+    BatchedPolygonSLAM,
 )
-from bearing_env.slam.transfer import TRANSFERS, Hypotheses, make_hypotheses, transfer_support
+from bearing_env.slam.geometry import KGon
 
-FRAME_OK = "ok"
-FRAME_L1_UNBOUNDED = "l1_unbounded"
-FRAME_L2_UNBOUNDED = "l2_unbounded"
-FRAME_L1_L2_OVERLAP = "l1_l2_overlap"
-FRAME_L1_L2_TOO_CLOSE = "l1_l2_too_close"
+FRAME_OK, FRAME_L1_UNBOUNDED, FRAME_L2_UNBOUNDED, FRAME_L1_L2_OVERLAP, FRAME_L1_L2_TOO_CLOSE = (
+    FRAME_STATUSES
+)
+LANDMARK_UPDATED, LANDMARK_UNBOUNDED, LANDMARK_INCONSISTENT, LANDMARK_SKIPPED = LANDMARK_STATUSES
+_LANDMARK_NAMES = np.array(LANDMARK_STATUSES, dtype="<U12")
 
-LANDMARK_UPDATED = "updated"
-LANDMARK_UNBOUNDED = "unbounded"
-LANDMARK_INCONSISTENT = "inconsistent"
-LANDMARK_SKIPPED = "skipped"
-
-INCONSISTENCY_POLICIES = ("restart", "keep")
+__all__ = [
+    "FRAME_L1_L2_OVERLAP",
+    "FRAME_L1_L2_TOO_CLOSE",
+    "FRAME_L1_UNBOUNDED",
+    "FRAME_L2_UNBOUNDED",
+    "FRAME_OK",
+    "INCONSISTENCY_POLICIES",
+    "LANDMARK_INCONSISTENT",
+    "LANDMARK_SKIPPED",
+    "LANDMARK_UNBOUNDED",
+    "LANDMARK_UPDATED",
+    "PolygonSLAM",
+    "UpdateResult",
+    "fl_to_world",
+    "world_to_fl",
+]
 
 
 @dataclass(frozen=True)
@@ -120,54 +130,87 @@ class PolygonSLAM:
         edge_samples: int = 3,
         on_inconsistency: str = "restart",
     ) -> None:
-        if isinstance(n_landmarks, bool) or not isinstance(n_landmarks, (int, np.integer)):
-            raise TypeError(f"n_landmarks must be an int, got {n_landmarks!r}")
-        if n_landmarks < 3:
-            raise ValueError(f"n_landmarks must be >= 3 (L1, L2 and one more), got {n_landmarks}")
-        epsilon = float(epsilon)
-        if not 0.0 < epsilon < np.pi / 2:
-            raise ValueError(f"epsilon must be in (0, pi/2) radians, got {epsilon!r}")
-        if transfer not in TRANSFERS:
-            raise ValueError(f"transfer must be one of {TRANSFERS}, got {transfer!r}")
-        if on_inconsistency not in INCONSISTENCY_POLICIES:
-            raise ValueError(
-                f"on_inconsistency must be one of {INCONSISTENCY_POLICIES}, "
-                f"got {on_inconsistency!r}"
-            )
-        if isinstance(edge_samples, bool) or not isinstance(edge_samples, (int, np.integer)):
-            raise TypeError(f"edge_samples must be an int, got {edge_samples!r}")
-        if edge_samples < 1:
-            raise ValueError(f"edge_samples must be >= 1, got {edge_samples}")
-        self.n_landmarks = int(n_landmarks)
-        self.epsilon = epsilon
-        self.transfer = transfer
-        self.edge_samples = int(edge_samples)
-        self.on_inconsistency = on_inconsistency
-        if isinstance(directions, bool) or not isinstance(directions, (int, np.integer)):
-            raise TypeError(f"directions must be an int, got {directions!r}")
-        self.kgon = KGon(int(directions))
-        self.reset()
+        self._batch = BatchedPolygonSLAM(
+            1,
+            n_landmarks,
+            epsilon,
+            transfer=transfer,
+            directions=directions,
+            edge_samples=edge_samples,
+            on_inconsistency=on_inconsistency,
+        )
+        self._attach(self._batch, 0)
+
+    def _attach(self, batch: BatchedPolygonSLAM, index: int) -> None:
+        self._batch = batch
+        self._index = index
+        self._rows = np.array([index])
+        self.n_landmarks = batch.n_landmarks
+        self.epsilon = batch.epsilon
+        self.transfer = batch.transfer
+        self.edge_samples = batch.edge_samples
+        self.on_inconsistency = batch.on_inconsistency
+        self.kgon = batch.kgon
+
+    @classmethod
+    def view(cls, batch: BatchedPolygonSLAM, index: int) -> PolygonSLAM:
+        """Map ``index`` of a batch, shared: updating either updates both.
+
+        The batched vector environment gives each sub-environment such a view, so the
+        sub-environment's code reads its map while the vector environment updates all
+        maps in one call.
+        """
+        if not 0 <= index < batch.num_maps:
+            raise IndexError(f"map index {index} out of range for a batch of {batch.num_maps}")
+        slam = cls.__new__(cls)
+        slam._attach(batch, int(index))
+        return slam
+
+    @property
+    def batch(self) -> BatchedPolygonSLAM:
+        """The batch holding this map (a batch of one unless this is a :meth:`view`)."""
+        return self._batch
+
+    @property
+    def index(self) -> int:
+        """This map's index in :attr:`batch`."""
+        return self._index
 
     # -- state -----------------------------------------------------------------------------
 
     def reset(self) -> None:
         """Forget everything: no landmark initialised, no robot region."""
-        n = self.n_landmarks - 2
-        self._support = np.full((n, self.kgon.k), np.inf)
-        self._initialised = np.zeros(n, dtype=bool)
-        self._robot_support: NDArray[np.float64] | None = None
-        self._robot_heading = float("nan")
-        self._areas = np.full(n, np.inf)
-        self._centroids = np.full(n, complex(np.nan, np.nan))
-        self._robot_centroid = complex(np.nan, np.nan)
-        self._robot_area = float("inf")
-        self.n_updates = 0
-        self.n_frame_changes = 0
-        self.n_inconsistent = 0
+        self._batch.reset(self._rows)
 
     def copy(self) -> PolygonSLAM:
         """An independent copy (for planning: simulate moves without touching the map)."""
-        return copy.deepcopy(self)
+        batch = self._batch
+        clone = PolygonSLAM(
+            batch.n_landmarks,
+            batch.epsilon,
+            transfer=batch.transfer,
+            directions=batch.kgon.k,
+            edge_samples=batch.edge_samples,
+            on_inconsistency=batch.on_inconsistency,
+        )
+        for name in STATE_ARRAYS:
+            getattr(clone._batch, name)[0] = getattr(batch, name)[self._index]
+        return clone
+
+    @property
+    def n_updates(self) -> int:
+        """Movements fed to :meth:`update`."""
+        return int(self._batch.n_updates[self._index])
+
+    @property
+    def n_frame_changes(self) -> int:
+        """Movements that could change frames and update the map."""
+        return int(self._batch.n_frame_changes[self._index])
+
+    @property
+    def n_inconsistent(self) -> int:
+        """Landmark updates that met an inconsistency, over all movements."""
+        return int(self._batch.n_inconsistent[self._index])
 
     # -- the update --------------------------------------------------------------------------
 
@@ -184,63 +227,13 @@ class PolygonSLAM:
         """
         b1 = self._check_bearings(bearings_start, "bearings_start")
         b2 = self._check_bearings(bearings_end, "bearings_end")
-        self.n_updates += 1
-        n_mapped = self.n_landmarks - 2
-        regions, fr_status = cone_intersections(b1, b2, self.epsilon)
-
-        frame_status = FRAME_OK
-        if fr_status[0] != FR_BOUNDED:
-            frame_status = FRAME_L1_UNBOUNDED
-        elif fr_status[1] != FR_BOUNDED:
-            frame_status = FRAME_L2_UNBOUNDED
-        hyp: Hypotheses | str = frame_status
-        if frame_status == FRAME_OK:
-            hyp = make_hypotheses(regions[0], regions[1], self.transfer, self.edge_samples)
-        if isinstance(hyp, str):
-            frame_status = hyp
-            skipped = np.full(n_mapped, LANDMARK_SKIPPED, dtype="<U12")
-            return UpdateResult(False, frame_status, skipped, 0)
-
-        self.n_frame_changes += 1
-        status = np.full(n_mapped, LANDMARK_UNBOUNDED, dtype="<U12")
-        status[fr_status[2:] == FR_EMPTY] = LANDMARK_INCONSISTENT
-        idx = np.flatnonzero(fr_status[2:] == FR_BOUNDED)
-
-        # One batched transfer: row 0 is the robot's R2 = 1 in FR, then the landmarks.
-        targets = np.empty((idx.size + 1, 4), dtype=complex)
-        targets[0] = 1.0
-        targets[1:] = regions[2 + idx]
-        new = transfer_support(self.kgon, hyp, targets)
-        robot, new = new[0], new[1:]
-        finite = np.all(np.isfinite(new), axis=-1)
-        idx, new = idx[finite], new[finite]
-
-        fused = new
-        was_init = self._initialised[idx]
-        inconsistent = np.zeros(idx.size, dtype=bool)
-        if was_init.any():
-            old = self._support[idx[was_init]]
-            merged, empty = self.kgon.intersect(old, new[was_init])
-            fallback = old if self.on_inconsistency == "keep" else new[was_init]
-            merged[empty] = fallback[empty]
-            fused = new.copy()
-            fused[was_init] = merged
-            inconsistent[np.flatnonzero(was_init)[empty]] = True
-        status[idx] = np.where(inconsistent, LANDMARK_INCONSISTENT, LANDMARK_UPDATED)
-        self._support[idx] = fused
-        self._initialised[idx] = True
-        self._robot_support = robot
-        area, centroid = self.kgon.area_centroid(np.concatenate([robot[None], fused]))
-        self._robot_centroid = complex(centroid[0])
-        self._robot_area = float(area[0])
-        self._areas[idx] = area[1:]
-        self._centroids[idx] = centroid[1:]
-        # Heading: the FR x-axis seen through T at the vertex means of A_L1 and A_L2.
-        self._robot_heading = float(-np.angle(regions[1].mean() - regions[0].mean()))
-
-        n_bad = int(np.count_nonzero(status == LANDMARK_INCONSISTENT))
-        self.n_inconsistent += n_bad
-        return UpdateResult(True, FRAME_OK, status, n_bad)
+        result = self._batch.update(b1[None], b2[None], maps=self._rows)
+        return UpdateResult(
+            frame_changed=bool(result.frame_changed[0]),
+            frame_status=FRAME_STATUSES[result.frame_status[0]],
+            landmark_status=_LANDMARK_NAMES[result.landmark_status[0]],
+            n_inconsistent=int(result.n_inconsistent[0]),
+        )
 
     def _check_bearings(self, bearings: ArrayLike, name: str) -> NDArray[np.float64]:
         arr = np.asarray(bearings, dtype=np.float64)
@@ -257,29 +250,34 @@ class PolygonSLAM:
     @property
     def initialised(self) -> NDArray[np.bool_]:
         """Bool (n_landmarks - 2,): landmark ``i >= 3`` has a region."""
-        return self._initialised.copy()
+        return self._batch.initialised[self._index].copy()
 
     @property
     def areas(self) -> NDArray[np.float64]:
         """Region areas (n_landmarks - 2,) in FL units squared; ``inf`` if not initialised."""
-        return self._areas.copy()
+        return self._batch.areas[self._index].copy()
 
     @property
     def estimates(self) -> NDArray[np.float64]:
         """Region centroids (n_landmarks - 2, 2) in FL; ``nan`` if not initialised."""
-        return np.stack([self._centroids.real, self._centroids.imag], axis=-1)
+        centroids = self._batch.centroids[self._index]
+        return np.stack([centroids.real, centroids.imag], axis=-1)
 
     @property
     def supports(self) -> NDArray[np.float64]:
         """Raw K-gon support values (n_landmarks - 2, K); ``inf`` rows if not initialised."""
-        return self._support.copy()
+        return self._batch.support[self._index].copy()
 
     @property
     def polygons(self) -> list[NDArray[np.float64] | None]:
         """Region vertices (k, 2) counter-clockwise in FL per landmark, or None."""
         return [
             _kgon_vertices_xy(self.kgon, h) if ok else None
-            for h, ok in zip(self._support, self._initialised, strict=True)
+            for h, ok in zip(
+                self._batch.support[self._index],
+                self._batch.initialised[self._index],
+                strict=True,
+            )
         ]
 
     @property
@@ -290,9 +288,9 @@ class PolygonSLAM:
     @property
     def robot_polygon(self) -> NDArray[np.float64] | None:
         """The robot's current region (R2 of the last frame-changing move) as vertices."""
-        if self._robot_support is None:
+        if not self._batch.has_robot[self._index]:
             return None
-        return _kgon_vertices_xy(self.kgon, self._robot_support)
+        return _kgon_vertices_xy(self.kgon, self._batch.robot_support[self._index])
 
     @property
     def robot_region(self) -> shapely.Polygon | None:
@@ -302,17 +300,18 @@ class PolygonSLAM:
     @property
     def robot_estimate(self) -> NDArray[np.float64]:
         """Centroid (2,) of the robot's region in FL; ``nan`` before any frame change."""
-        return np.array([self._robot_centroid.real, self._robot_centroid.imag])
+        centroid = self._batch.robot_centroid[self._index]
+        return np.array([centroid.real, centroid.imag])
 
     @property
     def robot_area(self) -> float:
         """Area of the robot's region in FL units squared; ``inf`` before any frame change."""
-        return self._robot_area
+        return float(self._batch.robot_area[self._index])
 
     @property
     def robot_heading(self) -> float:
         """Direction (radians, FL) of the last frame-changing movement; ``nan`` if none."""
-        return self._robot_heading
+        return float(self._batch.robot_heading[self._index])
 
     def contains(self, points_fl: ArrayLike) -> NDArray[np.bool_]:
         """Whether region ``i`` contains FL point ``i`` (shape (n_landmarks - 2, 2)).
@@ -320,20 +319,21 @@ class PolygonSLAM:
         False for landmarks that are not initialised.
         """
         z = _to_complex(points_fl)
-        if z.shape != self._initialised.shape:
+        ok = self._batch.initialised[self._index]
+        if z.shape != ok.shape:
             raise ValueError(
                 f"points_fl must have shape ({self.n_landmarks - 2}, 2), got {np.shape(points_fl)}"
             )
         inside = np.zeros(z.shape, dtype=bool)
-        ok = self._initialised
-        inside[ok] = self.kgon.contains(self._support[ok], z[ok])
+        inside[ok] = self.kgon.contains(self._batch.support[self._index][ok], z[ok])
         return inside
 
     def robot_contains(self, point_fl: ArrayLike) -> bool:
         """Whether the robot's region contains ``point_fl`` (2,)."""
-        if self._robot_support is None:
+        if not self._batch.has_robot[self._index]:
             return False
-        return bool(self.kgon.contains(self._robot_support, _to_complex(point_fl)))
+        support = self._batch.robot_support[self._index]
+        return bool(self.kgon.contains(support, _to_complex(point_fl)))
 
 
 def _kgon_vertices_xy(kgon: KGon, h: NDArray[np.float64]) -> NDArray[np.float64]:

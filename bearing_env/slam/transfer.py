@@ -38,10 +38,10 @@ Two transfers are offered:
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from bearing_env.slam.geometry import (
     ComplexArray,
@@ -58,103 +58,188 @@ TRANSFERS = ("conservative", "paper")
 #: than ``edge_samples`` only when L1 and L2 are close relative to their regions' size).
 MAX_EDGE_SAMPLES = 8
 
+#: Outcomes of :func:`plan_frame_changes`.
+PLAN_OK = 0
+PLAN_OVERLAP = 1
+PLAN_TOO_CLOSE = 2
+
+#: Elements per temporary array in :func:`transfer_support`; chunks of this size stay in
+#: the CPU cache however many maps are batched.
+_CHUNK_ELEMENTS = 1 << 17
+
+
+@dataclass(frozen=True)
+class FramePlan:
+    """How each movement of a batch changes frames (arrays over the batch).
+
+    ``status`` is :data:`PLAN_OK`, :data:`PLAN_OVERLAP` (the regions of L1 and L2 touch, so
+    ``h2 - h1`` can be 0) or :data:`PLAN_TOO_CLOSE` (the conservative bound does not
+    apply: an edge piece would be longer than twice their distance). ``per_edge`` is the
+    number of samples per edge of A_L1 and A_L2 (1 for the paper transfer: the vertices).
+    """
+
+    status: NDArray[np.int8]
+    distance: FloatArray
+    per_edge: NDArray[np.int64]
+    longest1: FloatArray
+    longest2: FloatArray
+
+
+def plan_frame_changes(
+    a1: ComplexArray, a2: ComplexArray, transfer: str, edge_samples: int
+) -> FramePlan:
+    """Decide, per movement, whether and how finely to sample the hypotheses.
+
+    Args:
+        a1, a2: vertex arrays (N, V) of the FR regions of L1 and L2 (bounded).
+        transfer: ``"paper"`` or ``"conservative"``.
+        edge_samples: the fewest samples per edge for the conservative transfer.
+    """
+    if transfer not in TRANSFERS:
+        raise ValueError(f"transfer must be one of {TRANSFERS}, got {transfer!r}")
+    distance = polygon_distance(a1, a2)
+    longest1, longest2 = max_edge_length(a1), max_edge_length(a2)
+    overlap = ~(distance > 0.0)
+    if transfer == "paper":
+        per_edge = np.ones(distance.shape, dtype=np.int64)
+        too_close = np.zeros(distance.shape, dtype=bool)
+    else:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            needed = np.ceil(np.maximum(longest1, longest2) / (2.0 * distance))
+        needed = np.where(overlap, 1.0, needed)
+        too_close = ~overlap & (needed > MAX_EDGE_SAMPLES)
+        per_edge = np.maximum(edge_samples, np.where(too_close, 1.0, needed)).astype(np.int64)
+    status = np.where(overlap, PLAN_OVERLAP, np.where(too_close, PLAN_TOO_CLOSE, PLAN_OK))
+    return FramePlan(status.astype(np.int8), distance, per_edge, longest1, longest2)
+
+
 @dataclass(frozen=True)
 class Hypotheses:
-    """The sampled frame changes of one movement, shared by every target.
+    """The sampled frame changes of a batch of movements with equal ``per_edge``.
 
-    ``inv_d[p] = 1 / (h2 - h1)`` and ``h1[p]`` for the sampled hypothesis pairs ``p``;
-    ``T(z) = (z - h1) * inv_d``.
+    ``inv_d[g, p] = 1 / (h2 - h1)`` and ``h1[g, p]`` for the sampled hypothesis pairs
+    ``p`` of movement ``g``; ``T(z) = (z - h1) * inv_d``.
     """
 
     h1: ComplexArray
     inv_d: ComplexArray
     a1: ComplexArray
     a2: ComplexArray
-    distance: float
-    delta1: float
-    delta2: float
+    distance: FloatArray
+    delta1: FloatArray
+    delta2: FloatArray
     conservative: bool
 
     def images(self, points: ComplexArray) -> ComplexArray:
-        """FL images of FR points under every sampled hypothesis: (..., n_hypotheses)."""
-        return (points[..., None] - self.h1) * self.inv_d
+        """FL images of FR points (G, ...) under every sampled hypothesis: (G, ..., P)."""
+        extra = (None,) * (points.ndim - 1)
+        h1 = self.h1[(slice(None), *extra)]
+        inv_d = self.inv_d[(slice(None), *extra)]
+        return (points[..., None] - h1) * inv_d
 
     def inflation(self, targets: ComplexArray) -> FloatArray:
-        """Radius ``r`` that makes the sampled hull conservative, per target row."""
+        """Radius ``r`` that makes the sampled hull conservative: (G, m) for targets (G, m, V)."""
         if not self.conservative:
             return np.zeros(targets.shape[:-1])
-        v1 = np.abs(targets[..., :, None] - self.a1).max(axis=(-1, -2))
-        v2 = np.abs(targets[..., :, None] - self.a2).max(axis=(-1, -2))
-        r = (v2 * self.delta1**2 + v1 * self.delta2**2) / (4.0 * self.distance**3)
+        v1 = np.abs(targets[..., :, None] - self.a1[:, None, None, :]).max(axis=(-1, -2))
+        v2 = np.abs(targets[..., :, None] - self.a2[:, None, None, :]).max(axis=(-1, -2))
+        distance = self.distance[:, None]
+        r = (v2 * self.delta1[:, None] ** 2 + v1 * self.delta2[:, None] ** 2) / (
+            4.0 * distance**3
+        )
         # A relative margin far above rounding error keeps the bound a bound in floats.
-        return r + 1e-9 * (1.0 + v1 / self.distance)
+        return r + 1e-9 * (1.0 + v1 / distance)
+
+
+def sample_hypotheses(
+    a1: ComplexArray, a2: ComplexArray, plan: FramePlan, per_edge: int, conservative: bool
+) -> Hypotheses:
+    """The hypothesis pairs of movements (rows of ``a1``/``a2``/``plan``) sharing ``per_edge``."""
+    h1, h2 = boundary_samples(a1, per_edge), boundary_samples(a2, per_edge)
+    n_rows, n_samples = h1.shape
+    if conservative:
+        delta1, delta2 = plan.longest1 / per_edge, plan.longest2 / per_edge
+    else:
+        delta1 = delta2 = np.zeros(n_rows)
+    return Hypotheses(
+        h1=np.repeat(h1, n_samples, axis=-1),
+        inv_d=(1.0 / (h2[:, None, :] - h1[:, :, None])).reshape(n_rows, -1),
+        a1=a1,
+        a2=a2,
+        distance=plan.distance,
+        delta1=delta1,
+        delta2=delta2,
+        conservative=conservative,
+    )
 
 
 def make_hypotheses(
     a1: ComplexArray, a2: ComplexArray, transfer: str, edge_samples: int
 ) -> Hypotheses | str:
-    """Sample the hypotheses ``(h1, h2)`` of one movement.
+    """Sample the hypotheses ``(h1, h2)`` of one movement (a batch of one).
 
     Args:
-        a1, a2: vertex arrays (4,) of the FR regions of L1 and L2.
+        a1, a2: vertex arrays (V,) of the FR regions of L1 and L2.
         transfer: ``"paper"`` (vertex pairs) or ``"conservative"``.
         edge_samples: samples per edge for the conservative transfer.
 
     Returns:
-        The hypotheses, or why the frame cannot be changed: ``"l1_l2_overlap"`` when the
-        regions touch (``h2 - h1`` can be 0), ``"l1_l2_too_close"`` when the conservative
-        bound does not apply (a sampled edge piece is longer than twice the distance).
+        The hypotheses, or why the frame cannot be changed: ``"l1_l2_overlap"`` or
+        ``"l1_l2_too_close"`` (see :class:`FramePlan`).
     """
-    if transfer not in TRANSFERS:
-        raise ValueError(f"transfer must be one of {TRANSFERS}, got {transfer!r}")
     if a1.shape != a2.shape:  # pad the shorter by repeating its last vertex
         size = max(a1.size, a2.size)
         a1 = np.concatenate([a1, np.repeat(a1[-1:], size - a1.size)])
         a2 = np.concatenate([a2, np.repeat(a2[-1:], size - a2.size)])
-    distance = polygon_distance(a1, a2)
-    if not distance > 0.0:
+    a1, a2 = a1[None], a2[None]
+    plan = plan_frame_changes(a1, a2, transfer, edge_samples)
+    if plan.status[0] == PLAN_OVERLAP:
         return "l1_l2_overlap"
-    if transfer == "paper":
-        h1, h2 = a1, a2
-        delta1 = delta2 = 0.0
-    else:
-        longest1, longest2 = max_edge_length(a1), max_edge_length(a2)
-        per_edge = max(edge_samples, math.ceil(max(longest1, longest2) / (2.0 * distance)))
-        if per_edge > MAX_EDGE_SAMPLES:
-            return "l1_l2_too_close"
-        delta1, delta2 = longest1 / per_edge, longest2 / per_edge
-        h1, h2 = boundary_samples(np.stack([a1, a2]), per_edge)
-    h1_pairs = np.repeat(h1, h2.shape[-1])
-    return Hypotheses(
-        h1=h1_pairs,
-        inv_d=1.0 / (h2[None, :] - h1[:, None]).reshape(-1),
-        a1=a1,
-        a2=a2,
-        distance=distance,
-        delta1=delta1,
-        delta2=delta2,
-        conservative=transfer == "conservative",
-    )
+    if plan.status[0] == PLAN_TOO_CLOSE:
+        return "l1_l2_too_close"
+    return sample_hypotheses(a1, a2, plan, int(plan.per_edge[0]), transfer == "conservative")
 
 
-def transfer_support(kgon: KGon, hyp: Hypotheses, targets: ComplexArray) -> FloatArray:
-    """FL support K-gons of FR regions (vertex arrays ``(m, V)``): shape (m, K).
+def transfer_support(
+    kgon: KGon, hyp: Hypotheses, *targets: ComplexArray
+) -> tuple[FloatArray, ...]:
+    """FL support K-gons of FR regions, one result (G, m, K) per target array (G, m, V).
 
     Every target row is the vertex array of one convex FR region (a point is a row of
     one vertex). The result is the tight K-gon circumscribing the hull of the images,
-    grown by the conservative inflation radius.
+    grown by the conservative inflation radius. All target arrays share one matrix
+    product per chunk of maps.
+
+    Chunks are small enough to keep the product in the CPU cache. A map's numbers come
+    from a matrix product of the same shape whatever the batch (numpy multiplies a stack
+    matrix by matrix), so a map's result does not depend on the other maps in its batch.
     """
-    m, n_vert = targets.shape
-    # <u_k, (v - h1) g> = Re(v) Re(conj(u) g) - Im(v) Im(conj(u) g) - Re(conj(u) h1 g):
+    n_rows = hyp.h1.shape[0]
+    n_pairs, k = hyp.h1.shape[1], kgon.k
+    # <u_k, (z - h1) g> = Re(z) Re(conj(u) g) - Im(z) Im(conj(u) g) - Re(conj(u) g h1):
     # one real matrix product over all (vertex, hypothesis, direction) triples.
-    rot = np.conj(kgon.normals)[:, None] * hyp.inv_d  # (K, P)
-    offset = (np.conj(kgon.normals)[:, None] * (hyp.h1 * hyp.inv_d)).real
-    basis = np.stack([rot.real, rot.imag, offset]).reshape(3, -1)  # (3, K*P)
-    flat = targets.reshape(-1)
-    coeff = np.stack([flat.real, -flat.imag, -np.ones(flat.shape)], axis=-1)  # (m*V, 3)
-    values = (coeff @ basis).reshape(m, n_vert, kgon.k, -1)
-    support = values.max(axis=(1, 3))
-    return support + hyp.inflation(targets)[:, None]
+    rot = np.conj(kgon.normals)[:, None] * hyp.inv_d[:, None, :]  # (G, K, P)
+    offset = (rot * hyp.h1[:, None, :]).real
+    basis = np.stack([rot.real, rot.imag, offset], axis=1).reshape(n_rows, 3, k * n_pairs)
+    flat = np.concatenate([t.reshape(n_rows, -1) for t in targets], axis=-1)
+    coeff = np.stack([flat.real, -flat.imag, -np.ones(flat.shape)], axis=-1)  # (G, rows, 3)
+    supports = [np.empty((n_rows, t.shape[1], k)) for t in targets]
+    per_map = flat.shape[1] * n_pairs * k
+    step = max(1, _CHUNK_ELEMENTS // per_map)
+    for lo in range(0, n_rows, step):
+        chunk = slice(lo, lo + step)
+        values = coeff[chunk] @ basis[chunk]  # (c, rows, K*P)
+        start = 0
+        for target, support in zip(targets, supports, strict=True):
+            m, n_vert = target.shape[1:]
+            block = values[:, start : start + m * n_vert]
+            # The hypothesis axis is contiguous: reduce it first, where numpy is fastest.
+            support[chunk] = block.reshape(-1, m, n_vert, k, n_pairs).max(axis=-1).max(axis=2)
+            start += m * n_vert
+    return tuple(
+        support + hyp.inflation(target)[..., None]
+        for target, support in zip(targets, supports, strict=True)
+    )
 
 
 def transfer_points_fl(
@@ -174,5 +259,5 @@ def transfer_points_fl(
     if isinstance(hyp, str):
         return None
     pts = np.atleast_1d(np.asarray(points_fr, complex))
-    cloud = hyp.images(pts).reshape(-1)
-    return cloud, float(hyp.inflation(pts[None, :])[0])
+    cloud = hyp.images(pts[None])[0].reshape(-1)
+    return cloud, float(hyp.inflation(pts[None, None, :])[0, 0])
