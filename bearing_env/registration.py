@@ -17,6 +17,11 @@ ENV_IDS: dict[str, str] = {
     "BearingSLAM-v0": "bearing_env.envs.bearing_slam:BearingSLAMEnv",
     "BearingSLAMDiscrete-v0": "bearing_env.envs.bearing_slam_discrete:BearingSLAMDiscreteEnv",
 }
+#: The batched vector environments, registered as each id's ``vector_entry_point``.
+VECTOR_ENTRY_POINTS: dict[str, str] = {
+    "BearingSLAM-v0": "bearing_env.envs.bearing_slam_vector:BearingSLAMVectorEnv",
+    "BearingSLAMDiscrete-v0": "bearing_env.envs.bearing_slam_vector:BearingSLAMDiscreteVectorEnv",
+}
 MAX_EPISODE_STEPS = 20
 
 
@@ -26,4 +31,9 @@ def register_envs() -> None:
         # Registering an existing id again would make Gymnasium warn about overriding it.
         if env_id in gym.registry:
             continue
-        gym.register(id=env_id, entry_point=entry_point, max_episode_steps=MAX_EPISODE_STEPS)
+        gym.register(
+            id=env_id,
+            entry_point=entry_point,
+            vector_entry_point=VECTOR_ENTRY_POINTS[env_id],
+            max_episode_steps=MAX_EPISODE_STEPS,
+        )

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any, SupportsFloat
 
 import gymnasium as gym
@@ -59,6 +60,18 @@ ROBOT_FEATURES: tuple[str, ...] = (
 )
 LANDMARK_FEATURES: tuple[str, ...] = ("present", "uninitialised", "x", "y", "log_area")
 BEARING_FEATURES: tuple[str, ...] = ("present", "cos", "sin")
+
+
+@dataclass(frozen=True)
+class Movement:
+    """One step's motion and readings, before the SLAM update."""
+
+    move: MoveResult
+    start_position: FloatArray
+    start_bearings: FloatArray
+    end_bearings: FloatArray
+    #: False when the robot could not move: both readings come from the same place.
+    changes_map: bool
 
 
 def observation_size(max_landmarks: int) -> int:
@@ -336,7 +349,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         self.action_space = self._make_action_space()
         self.observation_space = self._make_observation_space()
 
-        self._slam = PolygonSLAM(self.n_landmarks, self.epsilon, transfer=self.transfer)
+        self._slam = self._make_slam(self.n_landmarks)
         self._world: World | None = None
         self._landmarks_fl = np.zeros((0, 2))
         self._moves = 0
@@ -530,7 +543,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             count = int(rng.integers(lo, hi + 1))
             if count != self.n_landmarks:
                 self.n_landmarks = count
-                self._slam = PolygonSLAM(count, self.epsilon, transfer=self.transfer)
+                self._slam = self._make_slam(count)
         if self.fixed_landmarks is not None:
             landmarks = self.fixed_landmarks.copy()
         else:
@@ -560,31 +573,42 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     ) -> tuple[NDArray[np.float32], SupportsFloat, bool, bool, dict[str, Any]]:
         if self._world is None:
             raise RuntimeError("call reset() before step()")
-        turn, length = self._decode_action(action)
-        world, rng = self._world, self.np_random
+        movement = self._move(*self._decode_action(action))
+        frame_changed, inconsistent = False, 0
+        if movement.changes_map:
+            result = self._slam.update(movement.start_bearings, movement.end_bearings)
+            frame_changed, inconsistent = result.frame_changed, result.n_inconsistent
+        return self._finish_step(movement, frame_changed, inconsistent)
 
+    def _move(self, turn: float, length: float) -> Movement:
+        """The world half of a step: turn, read, move, read (the SLAM update comes next)."""
+        world, rng = self._world, self.np_random
+        assert world is not None
         world.turn(turn)
         start_position = world.position.copy()
         start_bearings = world.read_bearings(rng)
         move = world.move(length)
         end_bearings = world.read_bearings(rng)
-
-        frame_changed, inconsistent = False, 0
         # A move that could not start took both readings from the same place: there is no
         # robot frame (R1 = R2), so the SLAM must not see it. The robot knows it did not
         # move (it is stuck against the wall).
-        if move.travelled >= world.min_baseline:
-            result = self._slam.update(start_bearings, end_bearings)
-            frame_changed, inconsistent = bool(result.frame_changed), int(result.n_inconsistent)
-            if frame_changed:
-                self._robot_area = self._slam.robot_area
+        changes_map = move.travelled >= world.min_baseline
+        return Movement(move, start_position, start_bearings, end_bearings, changes_map)
 
+    def _finish_step(
+        self, movement: Movement, frame_changed: bool, inconsistent: int
+    ) -> tuple[NDArray[np.float32], SupportsFloat, bool, bool, dict[str, Any]]:
+        """The bookkeeping half of a step, after the SLAM update of ``movement``."""
+        world, move = self._world, movement.move
+        assert world is not None
+        if frame_changed:
+            self._robot_area = self._slam.robot_area
         self._moves += 1
-        self._latest_bearings = end_bearings
+        self._latest_bearings = movement.end_bearings
         self._last_frame_changed = frame_changed
         self._last_move = move
-        self._last_start_bearings = start_bearings
-        self._last_start_position = start_position
+        self._last_start_bearings = movement.start_bearings
+        self._last_start_position = movement.start_position
         self._trajectory.append(world.position.copy())
 
         potential = self._uncertainty_potential()
@@ -636,6 +660,11 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     # ------------------------------------------------------------------------------------
     # Internals
     # ------------------------------------------------------------------------------------
+
+    def _make_slam(self, n_landmarks: int) -> PolygonSLAM:
+        """The map for an episode with ``n_landmarks`` (the batched vector env overrides
+        this per sub-env, to hand out rows of its shared batch)."""
+        return PolygonSLAM(n_landmarks, self.epsilon, transfer=self.transfer)
 
     def _decode_action(self, action: Any) -> tuple[float, float]:
         """(turn angle in radians, requested move length in metres) from an action."""

@@ -1,0 +1,351 @@
+"""``BearingSLAM-v0`` as a natively batched vector environment.
+
+``gym.make_vec("BearingSLAM-v0", num_envs=64, vectorization_mode="vector_entry_point")``
+returns :class:`BearingSLAMVectorEnv`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+from numpy.typing import NDArray
+
+from bearing_env.envs.bearing_slam import BearingSLAMEnv, Movement
+from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
+from bearing_env.slam import PolygonSLAM
+from bearing_env.slam.batch import BatchedPolygonSLAM
+
+AUTORESET_MODES = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)
+
+#: Per-landmark info arrays and the value that pads them when landmark counts vary.
+LANDMARK_INFO_PADDING: dict[str, Any] = {
+    "landmark_area": np.inf,
+    "landmark_error": np.inf,
+    "landmark_contains_truth": False,
+}
+
+
+class SharedMaps:
+    """One :class:`BatchedPolygonSLAM` per landmark count, with a row per sub-env.
+
+    Sub-envs with a range of landmark counts switch batches at reset; the rows of the
+    other batches are simply left idle.
+    """
+
+    def __init__(self, num_maps: int, epsilon: float, transfer: str) -> None:
+        self.num_maps = num_maps
+        self.epsilon = epsilon
+        self.transfer = transfer
+        self.batches: dict[int, BatchedPolygonSLAM] = {}
+
+    def batch_for(self, n_landmarks: int) -> BatchedPolygonSLAM:
+        if n_landmarks not in self.batches:
+            self.batches[n_landmarks] = BatchedPolygonSLAM(
+                self.num_maps, n_landmarks, self.epsilon, transfer=self.transfer
+            )
+        return self.batches[n_landmarks]
+
+
+class SharedMapRow:
+    """A sub-env's map factory: its own row of the shared batch (picklable)."""
+
+    def __init__(self, maps: SharedMaps, index: int) -> None:
+        self.maps = maps
+        self.index = index
+
+    def __call__(self, n_landmarks: int) -> PolygonSLAM:
+        return PolygonSLAM.view(self.maps.batch_for(n_landmarks), self.index)
+
+
+class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[Any]]):
+    """
+    ## Description
+
+    `num_envs` copies of :class:`~bearing_env.envs.bearing_slam.BearingSLAMEnv` stepped
+    together. The SLAM updates of all sub-environments, which are most of the work of
+    a step, run as one batched numpy computation (:class:`BatchedPolygonSLAM`); the world
+    simulation, observations and infos reuse the single environment's code, so the two
+    cannot drift apart.
+
+    For the same per-env seeds and actions it reproduces
+    `gym.make_vec(id, num_envs, vectorization_mode="sync")` exactly: observations,
+    rewards, terminations, truncations and infos are equal bit for bit, step for step.
+    Each map's result does not depend on the other maps in its batch (see
+    :mod:`bearing_env.slam.batch`).
+
+    ## Spaces
+
+    `single_observation_space` and `single_action_space` are the single environment's;
+    `observation_space` and `action_space` batch them along a first axis of `num_envs`.
+
+    ## Autoreset
+
+    Gymnasium 1.x semantics, chosen with `autoreset_mode`:
+
+    - `AutoresetMode.NEXT_STEP` (default): a sub-env that terminated or truncated is
+      reset by the next `step()`, which ignores its action and returns its first
+      observation with reward 0;
+    - `AutoresetMode.SAME_STEP`: it is reset at once; its last observation and info are
+      in `infos["final_obs"]` and `infos["final_info"]` (what SB3's adapter needs).
+
+    ## Arguments
+
+    - `num_envs`: number of sub-environments, >= 1.
+    - `autoreset_mode`: `"next_step"` (default) or `"same_step"` (or the enum).
+    - `max_episode_steps`: truncate after this many steps, like the `TimeLimit` that
+      `gym.make` adds (`gym.make_vec` passes the registered 20); None for no limit.
+    - `render_mode`: None or `"rgb_array"` (`render()` returns a tuple of frames).
+    - `n_landmarks=(lo, hi)` works too. The per-landmark info arrays (`landmark_area`,
+      `landmark_error`, `landmark_contains_truth`) are then padded to `max_landmarks - 2`
+      entries (with inf, inf and False) so they batch; Gymnasium's own vector envs cannot
+      batch them at all.
+    - every other keyword: as for the single environment (`scenario`, `n_landmarks`,
+      `epsilon_deg`, ...), validated by it.
+
+    ## Version History
+
+    * v0: Initial version.
+    """
+
+    metadata: dict[str, Any] = {  # noqa: RUF012
+        "autoreset_mode": AutoresetMode.NEXT_STEP,
+        "render_modes": ["rgb_array"],
+    }
+    single_env_class: type[BearingSLAMEnv] = BearingSLAMEnv
+
+    def __init__(
+        self,
+        num_envs: int = 1,
+        *,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+        max_episode_steps: int | None = None,
+        render_mode: str | None = None,
+        **env_kwargs: Any,
+    ) -> None:
+        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)):
+            raise TypeError(f"num_envs must be an int, got {num_envs!r}")
+        if num_envs < 1:
+            raise ValueError(f"num_envs must be >= 1, got {num_envs}")
+        self.autoreset_mode = _autoreset_mode(autoreset_mode)
+        if max_episode_steps is not None and (
+            isinstance(max_episode_steps, bool)
+            or not isinstance(max_episode_steps, (int, np.integer))
+            or max_episode_steps < 1
+        ):
+            raise ValueError(
+                f"max_episode_steps must be None or an int >= 1, got {max_episode_steps!r}"
+            )
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ValueError(
+                f"unknown render_mode {render_mode!r}; expected None or one of "
+                f"{tuple(self.metadata['render_modes'])}"
+            )
+        self.num_envs = int(num_envs)
+        self.max_episode_steps = None if max_episode_steps is None else int(max_episode_steps)
+        self.render_mode = render_mode
+        # Instance-level metadata: the class's dict is shared and must not be mutated.
+        self.metadata = {**type(self).metadata, "autoreset_mode": self.autoreset_mode}
+
+        self.envs = [
+            self.single_env_class(render_mode=render_mode, **env_kwargs)
+            for _ in range(self.num_envs)
+        ]
+        first = self.envs[0]
+        self._maps = SharedMaps(self.num_envs, first.epsilon, first.transfer)
+        for index, env in enumerate(self.envs):
+            env._make_slam = SharedMapRow(self._maps, index)  # type: ignore[method-assign]
+            env._slam = env._make_slam(env.n_landmarks)
+
+        self.single_observation_space = first.observation_space
+        self.single_action_space = first.action_space
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+
+        lo, hi = first.landmark_counts
+        #: Landmark slots of the per-landmark info arrays when counts vary per episode.
+        self._info_slots = first.max_landmarks - 2 if hi > lo else None
+        self._autoreset_envs = np.zeros(self.num_envs, dtype=bool)
+        self._elapsed_steps = np.zeros(self.num_envs, dtype=np.int64)
+        self._has_reset = False
+
+    # ------------------------------------------------------------------------------------
+    # VectorEnv API
+    # ------------------------------------------------------------------------------------
+
+    def reset(
+        self,
+        *,
+        seed: int | Sequence[int | None] | None = None,
+        options: dict[str, Any] | None = None,
+    ) -> tuple[NDArray[np.float32], dict[str, Any]]:
+        """Reset every sub-env; an int seed gives sub-env ``i`` the seed ``seed + i``."""
+        if seed is None:
+            seeds: list[int | None] = [None] * self.num_envs
+        elif isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+            seeds = [int(seed) + i for i in range(self.num_envs)]
+        else:
+            seeds = list(seed)  # type: ignore[arg-type]
+            if len(seeds) != self.num_envs:
+                raise ValueError(
+                    f"seed must be None, an int or {self.num_envs} seeds, got {len(seeds)}"
+                )
+        observations, infos = [], {}
+        for index, (env, env_seed) in enumerate(zip(self.envs, seeds, strict=True)):
+            observation, info = env.reset(seed=env_seed, options=options)
+            observations.append(observation)
+            infos = self._add_info(infos, self._padded(info), index)
+        self._autoreset_envs[:] = False
+        self._elapsed_steps[:] = 0
+        self._has_reset = True
+        return np.stack(observations), infos
+
+    def step(
+        self, actions: NDArray[Any]
+    ) -> tuple[
+        NDArray[np.float32],
+        NDArray[np.float64],
+        NDArray[np.bool_],
+        NDArray[np.bool_],
+        dict[str, Any],
+    ]:
+        if not self._has_reset:
+            raise RuntimeError("call reset() before step()")
+        actions = np.asarray(actions)
+        if actions.shape != self.action_space.shape:
+            raise ValueError(
+                f"actions must have shape {self.action_space.shape} (num_envs = "
+                f"{self.num_envs}), got {actions.shape}"
+            )
+        n = self.num_envs
+        resetting = self._autoreset_envs & (self.autoreset_mode == AutoresetMode.NEXT_STEP)
+
+        # The world half of every stepping sub-env, then all SLAM updates at once.
+        movements: list[Movement | None] = [None] * n
+        for index in np.flatnonzero(~resetting):
+            env = self.envs[index]
+            movements[index] = env._move(*env._decode_action(actions[index]))
+        frame_changed, inconsistent = self._update_maps(movements)
+
+        observations: list[NDArray[np.float32]] = [None] * n  # type: ignore[list-item]
+        rewards = np.zeros(n, dtype=np.float64)
+        terminations = np.zeros(n, dtype=bool)
+        truncations = np.zeros(n, dtype=bool)
+        infos: dict[str, Any] = {}
+        for index, env in enumerate(self.envs):
+            movement = movements[index]
+            if movement is None:
+                observations[index], info = env.reset()
+                self._elapsed_steps[index] = 0
+            else:
+                observation, reward, terminated, truncated, info = env._finish_step(
+                    movement, bool(frame_changed[index]), int(inconsistent[index])
+                )
+                self._elapsed_steps[index] += 1
+                if (
+                    self.max_episode_steps is not None
+                    and self._elapsed_steps[index] >= self.max_episode_steps
+                ):
+                    truncated = True
+                observations[index] = observation
+                rewards[index] = reward
+                terminations[index] = terminated
+                truncations[index] = truncated
+                if self.autoreset_mode == AutoresetMode.SAME_STEP and (terminated or truncated):
+                    infos = self._add_info(
+                        infos, {"final_obs": observation, "final_info": self._padded(info)}, index
+                    )
+                    observations[index], info = env.reset()
+                    self._elapsed_steps[index] = 0
+            infos = self._add_info(infos, self._padded(info), index)
+        self._autoreset_envs = terminations | truncations
+        return np.stack(observations), rewards, terminations, truncations, infos
+
+    def render(self) -> tuple[Any, ...] | None:
+        if self.render_mode is None:
+            return None
+        return tuple(env.render() for env in self.envs)
+
+    def close_extras(self, **kwargs: Any) -> None:
+        for env in self.envs:
+            env.close()
+
+    def call(self, name: str, *args: Any, **kwargs: Any) -> tuple[Any, ...]:
+        """Call method ``name`` of every sub-env (or read the attribute if not callable)."""
+        results = []
+        for env in self.envs:
+            attribute = getattr(env, name)
+            results.append(attribute(*args, **kwargs) if callable(attribute) else attribute)
+        return tuple(results)
+
+    def get_attr(self, name: str) -> tuple[Any, ...]:
+        """Attribute ``name`` of every sub-env."""
+        return tuple(getattr(env, name) for env in self.envs)
+
+    def set_attr(self, name: str, values: Any | Sequence[Any]) -> None:
+        """Set attribute ``name`` of every sub-env (one value for all, or one per env)."""
+        if not isinstance(values, (list, tuple)):
+            values = [values] * self.num_envs
+        if len(values) != self.num_envs:
+            raise ValueError(f"expected {self.num_envs} values for {name!r}, got {len(values)}")
+        for env, value in zip(self.envs, values, strict=True):
+            setattr(env, name, value)
+
+    # ------------------------------------------------------------------------------------
+    # Internals
+    # ------------------------------------------------------------------------------------
+
+    def _padded(self, info: dict[str, Any]) -> dict[str, Any]:
+        """With varying landmark counts, per-landmark arrays padded to a fixed length
+        (Gymnasium batches an info key into one array, so every sub-env's must agree)."""
+        if self._info_slots is None:
+            return info
+        padded = dict(info)
+        for key, fill in LANDMARK_INFO_PADDING.items():
+            values = info[key]
+            padded[key] = np.full(self._info_slots, fill, dtype=values.dtype)
+            padded[key][: values.shape[0]] = values
+        return padded
+
+    def _update_maps(
+        self, movements: list[Movement | None]
+    ) -> tuple[NDArray[np.bool_], NDArray[np.int64]]:
+        """One batched SLAM update per landmark count, over the sub-envs that moved."""
+        frame_changed = np.zeros(self.num_envs, dtype=bool)
+        inconsistent = np.zeros(self.num_envs, dtype=np.int64)
+        moved: dict[int, list[int]] = {}
+        for index, movement in enumerate(movements):
+            if movement is not None and movement.changes_map:
+                moved.setdefault(self.envs[index].n_landmarks, []).append(index)
+        for n_landmarks, rows in moved.items():
+            result = self._maps.batch_for(n_landmarks).update(
+                np.stack([movements[i].start_bearings for i in rows]),  # type: ignore[union-attr]
+                np.stack([movements[i].end_bearings for i in rows]),  # type: ignore[union-attr]
+                maps=np.array(rows),
+            )
+            frame_changed[rows] = result.frame_changed
+            inconsistent[rows] = result.n_inconsistent
+        return frame_changed, inconsistent
+
+
+class BearingSLAMDiscreteVectorEnv(BearingSLAMVectorEnv):
+    """``BearingSLAMDiscrete-v0`` batched: :class:`BearingSLAMVectorEnv` over
+    :class:`~bearing_env.envs.bearing_slam_discrete.BearingSLAMDiscreteEnv` (actions are
+    an array of ``num_envs`` discrete action indices)."""
+
+    single_env_class = BearingSLAMDiscreteEnv
+
+
+def _autoreset_mode(value: AutoresetMode | str) -> AutoresetMode:
+    try:
+        mode = AutoresetMode(value)
+    except ValueError:
+        mode = None
+    if mode not in AUTORESET_MODES:
+        raise ValueError(
+            f"autoreset_mode must be one of {[m.value for m in AUTORESET_MODES]}, got {value!r}"
+        )
+    return mode
