@@ -13,6 +13,7 @@ from gymnasium import spaces
 from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.slam import TRANSFERS, PolygonSLAM, fl_to_world, world_to_fl
+from bearing_env.slam.batch import BatchedPolygonSLAM
 from bearing_env.world import (
     SCENARIOS,
     Arena,
@@ -356,7 +357,6 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         self._potential = 0.0
         self._latest_bearings = np.zeros(self.n_landmarks)
         self._last_frame_changed = False
-        self._robot_area: float | None = None
         self._last_move: MoveResult | None = None
         self._trajectory: list[FloatArray] = []
         self._last_start_bearings: FloatArray | None = None
@@ -553,17 +553,20 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         # Landmarks do not move: their true FL positions (for info) are fixed per episode.
         self._landmarks_fl = world_to_fl(landmarks[2:], landmarks[0], landmarks[1])
         self._slam.reset()
-        self._robot_area = None
         self._moves = 0
-        self._potential = self._uncertainty_potential()
         self._latest_bearings = self._world.read_bearings(rng)
         self._last_frame_changed = False
         self._last_move = None
         self._trajectory = [self._world.position.copy()]
         self._last_start_bearings = None
         self._last_start_position = None
-        observation = self._observation()
-        info = self._info(frame_changed=False, inconsistent=0, path_length=0.0, rewards=None)
+        self._potential = float(_potentials([self])[0])
+        observation = _observations([self])[0]
+        zeros = np.zeros(1)
+        info = _row_info(
+            _batched_infos([self], np.zeros(1, bool), np.zeros(1, np.int64), zeros, zeros, zeros),
+            0,
+        )
         if self.render_mode == "human":
             self.render()
         return observation, info
@@ -599,35 +602,67 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         self, movement: Movement, frame_changed: bool, inconsistent: int
     ) -> tuple[NDArray[np.float32], SupportsFloat, bool, bool, dict[str, Any]]:
         """The bookkeeping half of a step, after the SLAM update of ``movement``."""
-        world, move = self._world, movement.move
-        assert world is not None
-        if frame_changed:
-            self._robot_area = self._slam.robot_area
-        self._moves += 1
-        self._latest_bearings = movement.end_bearings
-        self._last_frame_changed = frame_changed
-        self._last_move = move
-        self._last_start_bearings = movement.start_bearings
-        self._last_start_position = movement.start_position
-        self._trajectory.append(world.position.copy())
-
-        potential = self._uncertainty_potential()
-        rewards = {
-            "uncertainty": float(self._potential - potential),
-            "path_cost": -self.path_cost * move.travelled,
-            "move_cost": -self.move_cost,
-        }
-        self._potential = potential
-        reward = float(sum(rewards.values()))
-
-        areas = self._slam.areas
-        terminated = bool(np.all(self._slam.initialised) and np.all(areas <= self.target_area))
-        truncated = (not terminated) and self._moves >= self.max_moves
-        observation = self._observation()
-        info = self._info(frame_changed, inconsistent, move.travelled, rewards)
+        observations, rewards, terminated, truncated, infos = self._finish_steps(
+            [self], [movement], np.array([frame_changed]), np.array([inconsistent])
+        )
         if self.render_mode == "human":
             self.render()
-        return observation, reward, terminated, truncated, info
+        return (
+            observations[0],
+            float(rewards[0]),
+            bool(terminated[0]),
+            bool(truncated[0]),
+            _row_info(infos, 0),
+        )
+
+    @staticmethod
+    def _finish_steps(
+        envs: Sequence[BearingSLAMEnv],
+        movements: Sequence[Movement],
+        frame_changed: NDArray[np.bool_],
+        inconsistent: NDArray[np.int64],
+    ) -> tuple[
+        NDArray[np.float32], FloatArray, NDArray[np.bool_], NDArray[np.bool_], dict[str, Any]
+    ]:
+        """:meth:`_finish_step` for several envs whose maps share one batch, at once.
+
+        Returns batched observations, rewards, terminations, truncations and infos (as a
+        Gymnasium vector env batches them, without the masks). The single env calls it
+        with a batch of one, so both compute with the same code and agree bit for bit.
+        """
+        for env, movement, changed in zip(envs, movements, frame_changed, strict=True):
+            assert env._world is not None
+            env._moves += 1
+            env._latest_bearings = movement.end_bearings
+            env._last_frame_changed = bool(changed)
+            env._last_move = movement.move
+            env._last_start_bearings = movement.start_bearings
+            env._last_start_position = movement.start_position
+            env._trajectory.append(env._world.position.copy())
+
+        first = envs[0]
+        travelled = np.array([movement.move.travelled for movement in movements])
+        potential = _potentials(envs)
+        previous = np.array([env._potential for env in envs])
+        uncertainty = previous - potential
+        path_cost = -first.path_cost * travelled
+        move_cost = np.full(len(envs), -first.move_cost)
+        rewards = ((0.0 + uncertainty) + path_cost) + move_cost
+        for env, value in zip(envs, potential, strict=True):
+            env._potential = float(value)
+
+        batch, rows = _batch_rows(envs)
+        areas = batch.areas[rows]
+        terminated = np.all(batch.initialised[rows], axis=-1) & np.all(
+            areas <= first.target_area, axis=-1
+        )
+        moves = np.array([env._moves for env in envs])
+        truncated = ~terminated & (moves >= first.max_moves)
+        observations = _observations(envs)
+        infos = _batched_infos(
+            envs, frame_changed, inconsistent, travelled, uncertainty, path_cost, move_cost
+        )
+        return observations, rewards, terminated, truncated, infos
 
     def render(self) -> NDArray[np.uint8] | None:
         if self.render_mode is None:
@@ -683,88 +718,6 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         lo, hi = self.move_length
         return math.pi * float(values[0]), lo + 0.5 * (float(values[1]) + 1.0) * (hi - lo)
 
-    def _capped_areas(self) -> FloatArray:
-        # Uninitialised landmarks have area inf, so the cap also stands in for them.
-        return np.clip(self._slam.areas, AREA_FLOOR, self.area_cap)
-
-    def _uncertainty_potential(self) -> float:
-        capped = self._capped_areas()
-        if self.reward_kind == "log_area":
-            return float(np.sum(np.log(capped)))
-        return float(np.sum(capped))
-
-    def _observation(self) -> NDArray[np.float32]:
-        slam = self._slam
-        log_cap = math.log(self.area_cap)
-        n_slots = self.max_landmarks
-
-        robot = np.zeros(len(ROBOT_FEATURES))
-        robot_estimate = slam.robot_estimate
-        if self._robot_area is not None and np.all(np.isfinite(robot_estimate)):
-            robot[0:2] = np.clip(robot_estimate, -FL_COORD_LIMIT, FL_COORD_LIMIT)
-            robot[2] = math.log(min(max(self._robot_area, AREA_FLOOR), self.area_cap))
-        else:
-            robot[2] = log_cap
-            robot[3] = 1.0
-        heading = slam.robot_heading
-        if math.isfinite(heading):
-            robot[4:6] = (math.cos(heading), math.sin(heading))
-        robot[6] = min(self._moves / self.max_moves, 1.0)
-        robot[7] = float(self._last_frame_changed)
-        robot[8] = float(self._last_move is not None and self._last_move.blocked)
-
-        mapped = np.zeros((n_slots - 2, len(LANDMARK_FEATURES)))
-        n_mapped = self.n_landmarks - 2
-        initialised = slam.initialised
-        estimates = np.nan_to_num(slam.estimates, nan=0.0)
-        mapped[:n_mapped, 0] = 1.0
-        mapped[:n_mapped, 1] = ~initialised
-        mapped[:n_mapped, 2:4] = np.where(
-            initialised[:, None], np.clip(estimates, -FL_COORD_LIMIT, FL_COORD_LIMIT), 0.0
-        )
-        mapped[:n_mapped, 4] = np.log(self._capped_areas())
-
-        bearings = np.zeros((n_slots, len(BEARING_FEATURES)))
-        bearings[: self.n_landmarks, 0] = 1.0
-        bearings[: self.n_landmarks, 1] = np.cos(self._latest_bearings)
-        bearings[: self.n_landmarks, 2] = np.sin(self._latest_bearings)
-
-        return np.concatenate([robot, mapped.ravel(), bearings.ravel()]).astype(np.float32)
-
-    def _info(
-        self,
-        frame_changed: bool,
-        inconsistent: int,
-        path_length: float,
-        rewards: dict[str, float] | None,
-    ) -> dict[str, Any]:
-        world, slam = self._world, self._slam
-        assert world is not None
-        l1, l2 = world.landmarks[0], world.landmarks[1]
-        truth_fl = self._landmarks_fl
-        initialised = slam.initialised
-        areas = slam.areas
-        errors = np.full(self.n_landmarks - 2, np.inf)
-        errors[initialised] = np.hypot(*(slam.estimates[initialised] - truth_fl[initialised]).T)
-        robot_estimate = slam.robot_estimate
-        robot_error = math.inf
-        if np.all(np.isfinite(robot_estimate)):
-            robot_truth_fl = world_to_fl(world.position, l1, l2)
-            robot_error = float(np.hypot(*(robot_estimate - robot_truth_fl)))
-        if rewards is None:
-            rewards = {"uncertainty": 0.0, "path_cost": 0.0, "move_cost": 0.0}
-        return {
-            "landmark_area": areas,
-            "landmark_error": errors,
-            "landmark_contains_truth": slam.contains(truth_fl),
-            "total_area": float(np.sum(areas)),
-            "robot_error": robot_error,
-            "frame_changed": bool(frame_changed),
-            "inconsistent": int(inconsistent),
-            "path_length": float(path_length),
-            "rewards": dict(rewards),
-        }
-
     def _scene(self) -> Any:
         from bearing_env.rendering import Scene
 
@@ -801,3 +754,149 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             robot_radius=self.arena.wall_margin,
         )
 
+
+
+# ----------------------------------------------------------------------------------------
+# Batched bookkeeping: observations, potentials and infos of envs sharing one map batch
+# ----------------------------------------------------------------------------------------
+
+
+def _batch_rows(envs: Sequence[BearingSLAMEnv]) -> tuple[BatchedPolygonSLAM, NDArray[np.int64]]:
+    """The map batch the envs share and their rows in it."""
+    batch = envs[0].slam.batch
+    if any(env.slam.batch is not batch for env in envs):
+        raise ValueError("the envs' maps must live in one batch")
+    return batch, np.array([env.slam.index for env in envs])
+
+
+def _log_capped(areas: FloatArray, area_cap: float) -> FloatArray:
+    # Uninitialised landmarks have area inf, so the cap also stands in for them.
+    return np.log(np.clip(areas, AREA_FLOOR, area_cap))
+
+
+def _potentials(envs: Sequence[BearingSLAMEnv]) -> FloatArray:
+    """The uncertainty potential Phi of each env (see the env's Rewards section)."""
+    first = envs[0]
+    batch, rows = _batch_rows(envs)
+    areas = batch.areas[rows]
+    if first.reward_kind == "log_area":
+        return np.sum(_log_capped(areas, first.area_cap), axis=-1)
+    return np.sum(np.clip(areas, AREA_FLOOR, first.area_cap), axis=-1)
+
+
+def _observations(envs: Sequence[BearingSLAMEnv]) -> NDArray[np.float32]:
+    """Observations (len(envs), observation_size) of envs with equal settings."""
+    first = envs[0]
+    batch, rows = _batch_rows(envs)
+    n_envs, n_slots, n_landmarks = len(envs), first.max_landmarks, first.n_landmarks
+    observation = np.zeros((n_envs, observation_size(n_slots)))
+    blocks = observation_slices(n_slots)
+    robot = observation[:, blocks["robot"]]
+    mapped = observation[:, blocks["landmarks"]].reshape(n_envs, n_slots - 2, -1)
+    bearing = observation[:, blocks["bearings"]].reshape(n_envs, n_slots, -1)
+
+    centroid = batch.robot_centroid[rows]
+    estimate = np.stack([centroid.real, centroid.imag], axis=-1)
+    known = batch.has_robot[rows] & np.all(np.isfinite(estimate), axis=-1)
+    robot[:, 0:2] = np.where(
+        known[:, None], np.clip(np.nan_to_num(estimate), -FL_COORD_LIMIT, FL_COORD_LIMIT), 0.0
+    )
+    robot[:, 2] = np.where(
+        known, _log_capped(batch.robot_area[rows], first.area_cap), math.log(first.area_cap)
+    )
+    robot[:, 3] = ~known
+    heading = batch.robot_heading[rows]
+    has_heading = np.isfinite(heading)
+    safe_heading = np.where(has_heading, heading, 0.0)
+    robot[:, 4] = np.where(has_heading, np.cos(safe_heading), 0.0)
+    robot[:, 5] = np.where(has_heading, np.sin(safe_heading), 0.0)
+    moves = np.array([env._moves for env in envs])
+    robot[:, 6] = np.minimum(moves / first.max_moves, 1.0)
+    robot[:, 7] = [env._last_frame_changed for env in envs]
+    robot[:, 8] = [env._last_move is not None and env._last_move.blocked for env in envs]
+
+    n_mapped = n_landmarks - 2
+    initialised = batch.initialised[rows]
+    centroids = batch.centroids[rows]
+    estimates = np.stack([centroids.real, centroids.imag], axis=-1)
+    mapped[:, :n_mapped, 0] = 1.0
+    mapped[:, :n_mapped, 1] = ~initialised
+    mapped[:, :n_mapped, 2:4] = np.where(
+        initialised[..., None],
+        np.clip(np.nan_to_num(estimates), -FL_COORD_LIMIT, FL_COORD_LIMIT),
+        0.0,
+    )
+    mapped[:, :n_mapped, 4] = _log_capped(batch.areas[rows], first.area_cap)
+
+    latest = np.stack([env._latest_bearings for env in envs])
+    bearing[:, :n_landmarks, 0] = 1.0
+    bearing[:, :n_landmarks, 1] = np.cos(latest)
+    bearing[:, :n_landmarks, 2] = np.sin(latest)
+    return observation.astype(np.float32)
+
+
+def _batched_infos(
+    envs: Sequence[BearingSLAMEnv],
+    frame_changed: NDArray[np.bool_],
+    inconsistent: NDArray[np.int64],
+    path_length: FloatArray,
+    uncertainty: FloatArray,
+    path_cost: FloatArray,
+    move_cost: FloatArray | None = None,
+) -> dict[str, Any]:
+    """The envs' infos, batched along a first axis (see the env's Info section)."""
+    batch, rows = _batch_rows(envs)
+    truth_fl = np.stack([env._landmarks_fl for env in envs])
+    initialised = batch.initialised[rows]
+    areas = batch.areas[rows]
+    centroids = batch.centroids[rows]
+    truth = truth_fl[..., 0] + 1j * truth_fl[..., 1]
+    errors = np.where(initialised, np.abs(np.where(initialised, centroids - truth, 0.0)), np.inf)
+    contains = np.zeros(initialised.shape, dtype=bool)
+    contains[initialised] = batch.kgon.contains(
+        batch.support[rows][initialised], truth[initialised]
+    )
+
+    worlds = [env._world for env in envs]
+    assert all(world is not None for world in worlds)
+    positions = np.stack([world.position for world in worlds])  # type: ignore[union-attr]
+    landmarks = np.stack([world.landmarks[:2] for world in worlds])  # type: ignore[union-attr]
+    robot_truth = world_to_fl(positions, landmarks[:, 0], landmarks[:, 1])
+    robot_centroid = batch.robot_centroid[rows]
+    robot_estimate = np.stack([robot_centroid.real, robot_centroid.imag], axis=-1)
+    robot_known = np.all(np.isfinite(robot_estimate), axis=-1)
+    robot_error = np.where(
+        robot_known,
+        np.hypot(*(np.where(robot_known[:, None], robot_estimate, 0.0) - robot_truth).T),
+        np.inf,
+    )
+    if move_cost is None:
+        move_cost = np.zeros(len(envs))
+    return {
+        "landmark_area": areas,
+        "landmark_error": errors,
+        "landmark_contains_truth": contains,
+        "total_area": np.sum(areas, axis=-1),
+        "robot_error": robot_error,
+        "frame_changed": np.asarray(frame_changed, dtype=bool),
+        "inconsistent": np.asarray(inconsistent, dtype=np.int64),
+        "path_length": np.asarray(path_length, dtype=np.float64),
+        "rewards": {
+            "uncertainty": np.asarray(uncertainty, dtype=np.float64),
+            "path_cost": np.asarray(path_cost, dtype=np.float64),
+            "move_cost": np.asarray(move_cost, dtype=np.float64),
+        },
+    }
+
+
+def _row_info(infos: dict[str, Any], row: int) -> dict[str, Any]:
+    """One env's info dict (Python scalars, per-landmark arrays) from batched infos."""
+    info: dict[str, Any] = {}
+    for key, value in infos.items():
+        if isinstance(value, dict):
+            info[key] = _row_info(value, row)
+        elif value.ndim > 1:
+            info[key] = value[row].copy()
+        else:
+            info[key] = value[row].item()
+    return info

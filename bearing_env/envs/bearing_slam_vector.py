@@ -14,7 +14,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 from numpy.typing import NDArray
 
-from bearing_env.envs.bearing_slam import BearingSLAMEnv, Movement
+from bearing_env.envs.bearing_slam import BearingSLAMEnv, Movement, _row_info
 from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import BatchedPolygonSLAM
@@ -230,39 +230,43 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             movements[index] = env._move(*env._decode_action(actions[index]))
         frame_changed, inconsistent = self._update_maps(movements)
 
-        observations: list[NDArray[np.float32]] = [None] * n  # type: ignore[list-item]
+        observations = np.zeros(self.observation_space.shape, dtype=np.float32)
         rewards = np.zeros(n, dtype=np.float64)
         terminations = np.zeros(n, dtype=bool)
         truncations = np.zeros(n, dtype=bool)
         infos: dict[str, Any] = {}
-        for index, env in enumerate(self.envs):
-            movement = movements[index]
-            if movement is None:
-                observations[index], info = env.reset()
-                self._elapsed_steps[index] = 0
-            else:
-                observation, reward, terminated, truncated, info = env._finish_step(
-                    movement, bool(frame_changed[index]), int(inconsistent[index])
-                )
-                self._elapsed_steps[index] += 1
-                if (
-                    self.max_episode_steps is not None
-                    and self._elapsed_steps[index] >= self.max_episode_steps
-                ):
-                    truncated = True
-                observations[index] = observation
-                rewards[index] = reward
-                terminations[index] = terminated
-                truncations[index] = truncated
-                if self.autoreset_mode == AutoresetMode.SAME_STEP and (terminated or truncated):
-                    infos = self._add_info(
-                        infos, {"final_obs": observation, "final_info": self._padded(info)}, index
-                    )
-                    observations[index], info = env.reset()
+        for group in self._groups_by_batch(np.flatnonzero(~resetting)):
+            (
+                observations[group],
+                rewards[group],
+                terminations[group],
+                truncations[group],
+                group_infos,
+            ) = self.single_env_class._finish_steps(
+                [self.envs[i] for i in group],
+                [movements[i] for i in group],  # type: ignore[misc]
+                frame_changed[group],
+                inconsistent[group],
+            )
+            self._elapsed_steps[group] += 1
+            if self.max_episode_steps is not None:
+                truncations[group] |= self._elapsed_steps[group] >= self.max_episode_steps
+            infos = self._merge_rows(infos, self._padded(group_infos), group)
+            if self.autoreset_mode == AutoresetMode.SAME_STEP:
+                for j in np.flatnonzero(terminations[group] | truncations[group]):
+                    index = int(group[j])
+                    final_info = self._padded(_row_info(group_infos, int(j)))
+                    final = {"final_obs": observations[index].copy(), "final_info": final_info}
+                    infos = self._add_info(infos, final, index)
+                    observations[index], info = self.envs[index].reset()
                     self._elapsed_steps[index] = 0
+                    infos = self._add_info(infos, self._padded(info), index)
+        for index in np.flatnonzero(resetting):
+            observations[index], info = self.envs[index].reset()
+            self._elapsed_steps[index] = 0
             infos = self._add_info(infos, self._padded(info), index)
         self._autoreset_envs = terminations | truncations
-        return np.stack(observations), rewards, terminations, truncations, infos
+        return observations, rewards, terminations, truncations, infos
 
     def render(self) -> tuple[Any, ...] | None:
         if self.render_mode is None:
@@ -300,15 +304,40 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
     def _padded(self, info: dict[str, Any]) -> dict[str, Any]:
         """With varying landmark counts, per-landmark arrays padded to a fixed length
-        (Gymnasium batches an info key into one array, so every sub-env's must agree)."""
+        (Gymnasium batches an info key into one array, so every sub-env's must agree).
+        Works on one env's info and on batched infos (landmarks on the last axis)."""
         if self._info_slots is None:
             return info
         padded = dict(info)
         for key, fill in LANDMARK_INFO_PADDING.items():
             values = info[key]
-            padded[key] = np.full(self._info_slots, fill, dtype=values.dtype)
-            padded[key][: values.shape[0]] = values
+            padded[key] = np.full((*values.shape[:-1], self._info_slots), fill, values.dtype)
+            padded[key][..., : values.shape[-1]] = values
         return padded
+
+    def _groups_by_batch(self, indices: NDArray[np.int64]) -> list[NDArray[np.int64]]:
+        """Sub-envs grouped by the map batch they share (one group per landmark count)."""
+        groups: dict[int, list[int]] = {}
+        for index in indices:
+            groups.setdefault(self.envs[index].n_landmarks, []).append(int(index))
+        return [np.array(group) for group in groups.values()]
+
+    def _merge_rows(
+        self, infos: dict[str, Any], batched: dict[str, Any], rows: NDArray[np.int64]
+    ) -> dict[str, Any]:
+        """What ``_add_info`` would build from each row's info, for many rows at once."""
+        for key, value in batched.items():
+            if isinstance(value, dict):
+                array = self._merge_rows(infos.get(key, {}), value, rows)
+            else:
+                array = infos.get(key)
+                if array is None:
+                    array = np.zeros((self.num_envs, *value.shape[1:]), dtype=value.dtype)
+                array[rows] = value
+            mask = infos.get(f"_{key}", np.zeros(self.num_envs, dtype=np.bool_))
+            mask[rows] = True
+            infos[key], infos[f"_{key}"] = array, mask
+        return infos
 
     def _update_maps(
         self, movements: list[Movement | None]
@@ -340,12 +369,19 @@ class BearingSLAMDiscreteVectorEnv(BearingSLAMVectorEnv):
 
 
 def _autoreset_mode(value: AutoresetMode | str) -> AutoresetMode:
-    try:
-        mode = AutoresetMode(value)
-    except ValueError:
-        mode = None
+    """The enum from itself, its value (``"SameStep"``) or its name (``"same_step"``)."""
+    mode: AutoresetMode | None = None
+    if isinstance(value, AutoresetMode):
+        mode = value
+    elif isinstance(value, str):
+        by_name = {m.name.lower(): m for m in AutoresetMode}
+        mode = by_name.get(value.lower()) or next(
+            (m for m in AutoresetMode if m.value.lower() == value.lower()), None
+        )
     if mode not in AUTORESET_MODES:
         raise ValueError(
-            f"autoreset_mode must be one of {[m.value for m in AUTORESET_MODES]}, got {value!r}"
+            "autoreset_mode must be one of "
+            f"{[m.name.lower() for m in AUTORESET_MODES]} (or the AutoresetMode enum), "
+            f"got {value!r}"
         )
     return mode

@@ -1,0 +1,312 @@
+"""The batched vector env: registered, exact against the single env, and well behaved."""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import pickle
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.vector import AutoresetMode
+
+import bearing_env  # noqa: F401  (registers the ids)
+from bearing_env.envs import BearingSLAMDiscreteVectorEnv, BearingSLAMVectorEnv
+from bearing_env.registration import ENV_IDS
+from bearing_env.slam import PolygonSLAM
+from bearing_env.slam.batch import BatchedPolygonSLAM
+
+VECTOR_CLASSES = {
+    "BearingSLAM-v0": BearingSLAMVectorEnv,
+    "BearingSLAMDiscrete-v0": BearingSLAMDiscreteVectorEnv,
+}
+
+
+def assert_same(a: Any, b: Any, path: str = "") -> None:
+    """Exact equality of nested step results (arrays bit for bit, dtypes included)."""
+    if isinstance(a, tuple):
+        assert isinstance(b, tuple) and len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            assert_same(x, y, f"{path}[{i}]")
+    elif isinstance(a, dict):
+        assert isinstance(b, dict) and set(a) == set(b), (path, set(a) ^ set(b))
+        for key in a:
+            assert_same(a[key], b[key], f"{path}/{key}")
+    elif isinstance(a, np.ndarray) and a.dtype == object:
+        assert isinstance(b, np.ndarray) and a.shape == b.shape, path
+        for x, y in zip(a, b, strict=True):
+            assert_same(x, y, path)
+    elif isinstance(a, np.ndarray):
+        assert isinstance(b, np.ndarray), path
+        assert a.dtype == b.dtype and a.shape == b.shape, (path, a.dtype, b.dtype)
+        assert np.array_equal(a, b, equal_nan=True), (path, a, b)
+    elif a is None:
+        assert b is None, path
+    else:
+        assert a == b, (path, a, b)
+
+
+def make_pair(
+    env_id: str, n: int, mode: AutoresetMode, **kwargs: Any
+) -> tuple[gym.vector.VectorEnv, gym.vector.VectorEnv]:
+    batched = gym.make_vec(
+        env_id, num_envs=n, vectorization_mode="vector_entry_point", autoreset_mode=mode, **kwargs
+    )
+    reference = gym.make_vec(
+        env_id,
+        num_envs=n,
+        vectorization_mode="sync",
+        vector_kwargs={"autoreset_mode": mode},
+        **kwargs,
+    )
+    return batched, reference
+
+
+@pytest.mark.parametrize("env_id", sorted(ENV_IDS))
+def test_make_vec_returns_the_batched_env_with_the_spec_time_limit(env_id: str) -> None:
+    env = gym.make_vec(env_id, num_envs=3, scenario="khepera")
+    assert isinstance(env, VECTOR_CLASSES[env_id])
+    assert env.max_episode_steps == gym.spec(env_id).max_episode_steps
+    assert env.single_observation_space == gym.make(env_id, scenario="khepera").observation_space
+    assert env.observation_space.shape == (3, *env.single_observation_space.shape)
+    assert env.observation_space.dtype == np.float32
+    env.close()
+
+
+@pytest.mark.parametrize("env_id", sorted(ENV_IDS))
+@pytest.mark.parametrize("mode", [AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP])
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"scenario": "khepera"},
+        {"n_landmarks": 6, "transfer": "paper"},
+        {"n_landmarks": 5, "noise": {"kind": "uniform", "bound_deg": 4.0}, "max_moves": 7},
+    ],
+    ids=["khepera", "random-paper", "random-outside-epsilon"],
+)
+def test_reproduces_sync_vector_env_exactly(
+    env_id: str, mode: AutoresetMode, kwargs: dict[str, Any]
+) -> None:
+    batched, reference = make_pair(env_id, 4, mode, **kwargs)
+    assert_same(batched.reset(seed=11), reference.reset(seed=11))
+    batched.action_space.seed(5)
+    episode_ends = 0
+    for _ in range(60):
+        actions = batched.action_space.sample()
+        result, expected = batched.step(actions), reference.step(actions)
+        assert_same(result, expected)
+        episode_ends += int(np.sum(result[2] | result[3]))
+    assert episode_ends >= 4  # the comparison covered autoresets
+    batched.close()
+    reference.close()
+
+
+def test_many_landmarks_reproduce_the_single_env_exactly() -> None:
+    batched, reference = make_pair("BearingSLAM-v0", 3, AutoresetMode.NEXT_STEP, n_landmarks=24)
+    assert_same(batched.reset(seed=2), reference.reset(seed=2))
+    batched.action_space.seed(1)
+    for _ in range(12):
+        actions = batched.action_space.sample()
+        assert_same(batched.step(actions), reference.step(actions))
+
+
+def test_landmark_count_ranges_match_single_envs_with_padded_infos() -> None:
+    n, slots = 4, 8
+    batched = gym.make_vec(
+        "BearingSLAM-v0", num_envs=n, vectorization_mode="vector_entry_point", n_landmarks=(3, 6)
+    )
+    singles = [gym.make("BearingSLAM-v0", n_landmarks=(3, 6)) for _ in range(n)]
+    observations, infos = batched.reset(seed=40)
+    for i, env in enumerate(singles):
+        observation, info = env.reset(seed=40 + i)
+        assert np.array_equal(observations[i], observation)
+        count = info["landmark_area"].shape[0]
+        assert np.array_equal(infos["landmark_area"][i, :count], info["landmark_area"])
+        assert np.all(np.isinf(infos["landmark_area"][i, count:]))
+        assert infos["landmark_area"].shape == (n, slots - 2)
+    counts = {env.unwrapped.n_landmarks for env in singles}
+    batched.action_space.seed(3)
+    done = np.zeros(n, dtype=bool)
+    for _ in range(45):
+        actions = batched.action_space.sample()
+        observations, rewards, terminated, truncated, infos = batched.step(actions)
+        for i, env in enumerate(singles):
+            if done[i]:
+                observation, info = env.reset()
+                reward = 0.0
+            else:
+                observation, reward, term, trunc, info = env.step(actions[i])
+                assert (term, trunc) == (terminated[i], truncated[i])
+            assert np.array_equal(observations[i], observation)
+            assert rewards[i] == reward
+            count = info["landmark_error"].shape[0]
+            assert np.array_equal(infos["landmark_error"][i, :count], info["landmark_error"])
+            counts.add(env.unwrapped.n_landmarks)
+        done = terminated | truncated
+    assert len(counts) >= 2  # the episodes really had different landmark counts
+
+
+def test_time_limit_truncates_like_gym_make() -> None:
+    env = gym.make_vec(
+        "BearingSLAM-v0", num_envs=2, vectorization_mode="vector_entry_point", max_episode_steps=3
+    )
+    env.reset(seed=0)
+    actions = np.zeros((2, 2), dtype=np.float32)
+    for _ in range(2):
+        _, _, _, truncated, _ = env.step(actions)
+        assert not truncated.any()
+    _, _, terminated, truncated, _ = env.step(actions)
+    assert np.all(truncated | terminated)
+    observations, rewards, terminated, truncated, _ = env.step(actions)  # autoreset
+    assert np.all(rewards == 0.0) and not (terminated | truncated).any()
+    assert np.all(observations[:, 6] == 0.0)  # progress restarts
+
+
+def test_same_step_autoreset_reports_final_observation_and_info() -> None:
+    env = BearingSLAMVectorEnv(2, autoreset_mode="same_step", max_moves=2, scenario="khepera")
+    env.reset(seed=0)
+    actions = np.zeros((2, 2), dtype=np.float32)
+    env.step(actions)
+    observations, _, terminated, truncated, infos = env.step(actions)
+    assert np.all(terminated | truncated)
+    assert infos["_final_obs"].all() and infos["final_obs"][0].shape == observations[0].shape
+    assert np.all(infos["final_obs"][0][6] == 1.0)  # the last observation: progress 1
+    assert np.all(observations[:, 6] == 0.0)  # the returned one: already reset
+    assert set(infos["final_info"]) >= {"landmark_area", "total_area", "rewards"}
+
+
+def test_invalid_arguments_raise_clear_errors() -> None:
+    with pytest.raises(ValueError, match="num_envs"):
+        BearingSLAMVectorEnv(0)
+    with pytest.raises(TypeError, match="num_envs"):
+        BearingSLAMVectorEnv(2.5)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="autoreset_mode"):
+        BearingSLAMVectorEnv(2, autoreset_mode="sometimes")
+    with pytest.raises(ValueError, match="autoreset_mode"):
+        BearingSLAMVectorEnv(2, autoreset_mode=AutoresetMode.DISABLED)
+    with pytest.raises(ValueError, match="max_episode_steps"):
+        BearingSLAMVectorEnv(2, max_episode_steps=0)
+    with pytest.raises(ValueError, match="render_mode"):
+        BearingSLAMVectorEnv(2, render_mode="human")
+    with pytest.raises(ValueError, match="epsilon_deg"):
+        BearingSLAMVectorEnv(2, epsilon_deg=-1.0)
+    with pytest.raises(TypeError, match="unexpected keyword"):
+        BearingSLAMVectorEnv(2, epsilon_degrees=2.0)
+    env = BearingSLAMVectorEnv(2)
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(np.zeros((2, 2), dtype=np.float32))
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="shape"):
+        env.step(np.zeros((3, 2), dtype=np.float32))
+    with pytest.raises(ValueError, match="outside"):
+        env.step(np.full((2, 2), 3.0, dtype=np.float32))
+    with pytest.raises(ValueError, match="seeds"):
+        env.reset(seed=[1, 2, 3])
+
+
+def test_class_metadata_is_not_mutated() -> None:
+    BearingSLAMVectorEnv(2, autoreset_mode="same_step")
+    assert BearingSLAMVectorEnv.metadata["autoreset_mode"] == AutoresetMode.NEXT_STEP
+
+
+def test_pickle_round_trip_continues_identically() -> None:
+    env = BearingSLAMVectorEnv(3, n_landmarks=5)
+    env.reset(seed=9)
+    actions = np.random.default_rng(0).uniform(-1, 1, (10, 3, 2)).astype(np.float32)
+    for a in actions[:4]:
+        env.step(a)
+    clone = pickle.loads(pickle.dumps(env))
+    for a in actions[4:]:
+        assert_same(env.step(a), clone.step(a))
+    # The clone's sub-envs still share one map batch of their own.
+    assert clone.envs[0].slam.batch is clone.envs[2].slam.batch
+    assert clone.envs[0].slam.batch is not env.envs[0].slam.batch
+
+
+def _step_in_subprocess(queue: Any) -> None:
+    env = gym.make_vec("BearingSLAM-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    env.reset(seed=3)
+    observations, *_ = env.step(np.zeros((2, 2), dtype=np.float32))
+    queue.put(observations)
+
+
+def test_make_vec_in_a_spawned_process() -> None:
+    context = mp.get_context("spawn")
+    queue = context.Queue()
+    process = context.Process(target=_step_in_subprocess, args=(queue,))
+    process.start()
+    observations = queue.get(timeout=120)
+    process.join(timeout=60)
+    assert process.exitcode == 0
+    env = gym.make_vec("BearingSLAM-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    env.reset(seed=3)
+    expected, *_ = env.step(np.zeros((2, 2), dtype=np.float32))
+    assert np.array_equal(observations, expected)
+
+
+def test_rgb_array_render_gives_one_frame_per_env(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
+    env = BearingSLAMVectorEnv(2, render_mode="rgb_array", scenario="khepera")
+    env.reset(seed=0)
+    env.step(np.zeros((2, 2), dtype=np.float32))
+    frames = env.render()
+    assert frames is not None and len(frames) == 2
+    assert frames[0].ndim == 3 and frames[0].shape[2] == 3 and frames[0].std() > 0
+    env.close()
+
+
+def test_attribute_access() -> None:
+    env = BearingSLAMVectorEnv(2, scenario="khepera")
+    assert env.get_attr("n_landmarks") == (4, 4)
+    env.set_attr("path_cost", [0.0, 1.0])
+    assert env.get_attr("path_cost") == (0.0, 1.0)
+    with pytest.raises(ValueError, match="expected 2 values"):
+        env.set_attr("path_cost", [1.0])
+
+
+# ----------------------------------------------------------------------------------------
+# The batched world model underneath
+# ----------------------------------------------------------------------------------------
+
+
+def test_a_maps_update_does_not_depend_on_its_batch() -> None:
+    rng = np.random.default_rng(4)
+    n_maps, n_landmarks, eps = 9, 6, np.deg2rad(2.0)
+    shape = (n_maps, n_landmarks)
+    landmarks = rng.uniform(0, 10, shape) + 1j * rng.uniform(0, 10, shape)
+    batch = BatchedPolygonSLAM(n_maps, n_landmarks, eps)
+    singles = [PolygonSLAM(n_landmarks, eps) for _ in range(n_maps)]
+    position = np.full(n_maps, 5.0 + 5.0j)
+    for _ in range(8):
+        step = 1.5 * np.exp(1j * rng.uniform(-np.pi, np.pi, n_maps))
+        heading = step / np.abs(step)
+        b1 = np.angle((landmarks - position[:, None]) / heading[:, None])
+        b2 = np.angle((landmarks - (position + step)[:, None]) / heading[:, None])
+        b1 += rng.uniform(-eps, eps, b1.shape)
+        b2 += rng.uniform(-eps, eps, b2.shape)
+        moving = np.flatnonzero(rng.random(n_maps) < 0.7)
+        result = batch.update(b1[moving], b2[moving], maps=moving)
+        for j, i in enumerate(moving):
+            single = singles[i].update(b1[i], b2[i])
+            assert single.frame_changed == result.frame_changed[j]
+        position = position + step
+    for i, single in enumerate(singles):
+        view = PolygonSLAM.view(batch, i)
+        assert np.array_equal(view.supports, single.supports)
+        assert np.array_equal(view.areas, single.areas)
+        assert np.array_equal(view.estimates, single.estimates, equal_nan=True)
+        assert view.n_updates == single.n_updates
+        assert view.robot_area == single.robot_area or np.isinf(single.robot_area)
+
+
+def test_views_share_their_batch_and_copies_do_not() -> None:
+    batch = BatchedPolygonSLAM(3, 4, np.deg2rad(2.0))
+    view = PolygonSLAM.view(batch, 1)
+    b1, b2 = np.array([0.3, 0.6, 1.2, 1.9]), np.array([0.5, 0.9, 1.5, 2.3])
+    clone = view.copy()
+    view.update(b1, b2)
+    assert batch.n_updates.tolist() == [0, 1, 0]
+    assert clone.n_updates == 0 and clone.batch is not batch
+    with pytest.raises(IndexError):
+        PolygonSLAM.view(batch, 3)
