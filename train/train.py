@@ -20,6 +20,16 @@ same files run under rl-zoo3::
 instead), and ``--hyperparams k=v ...`` over the entry itself. Values are Python literals
 when they parse as one, strings otherwise.
 
+**Vectorisation** (``--vec-env``). ``batched`` runs the ``n_envs`` training envs as one
+Gymnasium vector env in this process, through ``train.vec_env``'s SB3 adapter: the id's
+natively batched ``vector_entry_point`` when it registers one (one numpy call steps every
+env), else a ``SyncVectorEnv`` of single envs. ``subproc`` runs one single env per worker
+process (spawn), ``dummy`` all of them in this process. ``auto``, the default, is
+``batched`` when the id registers a batched vector env and ``subproc`` otherwise. Every
+kind seeds env ``i`` alike, so the kinds train on the same data when the batched env
+reproduces the single env; ``run.json`` records the kind used by each segment, and a run
+may be resumed with another kind.
+
 **Seeds.** Training env ``i`` first resets with seed ``s + i`` and then runs on from its
 own random stream, where ``s = --seed`` for a new run and ``(seed + t) mod (900000 -
 n_envs)`` for a segment resumed at timestep ``t``: every training seed is below
@@ -38,7 +48,8 @@ same episodes at every evaluation. Both ranges lie below ``train.compare``'s tes
     best/best.json           its score: mean reward, median total area after 10 moves, ...
     best/evaluations.npz     every evaluation (SB3's format)
     checkpoints/             rl_model_<N>_steps.zip (+ _vecnormalize_, _replay_buffer_)
-    monitor/                 per-env episode logs (SB3 Monitor CSV)
+    monitor/                 episode logs (SB3 Monitor CSV): <i>.monitor.csv per env, or
+                             batched.monitor.csv for all envs of --vec-env batched
     tensorboard/             TensorBoard logs (``tensorboard --logdir runs``)
 
 **Interruptions.** Ctrl-C (or SIGTERM) stops at the next env step and saves a checkpoint
@@ -78,7 +89,13 @@ from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.monitor import Monitor
 from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
-from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecEnv, VecNormalize
+from stable_baselines3.common.vec_env import (
+    DummyVecEnv,
+    SubprocVecEnv,
+    VecEnv,
+    VecMonitor,
+    VecNormalize,
+)
 
 import bearing_env
 from train.callbacks import (
@@ -96,6 +113,13 @@ from train.callbacks import (
     save_model_atomically,
     save_vecnormalize_atomically,
     write_json_atomically,
+)
+from train.vec_env import (
+    MONITOR_INFO_KEYWORDS,
+    gym_make_kwargs,
+    has_vector_entry_point,
+    make_batched_vec_env,
+    monitor_csv_path,
 )
 
 ALGORITHMS: dict[str, type[BaseAlgorithm]] = {"ppo": PPO, "sac": SAC, "dqn": DQN}
@@ -127,7 +151,13 @@ EXPORT_VECNORMALIZE_SUFFIX = "_vecnormalize.pkl"
 RUN_FORMAT_VERSION = 1
 EXIT_INTERRUPTED = 130
 
-VEC_ENV_KINDS: tuple[str, ...] = ("subproc", "dummy")
+#: How the training envs run: ``batched`` is one Gymnasium vector env (the id's natively
+#: batched ``vector_entry_point``, else a ``SyncVectorEnv``) behind ``train.vec_env``'s
+#: adapter; ``subproc`` one process per env (spawn); ``dummy`` all envs in this process.
+VEC_ENV_KINDS: tuple[str, ...] = ("batched", "subproc", "dummy")
+#: ``--vec-env`` also takes ``auto``: ``batched`` when the env id registers a batched
+#: vector env (``vector_entry_point``), else ``subproc``.
+VEC_ENV_CHOICES: tuple[str, ...] = ("auto", *VEC_ENV_KINDS)
 
 #: rl-zoo3 keys that this trainer does not implement (rl-zoo3 itself does).
 UNSUPPORTED_ZOO_KEYS: frozenset[str] = frozenset(
@@ -345,15 +375,6 @@ class SuccessInfo(gym.Wrapper[Any, Any, Any, Any]):
         return observation, reward, terminated, truncated, info
 
 
-def gym_make_kwargs(env_kwargs: Mapping[str, Any]) -> dict[str, Any]:
-    """``env_kwargs`` for ``gym.make``: a ``max_moves`` also sets the spec's time limit
-    (``max_episode_steps``, 20 by default), unless that is given too."""
-    kwargs = dict(env_kwargs)
-    if "max_moves" in kwargs:
-        kwargs.setdefault("max_episode_steps", kwargs["max_moves"])
-    return kwargs
-
-
 @dataclass(frozen=True, eq=False)
 class EnvFactory:
     """Builds one wrapped env; picklable, so ``SubprocVecEnv`` (spawn) can call it in a worker."""
@@ -362,6 +383,8 @@ class EnvFactory:
     env_kwargs: dict[str, Any] = field(default_factory=dict)
     monitor_path: str | None = None
     episode_seeds: tuple[int, ...] | None = None
+    #: Log episodes with SB3's ``Monitor``; False when a ``VecMonitor`` does it instead.
+    monitor: bool = True
     #: In worker processes: leave Ctrl-C to the trainer, which stops and checkpoints.
     ignore_interrupts: bool = False
 
@@ -371,15 +394,33 @@ class EnvFactory:
         bearing_env.registration.register_envs()
         env: gym.Env[Any, Any] = gym.make(self.env_id, **gym_make_kwargs(self.env_kwargs))
         env = SuccessInfo(env)
-        env = Monitor(
-            env,
-            filename=self.monitor_path,
-            info_keywords=("is_success",),
-            override_existing=False,
-        )
+        if self.monitor:
+            env = Monitor(
+                env,
+                filename=self.monitor_path,
+                info_keywords=("is_success",),
+                # A resumed run appends; a new log starts with SB3's header (load_results
+                # needs it).
+                override_existing=self.monitor_path is None
+                or not Path(monitor_csv_path(self.monitor_path)).is_file(),
+            )
         if self.episode_seeds is not None:
             env = EpisodeSeedCycle(env, self.episode_seeds)
         return env
+
+
+def resolve_vec_env_kind(vec_env_kind: str, env_id: str) -> str:
+    """The kind of :data:`VEC_ENV_KINDS` that ``vec_env_kind`` means for ``env_id``.
+
+    ``auto`` is ``batched`` when the id registers a natively batched vector env, which
+    steps all envs in one numpy call, and ``subproc`` otherwise: a ``SyncVectorEnv``
+    fallback would step the envs one by one in this process, and processes are faster.
+    """
+    if vec_env_kind == "auto":
+        return "batched" if has_vector_entry_point(env_id) else "subproc"
+    if vec_env_kind not in VEC_ENV_KINDS:
+        raise ValueError(f"unknown vec env {vec_env_kind!r}; expected one of {VEC_ENV_CHOICES}")
+    return vec_env_kind
 
 
 def make_training_env(
@@ -389,11 +430,19 @@ def make_training_env(
     vec_env_kind: str,
     monitor_dir: Path | None,
 ) -> VecEnv:
-    """``n_envs`` training envs in a ``SubprocVecEnv`` (spawn) or a ``DummyVecEnv``."""
-    if vec_env_kind not in VEC_ENV_KINDS:
-        raise ValueError(f"unknown vec env {vec_env_kind!r}; expected one of {VEC_ENV_KINDS}")
+    """``n_envs`` training envs: one batched Gymnasium vector env (``batched``, logged to
+    ``monitor_dir/batched.monitor.csv``), a ``SubprocVecEnv`` (spawn) or a ``DummyVecEnv``
+    (logged to ``monitor_dir/<i>.monitor.csv``). ``auto``: see :func:`resolve_vec_env_kind`.
+
+    Every kind seeds env ``i`` with ``seed + i`` at ``venv.seed(seed)``, so the kinds train
+    on the same data when the batched env reproduces the single env.
+    """
+    vec_env_kind = resolve_vec_env_kind(vec_env_kind, env_id)
     if monitor_dir is not None:
         monitor_dir.mkdir(parents=True, exist_ok=True)
+    if vec_env_kind == "batched":
+        monitor_path = None if monitor_dir is None else str(monitor_dir / "batched")
+        return make_batched_vec_env(env_id, env_kwargs, n_envs, monitor_path)
     factories = [
         EnvFactory(
             env_id=env_id,
@@ -414,10 +463,24 @@ def validation_seeds(n_episodes: int) -> tuple[int, ...]:
     return tuple(range(VALIDATION_SEED_START, VALIDATION_SEED_START + n_episodes))
 
 
-def make_validation_env(env_id: str, env_kwargs: dict[str, Any], n_episodes: int) -> VecEnv:
-    """One in-process env cycling through the validation seeds."""
-    factory = EnvFactory(env_id, dict(env_kwargs), episode_seeds=validation_seeds(n_episodes))
-    return DummyVecEnv([factory])
+def make_validation_env(
+    env_id: str, env_kwargs: dict[str, Any], n_episodes: int, vec_monitor: bool = False
+) -> VecEnv:
+    """One in-process env cycling through the validation seeds.
+
+    ``vec_monitor``: log episodes with a ``VecMonitor`` instead of a ``Monitor``, so that the
+    wrappers stack up as in a ``batched`` training env. SB3's evaluation copies the
+    ``VecNormalize`` statistics by walking both stacks in step, and fails on a
+    ``VecMonitor`` that only the training env has.
+    """
+    factory = EnvFactory(
+        env_id,
+        dict(env_kwargs),
+        episode_seeds=validation_seeds(n_episodes),
+        monitor=not vec_monitor,
+    )
+    venv: VecEnv = DummyVecEnv([factory])
+    return VecMonitor(venv, info_keywords=MONITOR_INFO_KEYWORDS) if vec_monitor else venv
 
 
 def training_seed_start(seed: int, start_timesteps: int, n_envs: int) -> int:
@@ -505,7 +568,7 @@ class TrainSettings:
     timesteps: int | None = None
     seed: int = 0
     n_envs: int | None = None
-    vec_env: str = "subproc"
+    vec_env: str = "auto"
     resume: bool = False
     eval_freq: int = DEFAULT_EVAL_FREQ
     eval_episodes: int = DEFAULT_EVAL_EPISODES
@@ -711,14 +774,20 @@ def train(settings: TrainSettings) -> TrainResult:
     if settings.torch_threads is not None:
         torch.set_num_threads(settings.torch_threads)
 
+    vec_env_kind = resolve_vec_env_kind(settings.vec_env, settings.env_id)
     # The validation env is built first, in this process: bad env kwargs fail here, fast.
-    eval_venv: VecEnv = make_validation_env(settings.env_id, env_kwargs, settings.eval_episodes)
+    eval_venv: VecEnv = make_validation_env(
+        settings.env_id,
+        env_kwargs,
+        settings.eval_episodes,
+        vec_monitor=vec_env_kind == "batched",
+    )
     area_cap = float(eval_venv.get_attr("area_cap")[0])
     settings.output.mkdir(parents=True, exist_ok=True)
     start_timesteps = checkpoint.timesteps if checkpoint is not None else 0
     seed_start = training_seed_start(settings.seed, start_timesteps, n_envs)
     venv: VecEnv = make_training_env(
-        settings.env_id, env_kwargs, n_envs, settings.vec_env, files.monitor
+        settings.env_id, env_kwargs, n_envs, vec_env_kind, files.monitor
     )
     try:
         if hyperparams.normalize is not None:
@@ -764,7 +833,7 @@ def train(settings: TrainSettings) -> TrainResult:
             "hyperparams": _json_safe(raw),
             "n_envs": n_envs,
             "seed": settings.seed,
-            "vec_env": settings.vec_env,
+            "vec_env": vec_env_kind,
             "target_timesteps": target,
             "num_timesteps": int(model.num_timesteps),
             "status": "running",
@@ -833,7 +902,7 @@ def train(settings: TrainSettings) -> TrainResult:
                     "start_timesteps": start_timesteps,
                     "end_timesteps": int(model.num_timesteps),
                     "n_envs": n_envs,
-                    "vec_env": settings.vec_env,
+                    "vec_env": vec_env_kind,
                     "wall_seconds": round(wall_seconds, 3),
                     "steps_per_second": round(steps_per_second, 1),
                 }
@@ -959,7 +1028,15 @@ def build_parser() -> argparse.ArgumentParser:
     add("--timesteps", type=int, help="total env steps of the run (default the YAML's n_timesteps)")
     add("--seed", type=int, default=0, help="default %(default)s")
     add("--n-envs", type=int, help="parallel envs (default the YAML's n_envs)")
-    add("--vec-env", choices=VEC_ENV_KINDS, default="subproc", help="default %(default)s (spawn)")
+    add(
+        "--vec-env",
+        choices=VEC_ENV_CHOICES,
+        default="auto",
+        help="batched: one Gymnasium vector env in this process (the id's batched "
+        "vector_entry_point, else a SyncVectorEnv); subproc: a process per env (spawn); "
+        "dummy: all in this process; auto (default): batched when the id registers a "
+        "batched vector env, else subproc",
+    )
     add("--output", type=Path, help="run folder (default runs/<algo>_<env>_seed<seed>)")
     add("--resume", action="store_true", help="continue the run in --output from its checkpoint")
     add(
