@@ -25,6 +25,7 @@ from bearing_env.world import (
 )
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
 
 #: Default episode length in moves; also the registered ``max_episode_steps``.
 DEFAULT_MAX_MOVES = 20
@@ -353,6 +354,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         self._slam = self._make_slam(self.n_landmarks)
         self._world: World | None = None
         self._landmarks_fl = np.zeros((0, 2))
+        self._landmarks_fl_complex = np.zeros(0, dtype=complex)
+        self._frame_origin, self._frame_unit = 0j, 1 + 0j
         self._moves = 0
         self._potential = 0.0
         self._latest_bearings = np.zeros(self.n_landmarks)
@@ -552,6 +555,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         self._world = World(self.arena, landmarks, position, heading, self.noise, self.epsilon)
         # Landmarks do not move: their true FL positions (for info) are fixed per episode.
         self._landmarks_fl = world_to_fl(landmarks[2:], landmarks[0], landmarks[1])
+        self._landmarks_fl_complex = self._landmarks_fl[:, 0] + 1j * self._landmarks_fl[:, 1]
+        self._frame_origin = complex(*landmarks[0])
+        self._frame_unit = complex(*landmarks[1]) - self._frame_origin
         self._slam.reset()
         self._moves = 0
         self._latest_bearings = self._world.read_bearings(rng)
@@ -560,13 +566,15 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         self._trajectory = [self._world.position.copy()]
         self._last_start_bearings = None
         self._last_start_position = None
-        self._potential = float(_potentials([self])[0])
-        observation = _observations([self])[0]
+        batch, rows = self._slam.batch, self._slam_rows()
+        self._potential = float(_potentials([self], batch, rows)[0])
+        observation = _observations([self], batch, rows)[0]
         zeros = np.zeros(1)
-        info = _row_info(
-            _batched_infos([self], np.zeros(1, bool), np.zeros(1, np.int64), zeros, zeros, zeros),
-            0,
+        no_change = np.zeros(1, dtype=bool)
+        infos = _batched_infos(
+            [self], batch, rows, no_change, np.zeros(1, np.int64), zeros, zeros, zeros
         )
+        info = _row_info(infos, 0)
         if self.render_mode == "human":
             self.render()
         return observation, info
@@ -641,8 +649,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             env._trajectory.append(env._world.position.copy())
 
         first = envs[0]
+        batch, rows = _batch_rows(envs)
         travelled = np.array([movement.move.travelled for movement in movements])
-        potential = _potentials(envs)
+        potential = _potentials(envs, batch, rows)
         previous = np.array([env._potential for env in envs])
         uncertainty = previous - potential
         path_cost = -first.path_cost * travelled
@@ -651,16 +660,23 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         for env, value in zip(envs, potential, strict=True):
             env._potential = float(value)
 
-        batch, rows = _batch_rows(envs)
         areas = batch.areas[rows]
         terminated = np.all(batch.initialised[rows], axis=-1) & np.all(
             areas <= first.target_area, axis=-1
         )
         moves = np.array([env._moves for env in envs])
         truncated = ~terminated & (moves >= first.max_moves)
-        observations = _observations(envs)
+        observations = _observations(envs, batch, rows)
         infos = _batched_infos(
-            envs, frame_changed, inconsistent, travelled, uncertainty, path_cost, move_cost
+            envs,
+            batch,
+            rows,
+            frame_changed,
+            inconsistent,
+            travelled,
+            uncertainty,
+            path_cost,
+            move_cost,
         )
         return observations, rewards, terminated, truncated, infos
 
@@ -695,6 +711,16 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     # ------------------------------------------------------------------------------------
     # Internals
     # ------------------------------------------------------------------------------------
+
+    def _slam_rows(self) -> IntArray:
+        """This env's row of its map batch, as an index array."""
+        return self._slam.rows
+
+    def _robot_fl(self) -> complex:
+        """The robot's true position in FL, as a complex number."""
+        assert self._world is not None
+        x, y = self._world.position
+        return (complex(x, y) - self._frame_origin) / self._frame_unit
 
     def _make_slam(self, n_landmarks: int) -> PolygonSLAM:
         """The map for an episode with ``n_landmarks`` (the batched vector env overrides
@@ -761,9 +787,11 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 # ----------------------------------------------------------------------------------------
 
 
-def _batch_rows(envs: Sequence[BearingSLAMEnv]) -> tuple[BatchedPolygonSLAM, NDArray[np.int64]]:
+def _batch_rows(envs: Sequence[BearingSLAMEnv]) -> tuple[BatchedPolygonSLAM, IntArray]:
     """The map batch the envs share and their rows in it."""
     batch = envs[0].slam.batch
+    if len(envs) == 1:
+        return batch, envs[0]._slam_rows()
     if any(env.slam.batch is not batch for env in envs):
         raise ValueError("the envs' maps must live in one batch")
     return batch, np.array([env.slam.index for env in envs])
@@ -771,23 +799,36 @@ def _batch_rows(envs: Sequence[BearingSLAMEnv]) -> tuple[BatchedPolygonSLAM, NDA
 
 def _log_capped(areas: FloatArray, area_cap: float) -> FloatArray:
     # Uninitialised landmarks have area inf, so the cap also stands in for them.
-    return np.log(np.clip(areas, AREA_FLOOR, area_cap))
+    return np.log(_clipped(areas, AREA_FLOOR, area_cap))
 
 
-def _potentials(envs: Sequence[BearingSLAMEnv]) -> FloatArray:
+def _clipped(values: FloatArray, low: float, high: float) -> FloatArray:
+    # np.clip's Python wrapper costs more than the arithmetic on these small arrays.
+    return np.minimum(np.maximum(values, low), high)
+
+
+def _xy(points: NDArray[np.complex128]) -> FloatArray:
+    """Complex points as (..., 2) coordinates, without copying."""
+    points = np.ascontiguousarray(points)
+    return points.view(np.float64).reshape(*points.shape, 2)
+
+
+def _potentials(
+    envs: Sequence[BearingSLAMEnv], batch: BatchedPolygonSLAM, rows: IntArray
+) -> FloatArray:
     """The uncertainty potential Phi of each env (see the env's Rewards section)."""
     first = envs[0]
-    batch, rows = _batch_rows(envs)
     areas = batch.areas[rows]
     if first.reward_kind == "log_area":
-        return np.sum(_log_capped(areas, first.area_cap), axis=-1)
-    return np.sum(np.clip(areas, AREA_FLOOR, first.area_cap), axis=-1)
+        return _log_capped(areas, first.area_cap).sum(axis=-1)
+    return _clipped(areas, AREA_FLOOR, first.area_cap).sum(axis=-1)
 
 
-def _observations(envs: Sequence[BearingSLAMEnv]) -> NDArray[np.float32]:
+def _observations(
+    envs: Sequence[BearingSLAMEnv], batch: BatchedPolygonSLAM, rows: IntArray
+) -> NDArray[np.float32]:
     """Observations (len(envs), observation_size) of envs with equal settings."""
     first = envs[0]
-    batch, rows = _batch_rows(envs)
     n_envs, n_slots, n_landmarks = len(envs), first.max_landmarks, first.n_landmarks
     observation = np.zeros((n_envs, observation_size(n_slots)))
     blocks = observation_slices(n_slots)
@@ -796,10 +837,9 @@ def _observations(envs: Sequence[BearingSLAMEnv]) -> NDArray[np.float32]:
     bearing = observation[:, blocks["bearings"]].reshape(n_envs, n_slots, -1)
 
     centroid = batch.robot_centroid[rows]
-    estimate = np.stack([centroid.real, centroid.imag], axis=-1)
-    known = batch.has_robot[rows] & np.all(np.isfinite(estimate), axis=-1)
-    robot[:, 0:2] = np.where(
-        known[:, None], np.clip(np.nan_to_num(estimate), -FL_COORD_LIMIT, FL_COORD_LIMIT), 0.0
+    known = batch.has_robot[rows] & np.isfinite(centroid)
+    robot[:, 0:2] = _clipped(
+        _xy(np.where(known, centroid, 0.0)), -FL_COORD_LIMIT, FL_COORD_LIMIT
     )
     robot[:, 2] = np.where(
         known, _log_capped(batch.robot_area[rows], first.area_cap), math.log(first.area_cap)
@@ -810,21 +850,17 @@ def _observations(envs: Sequence[BearingSLAMEnv]) -> NDArray[np.float32]:
     safe_heading = np.where(has_heading, heading, 0.0)
     robot[:, 4] = np.where(has_heading, np.cos(safe_heading), 0.0)
     robot[:, 5] = np.where(has_heading, np.sin(safe_heading), 0.0)
-    moves = np.array([env._moves for env in envs])
-    robot[:, 6] = np.minimum(moves / first.max_moves, 1.0)
-    robot[:, 7] = [env._last_frame_changed for env in envs]
-    robot[:, 8] = [env._last_move is not None and env._last_move.blocked for env in envs]
+    for row, env in enumerate(envs):
+        robot[row, 6] = min(env._moves / env.max_moves, 1.0)
+        robot[row, 7] = env._last_frame_changed
+        robot[row, 8] = env._last_move is not None and env._last_move.blocked
 
     n_mapped = n_landmarks - 2
     initialised = batch.initialised[rows]
-    centroids = batch.centroids[rows]
-    estimates = np.stack([centroids.real, centroids.imag], axis=-1)
     mapped[:, :n_mapped, 0] = 1.0
     mapped[:, :n_mapped, 1] = ~initialised
-    mapped[:, :n_mapped, 2:4] = np.where(
-        initialised[..., None],
-        np.clip(np.nan_to_num(estimates), -FL_COORD_LIMIT, FL_COORD_LIMIT),
-        0.0,
+    mapped[:, :n_mapped, 2:4] = _clipped(
+        _xy(np.where(initialised, batch.centroids[rows], 0.0)), -FL_COORD_LIMIT, FL_COORD_LIMIT
     )
     mapped[:, :n_mapped, 4] = _log_capped(batch.areas[rows], first.area_cap)
 
@@ -837,6 +873,8 @@ def _observations(envs: Sequence[BearingSLAMEnv]) -> NDArray[np.float32]:
 
 def _batched_infos(
     envs: Sequence[BearingSLAMEnv],
+    batch: BatchedPolygonSLAM,
+    rows: IntArray,
     frame_changed: NDArray[np.bool_],
     inconsistent: NDArray[np.int64],
     path_length: FloatArray,
@@ -845,30 +883,22 @@ def _batched_infos(
     move_cost: FloatArray | None = None,
 ) -> dict[str, Any]:
     """The envs' infos, batched along a first axis (see the env's Info section)."""
-    batch, rows = _batch_rows(envs)
-    truth_fl = np.stack([env._landmarks_fl for env in envs])
     initialised = batch.initialised[rows]
     areas = batch.areas[rows]
-    centroids = batch.centroids[rows]
-    truth = truth_fl[..., 0] + 1j * truth_fl[..., 1]
-    errors = np.where(initialised, np.abs(np.where(initialised, centroids - truth, 0.0)), np.inf)
-    contains = np.zeros(initialised.shape, dtype=bool)
-    contains[initialised] = batch.kgon.contains(
-        batch.support[rows][initialised], truth[initialised]
+    truth = np.stack([env._landmarks_fl_complex for env in envs])
+    errors = np.where(
+        initialised, np.abs(np.where(initialised, batch.centroids[rows] - truth, 0.0)), np.inf
     )
-
-    worlds = [env._world for env in envs]
-    assert all(world is not None for world in worlds)
-    positions = np.stack([world.position for world in worlds])  # type: ignore[union-attr]
-    landmarks = np.stack([world.landmarks[:2] for world in worlds])  # type: ignore[union-attr]
-    robot_truth = world_to_fl(positions, landmarks[:, 0], landmarks[:, 1])
+    contains = np.zeros(initialised.shape, dtype=bool)
+    if initialised.any():
+        contains[initialised] = batch.kgon.contains(
+            batch.support[rows][initialised], truth[initialised]
+        )
+    robot_truth = np.array([env._robot_fl() for env in envs])
     robot_centroid = batch.robot_centroid[rows]
-    robot_estimate = np.stack([robot_centroid.real, robot_centroid.imag], axis=-1)
-    robot_known = np.all(np.isfinite(robot_estimate), axis=-1)
+    robot_known = np.isfinite(robot_centroid)
     robot_error = np.where(
-        robot_known,
-        np.hypot(*(np.where(robot_known[:, None], robot_estimate, 0.0) - robot_truth).T),
-        np.inf,
+        robot_known, np.abs(np.where(robot_known, robot_centroid - robot_truth, 0.0)), np.inf
     )
     if move_cost is None:
         move_cost = np.zeros(len(envs))
@@ -876,7 +906,7 @@ def _batched_infos(
         "landmark_area": areas,
         "landmark_error": errors,
         "landmark_contains_truth": contains,
-        "total_area": np.sum(areas, axis=-1),
+        "total_area": areas.sum(axis=-1),
         "robot_error": robot_error,
         "frame_changed": np.asarray(frame_changed, dtype=bool),
         "inconsistent": np.asarray(inconsistent, dtype=np.int64),

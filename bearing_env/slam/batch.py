@@ -191,34 +191,36 @@ class BatchedPolygonSLAM:
         """Transfer and intersect the regions of the movements ``ok`` (indices into ``rows``)."""
         k = self.kgon.k
         n_mapped = self.n_landmarks - 2
-        per_edge_of = np.zeros(rows.size, dtype=np.int64)
-        per_edge_of[bounded] = plan.per_edge
-        plan_index = np.full(rows.size, -1, dtype=np.int64)
-        plan_index[bounded] = np.arange(bounded.size)
         robot_new = np.empty((ok.size, k))
         landmark_new = np.empty((ok.size, n_mapped, k))
+        conservative = self.transfer == "conservative"
+        in_plan = np.searchsorted(bounded, ok)  # every movement in ok is in the plan
+        per_edge_of = plan.per_edge[in_plan]
         # Maps needing the same sampling are transferred together; each map's sampling
         # depends on its own regions only.
-        for per_edge in np.unique(per_edge_of[ok]):
-            group = np.flatnonzero(per_edge_of[ok] == per_edge)
+        if np.all(per_edge_of == per_edge_of[0]):
+            groups = [(int(per_edge_of[0]), np.arange(ok.size))]
+        else:
+            groups = [
+                (int(per_edge), np.flatnonzero(per_edge_of == per_edge))
+                for per_edge in np.unique(per_edge_of)
+            ]
+        for per_edge, group in groups:
             members = ok[group]
-            sub_plan = _take_plan(plan, plan_index[members])
             hyp = sample_hypotheses(
                 regions[members, 0],
                 regions[members, 1],
-                sub_plan,
-                int(per_edge),
-                self.transfer == "conservative",
+                _take_plan(plan, in_plan[group]),
+                per_edge,
+                conservative,
             )
             targets = regions[members, 2:]
             usable = fr_status[members, 2:] == FR_BOUNDED
             # Unbounded targets hold nan vertices; any finite stand-in keeps the arithmetic
             # quiet, and their results are discarded below.
             targets = np.where(usable[..., None], targets, 0.0)
-            robot, landmarks = transfer_support(
-                self.kgon, hyp, np.ones((members.size, 1, 1), dtype=complex), targets
-            )
-            robot_new[group] = robot[:, 0]
+            robot, landmarks = transfer_support(self.kgon, hyp, targets)
+            robot_new[group] = robot
             landmark_new[group] = landmarks
 
         targets_ok = fr_status[ok, 2:] == FR_BOUNDED

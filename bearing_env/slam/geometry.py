@@ -19,6 +19,8 @@ Two polygon representations are used:
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -156,17 +158,25 @@ def _general_cone_vertices(
 def polygon_distance(p: ComplexArray, q: ComplexArray) -> FloatArray:
     """Distances between small convex polygons (vertex arrays (..., V), CCW); 0 if they touch.
 
-    Batched over leading axes (``p`` and ``q`` broadcast). Overlap is decided by the
-    separating-axis test; the distance of disjoint polygons is the smallest
-    vertex-to-edge distance either way. Degenerate polygons (a point, a segment, padded by
-    repeated vertices) are handled: the directions between vertices are candidate axes too.
+    Batched over leading axes (``p`` and ``q`` of one shape). The separating-axis test
+    decides whether they are disjoint (the edge normals, and the directions between
+    vertices, which separate degenerate polygons: points and segments padded by repeated
+    vertices); disjoint polygons are at the smallest vertex-to-edge distance either way.
     """
-    p, q = np.broadcast_arrays(np.asarray(p, complex), np.asarray(q, complex))
+    both = np.stack([p, q]).astype(complex, copy=False)
+    # Vertices of p against the edges of q, and of q against those of p, in one go.
+    gaps = _point_edge_distances(both, both[::-1]).min(axis=(0, -1, -2))
+    return np.where(_separating_axis_exists(both[0], both[1]), gaps, 0.0)
+
+
+def _separating_axis_exists(p: ComplexArray, q: ComplexArray) -> BoolArray:
+    """The separating-axis test for rows of small convex polygons (N, V)."""
+    n_vertices = p.shape[-1] * q.shape[-1]
     axes = np.concatenate(
         [
             -1j * (_next_vertex(p) - p),
             -1j * (_next_vertex(q) - q),
-            (q[..., None, :] - p[..., :, None]).reshape(*p.shape[:-1], p.shape[-1] * q.shape[-1]),
+            (q[..., None, :] - p[..., :, None]).reshape(*p.shape[:-1], n_vertices),
         ],
         axis=-1,
     )
@@ -174,14 +184,9 @@ def polygon_distance(p: ComplexArray, q: ComplexArray) -> FloatArray:
     proj_p = (conj_axes * p[..., None, :]).real
     proj_q = (conj_axes * q[..., None, :]).real
     # A zero axis projects both polygons to 0: never separating, no special case needed.
-    separated = (
+    return (
         (proj_q.min(axis=-1) > proj_p.max(axis=-1)) | (proj_p.min(axis=-1) > proj_q.max(axis=-1))
     ).any(axis=-1)
-    gaps = np.minimum(
-        _point_edge_distances(p, q).min(axis=(-1, -2)),
-        _point_edge_distances(q, p).min(axis=(-1, -2)),
-    )
-    return np.where(separated, gaps, 0.0)
 
 
 def _point_edge_distances(points: ComplexArray, poly: ComplexArray) -> FloatArray:
@@ -190,9 +195,9 @@ def _point_edge_distances(points: ComplexArray, poly: ComplexArray) -> FloatArra
     d = _next_vertex(poly)[..., None, :] - a
     z = points[..., :, None]
     len2 = d.real * d.real + d.imag * d.imag
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.clip(((z - a) * np.conj(d)).real / len2, 0.0, 1.0)
-    t = np.where(len2 > 0.0, t, 0.0)
+    degenerate = len2 == 0.0  # a repeated vertex: the distance to the point itself
+    along = ((z - a) * np.conj(d)).real / np.where(degenerate, 1.0, len2)
+    t = np.where(degenerate, 0.0, np.minimum(np.maximum(along, 0.0), 1.0))
     return np.abs(z - (a + t * d))
 
 
@@ -210,8 +215,12 @@ def max_edge_length(poly: ComplexArray) -> FloatArray:
 
 
 def _next_vertex(poly: ComplexArray) -> ComplexArray:
-    n = poly.shape[-1]
-    return poly[..., (np.arange(n) + 1) % n]
+    return poly[..., _next_index(poly.shape[-1])]
+
+
+@functools.cache
+def _next_index(n: int) -> NDArray[np.intp]:
+    return (np.arange(n) + 1) % n
 
 
 # --------------------------------------------------------------------------------------

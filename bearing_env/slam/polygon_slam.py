@@ -176,6 +176,11 @@ class PolygonSLAM:
         """This map's index in :attr:`batch`."""
         return self._index
 
+    @property
+    def rows(self) -> NDArray[np.int64]:
+        """``[index]``: this map's rows of :attr:`batch`, for batched calls."""
+        return self._rows
+
     # -- state -----------------------------------------------------------------------------
 
     def reset(self) -> None:

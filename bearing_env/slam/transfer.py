@@ -98,7 +98,7 @@ def plan_frame_changes(
     if transfer not in TRANSFERS:
         raise ValueError(f"transfer must be one of {TRANSFERS}, got {transfer!r}")
     distance = polygon_distance(a1, a2)
-    longest1, longest2 = max_edge_length(a1), max_edge_length(a2)
+    longest1, longest2 = max_edge_length(np.stack([a1, a2]))
     overlap = ~(distance > 0.0)
     if transfer == "paper":
         per_edge = np.ones(distance.shape, dtype=np.int64)
@@ -201,45 +201,53 @@ def make_hypotheses(
 
 
 def transfer_support(
-    kgon: KGon, hyp: Hypotheses, *targets: ComplexArray
-) -> tuple[FloatArray, ...]:
-    """FL support K-gons of FR regions, one result (G, m, K) per target array (G, m, V).
+    kgon: KGon, hyp: Hypotheses, regions: ComplexArray
+) -> tuple[FloatArray, FloatArray]:
+    """FL support K-gons of the robot's position R2 = 1 and of FR regions.
 
-    Every target row is the vertex array of one convex FR region (a point is a row of
-    one vertex). The result is the tight K-gon circumscribing the hull of the images,
-    grown by the conservative inflation radius. All target arrays share one matrix
-    product per chunk of maps.
+    Args:
+        kgon: the K fixed normals.
+        hyp: the hypotheses of G movements.
+        regions: vertex arrays (G, m, V) of convex FR regions, one row per landmark.
 
-    Chunks are small enough to keep the product in the CPU cache. A map's numbers come
-    from a matrix product of the same shape whatever the batch (numpy multiplies a stack
-    matrix by matrix), so a map's result does not depend on the other maps in its batch.
+    Returns:
+        ``(robot, landmarks)``: supports (G, K) and (G, m, K). Each is the tight K-gon
+        circumscribing the hull of the images, grown by the conservative inflation radius.
+
+    A map's numbers come from matrix products of the same shape whatever the batch (numpy
+    multiplies a stack matrix by matrix) and from maxima, which are exact, so a map's
+    result does not depend on the other maps in its batch. Chunks of maps keep the
+    products in the CPU cache.
     """
-    n_rows = hyp.h1.shape[0]
+    n_rows, m, n_vert = regions.shape
     n_pairs, k = hyp.h1.shape[1], kgon.k
     # <u_k, (z - h1) g> = Re(z) Re(conj(u) g) - Im(z) Im(conj(u) g) - Re(conj(u) g h1):
     # one real matrix product over all (vertex, hypothesis, direction) triples.
     rot = np.conj(kgon.normals)[:, None] * hyp.inv_d[:, None, :]  # (G, K, P)
-    offset = (rot * hyp.h1[:, None, :]).real
-    basis = np.stack([rot.real, rot.imag, offset], axis=1).reshape(n_rows, 3, k * n_pairs)
-    flat = np.concatenate([t.reshape(n_rows, -1) for t in targets], axis=-1)
-    coeff = np.stack([flat.real, -flat.imag, -np.ones(flat.shape)], axis=-1)  # (G, rows, 3)
-    supports = [np.empty((n_rows, t.shape[1], k)) for t in targets]
-    per_map = flat.shape[1] * n_pairs * k
-    step = max(1, _CHUNK_ELEMENTS // per_map)
+    basis = np.empty((n_rows, 3, k, n_pairs))
+    basis[:, 0] = rot.real
+    basis[:, 1] = rot.imag
+    basis[:, 2] = (rot * hyp.h1[:, None, :]).real
+    basis = basis.reshape(n_rows, 3, k * n_pairs)
+    # Row 0 is R2 = 1; then the regions' vertices.
+    coeff = np.empty((n_rows, 1 + m * n_vert, 3))
+    coeff[:, 0] = (1.0, 0.0, -1.0)
+    flat = regions.reshape(n_rows, m * n_vert)
+    coeff[:, 1:, 0] = flat.real
+    coeff[:, 1:, 1] = -flat.imag
+    coeff[:, 1:, 2] = -1.0
+    robot = np.empty((n_rows, k))
+    landmarks = np.empty((n_rows, m, k))
+    step = max(1, _CHUNK_ELEMENTS // (coeff.shape[1] * k * n_pairs))
     for lo in range(0, n_rows, step):
         chunk = slice(lo, lo + step)
-        values = coeff[chunk] @ basis[chunk]  # (c, rows, K*P)
-        start = 0
-        for target, support in zip(targets, supports, strict=True):
-            m, n_vert = target.shape[1:]
-            block = values[:, start : start + m * n_vert]
-            # The hypothesis axis is contiguous: reduce it first, where numpy is fastest.
-            support[chunk] = block.reshape(-1, m, n_vert, k, n_pairs).max(axis=-1).max(axis=2)
-            start += m * n_vert
-    return tuple(
-        support + hyp.inflation(target)[..., None]
-        for target, support in zip(targets, supports, strict=True)
-    )
+        values = coeff[chunk] @ basis[chunk]  # (c, 1 + m V, K P)
+        robot[chunk] = values[:, 0].reshape(-1, k, n_pairs).max(axis=-1)
+        # One reduction over vertices and hypotheses: faster than two.
+        landmarks[chunk] = values[:, 1:].reshape(-1, m, n_vert, k, n_pairs).max(axis=(2, 4))
+    robot += hyp.inflation(np.ones((n_rows, 1, 1)))
+    landmarks += hyp.inflation(regions)[..., None]
+    return robot, landmarks
 
 
 def transfer_points_fl(
