@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: test demo lint bench clean
+.PHONY: test demo lint bench bench-slam clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -23,6 +23,9 @@ demo: $(STAMP)
 	SDL_VIDEODRIVER=dummy $(PY) -m train.compare --quick
 
 bench: $(STAMP)
+	$(PY) benchmarks/bench_env.py
+
+bench-slam: $(STAMP)
 	$(PY) benchmarks/bench_slam.py
 
 lint: $(STAMP)

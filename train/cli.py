@@ -1,10 +1,13 @@
 """The ``bearing-env`` command line.
 
-    bearing-env demo [...]    the random polygonal demo in the Khepera scenario (make demo)
-    bearing-env bench [...]   world-model throughput against CartPole-v1
-    bearing-env compare [...] exploration policies on the same evaluation episodes
-    bearing-env figures [...] the paper's Figs. 7, 10 and 11 in simulation
-    bearing-env train [...]   PPO/SAC/DQN with stable-baselines3 (train/hyperparams/*.yml)
+    bearing-env demo [...]        the random polygonal demo in the Khepera scenario (make demo)
+    bearing-env bench [...]       env, vector env and PPO steps/s against CartPole-v1, as a
+                                  table and JSON (benchmarks/bench_env.py, make bench)
+    bearing-env bench-slam [...]  world-model update() throughput against CartPole-v1
+                                  (benchmarks/bench_slam.py; also ``bearing-env bench --slam``)
+    bearing-env compare [...]     exploration policies on the same evaluation episodes
+    bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
+    bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (train/hyperparams/*.yml)
 
 Each subcommand forwards its remaining arguments to the module that implements it, so
 ``bearing-env demo --help`` shows that module's options.
@@ -18,7 +21,8 @@ import sys
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "demo": ("train.demo", "random polygonal exploration in the Khepera scenario"),
-    "bench": ("benchmarks.bench_slam", "world-model update() throughput vs CartPole-v1"),
+    "bench": ("benchmarks.bench_env", "env, vector env and PPO steps/s vs CartPole-v1"),
+    "bench-slam": ("benchmarks.bench_slam", "world-model update() throughput vs CartPole-v1"),
     "train": ("train.train", "train PPO/SAC/DQN agents with stable-baselines3 (train/hyperparams)"),
     "compare": ("train.compare", "compare exploration policies on fixed evaluation episodes"),
     "figures": ("train.figures", "reproduce the paper's Figs. 7, 10 and 11 in simulation"),
@@ -37,9 +41,12 @@ def main(argv: list[str] | None = None) -> None:
         parser.print_help()
         return
     args = parser.parse_args(argv[:1])
-    module_name, _ = SUBCOMMANDS[args.command]
+    command, rest = args.command, argv[1:]
+    if command == "bench" and "--slam" in rest:  # bearing-env bench --slam == bench-slam
+        command, rest = "bench-slam", [arg for arg in rest if arg != "--slam"]
+    module_name, _ = SUBCOMMANDS[command]
     module = importlib.import_module(module_name)
-    sys.argv = [f"bearing-env {args.command}", *argv[1:]]
+    sys.argv = [f"bearing-env {command}", *rest]
     module.main()
 
 

@@ -1,0 +1,234 @@
+"""benchmarks/bench_env.py and ``bearing-env bench``: quick runs write complete JSON and print
+the table. Nothing here asserts on speed."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import pytest
+from gymnasium.vector import AutoresetMode
+
+import train.train
+from benchmarks import bench_env
+from train import cli
+
+MACHINE_KEYS = {"platform", "cpu_count", "numpy", "python", "gymnasium"}
+FIGURE_KEYS = {
+    "steps",
+    "seconds",
+    "steps_per_s",
+    "cartpole_reference",
+    "cartpole_steps_per_s",
+    "ratio_to_cartpole",
+    "ratio_to_cartpole_start",
+}
+
+
+def positive_finite(value: Any) -> bool:
+    return isinstance(value, (int, float)) and math.isfinite(value) and value > 0
+
+
+def run_quick(tmp_path: Path, *arguments: str) -> tuple[dict[str, Any], Path]:
+    path = tmp_path / "results" / "bench.json"  # the folder does not exist yet
+    bench_env.main(["--quick", "--json", str(path), *arguments])
+    return json.loads(path.read_text()), path
+
+
+def check_common(results: dict[str, Any], sections: set[str]) -> None:
+    assert results["format"] == bench_env.JSON_FORMAT
+    assert MACHINE_KEYS <= results["machine"].keys()
+    assert results["machine"]["cpu_count"] >= 1
+    assert set(results["settings"]["sections"]) == sections
+    references = results["cartpole_references"]
+    labels = [ref["label"] for ref in references]
+    assert labels[0] == "start" and labels[-1] == "end"
+    assert all(positive_finite(ref["steps_per_s"]) for ref in references)
+    assert {section for section in bench_env.SECTIONS if section in results} == sections
+    targets = {target["id"]: target for target in results["targets"]}
+    assert set(targets) == set(bench_env.TARGETS)
+    for target in targets.values():
+        assert target["met"] in (True, False, None)
+        assert (target["met"] is None) == (target["value"] is None)
+
+
+def check_figure(figure: dict[str, Any], labels: set[str]) -> None:
+    assert FIGURE_KEYS <= figure.keys()
+    assert figure["steps"] > 0
+    for key in ("seconds", "steps_per_s", "ratio_to_cartpole", "ratio_to_cartpole_start"):
+        assert positive_finite(figure[key]), (key, figure[key])
+    assert figure["cartpole_reference"] in labels
+
+
+def test_quick_single_and_vector(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    results, path = run_quick(tmp_path, "--sections", "single,vector")
+    check_common(results, {"single", "vector"})
+    labels = {ref["label"] for ref in results["cartpole_references"]}
+
+    single = {row["name"]: row for row in results["single"]}
+    assert set(single) == {"khepera", "random_4", "random_16", "random_64", "khepera_wrapped"}
+    for row in single.values():
+        check_figure(row, labels)
+    assert single["random_4"]["ratio_to_4_landmarks"] == pytest.approx(1.0)
+    assert positive_finite(single["random_64"]["ratio_to_4_landmarks"])
+
+    vector = results["vector"]
+    assert {(row["kind"], row["num_envs"]) for row in vector} == {
+        (kind, n) for kind in ("batched", "sync") for n in (1, 4)
+    }
+    for row in vector:
+        check_figure(row, labels)
+        assert row["step_calls"] >= 2
+        if row["kind"] == "batched":
+            assert positive_finite(row["ratio_to_sync"])
+            expected = "vector_entry_point" if row["fallback"] is False else "sync"
+            assert row["vectorization_mode"] == expected
+    targets = {target["id"]: target for target in results["targets"]}
+    assert targets["a"]["met"] is not None and targets["c"]["met"] is not None
+    assert targets["b"]["met"] is None  # --quick measures 1 and 4 envs, not 64
+    assert targets["d"]["met"] is None
+
+    out = capsys.readouterr().out
+    assert "CartPole-v1" in out and "khepera, 4 landmarks" in out and "Targets:" in out
+    assert str(path) in out
+    assert [p.name for p in path.parent.iterdir()] == [path.name]  # no temp file left
+
+
+def test_quick_ppo_in_process_kinds(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    results, _ = run_quick(tmp_path, "--sections", "ppo", "--ppo-kinds", "batched,dummy")
+    check_common(results, {"ppo"})
+    labels = {ref["label"] for ref in results["cartpole_references"]}
+    assert {"ppo/batched", "ppo/dummy"} <= labels
+    rows = {row["kind"]: row for row in results["ppo"]}
+    assert set(rows) == {"batched", "dummy"}
+    for row in rows.values():
+        check_figure(row, labels)
+        assert row["n_envs"] == 2
+        assert row["steps"] >= row["requested_steps"]
+        assert row["steps"] % row["rollout_steps"] == 0
+        assert row["ratio_to_subproc"] is None
+        assert row["hyperparams"]["n_steps"] == 8
+    assert "PPO" in capsys.readouterr().out
+
+
+def test_quick_ppo_subproc(tmp_path: Path) -> None:
+    results, _ = run_quick(
+        tmp_path, "--sections", "ppo", "--ppo-kinds", "subproc", "--ppo-envs", "1"
+    )
+    (row,) = results["ppo"]
+    assert row["kind"] == row["measured_with"] == "subproc"
+    check_figure(row, {ref["label"] for ref in results["cartpole_references"]})
+    assert row["ratio_to_subproc"] == pytest.approx(1.0)
+
+
+def stand_in_vector_env(num_envs: int, max_episode_steps: int, **env_kwargs: Any) -> Any:
+    """A vector entry point for the test (SAME_STEP autoreset, unlike the default)."""
+    factories = [lambda: gym.make(bench_env.ENV_ID, **env_kwargs)] * num_envs
+    return gym.vector.SyncVectorEnv(factories, autoreset_mode=AutoresetMode.SAME_STEP)
+
+
+def test_batched_rows_are_not_fallbacks_when_available(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With a vector entry point and a "batched" vec env kind, nothing is labelled fallback."""
+    monkeypatch.setattr(gym.spec(bench_env.ENV_ID), "vector_entry_point", stand_in_vector_env)
+    kinds = tuple(dict.fromkeys((*train.train.VEC_ENV_KINDS, "batched")))
+    monkeypatch.setattr(train.train, "VEC_ENV_KINDS", kinds)
+    make_training_env = train.train.make_training_env
+
+    def make_with_batched(
+        env_id: str, env_kwargs: dict[str, Any], n_envs: int, kind: str, monitor_dir: Path | None
+    ) -> Any:
+        return make_training_env(
+            env_id, env_kwargs, n_envs, "dummy" if kind == "batched" else kind, monitor_dir
+        )
+
+    monkeypatch.setattr(train.train, "make_training_env", make_with_batched)
+    results, _ = run_quick(
+        tmp_path, "--sections", "vector,ppo", "--num-envs", "2", "--ppo-kinds", "batched"
+    )
+    (batched, sync) = results["vector"]
+    assert batched["kind"] == "batched" and batched["vectorization_mode"] == "vector_entry_point"
+    assert batched["fallback"] is False and batched["autoreset_mode"] == "SameStep"
+    assert sync["autoreset_mode"] == "NextStep"
+    assert batched["steps"] == 2 * batched["step_calls"]  # SAME_STEP: every sub-step counts
+    (ppo,) = results["ppo"]
+    assert ppo["measured_with"] == "batched" and ppo["fallback"] is False
+    assert results["settings"]["vector_entry_point"] is True
+
+
+def fake_figure(rate: float, **extra: Any) -> dict[str, Any]:
+    return {"steps_per_s": rate, "ratio_to_cartpole": rate / 1000.0, **extra}
+
+
+def test_targets_from_results() -> None:
+    results = {
+        "single": [
+            fake_figure(200.0, name="khepera"),
+            fake_figure(400.0, name="random_4"),
+            fake_figure(20.0, name="random_64"),
+        ],
+        "vector": [fake_figure(1500.0, kind="batched", num_envs=64, fallback=False)],
+        "ppo": [
+            fake_figure(300.0, kind="batched", fallback=True),
+            fake_figure(100.0, kind="subproc", fallback=False),
+        ],
+    }
+    targets = {target["id"]: target for target in bench_env.evaluate_targets(results)}
+    assert targets["a"]["met"] is True and targets["a"]["value"] == pytest.approx(0.2)
+    assert targets["b"]["met"] is True and targets["b"]["fallback"] is False
+    assert targets["c"]["met"] is False and targets["c"]["value"] == pytest.approx(0.05)
+    assert targets["d"]["met"] is True and targets["d"]["fallback"] is True
+    assert "fallback" in targets["d"]["note"]
+    assert all(target["met"] is None for target in bench_env.evaluate_targets({}))
+
+
+def test_write_json_is_atomic_and_finite(tmp_path: Path) -> None:
+    path = tmp_path / "a" / "b.json"
+    bench_env.write_json(path, {"x": float("nan"), "y": [1.5, float("inf")]})
+    assert json.loads(path.read_text()) == {"x": None, "y": [1.5, None]}
+    bench_env.write_json(path, {"x": 2})
+    assert json.loads(path.read_text()) == {"x": 2}
+    assert [p.name for p in path.parent.iterdir()] == ["b.json"]
+
+
+def test_bad_arguments_are_rejected() -> None:
+    for arguments in (["--sections", "fast"], ["--num-envs", "0"], ["--ppo-kinds", "async"]):
+        with pytest.raises(SystemExit):
+            bench_env.main([*arguments, "--no-json"])
+
+
+def test_profile_prints_the_top_functions(capsys: pytest.CaptureFixture[str]) -> None:
+    assert bench_env.main(["--profile", "single", "--seconds", "0.05"]) is None
+    out = capsys.readouterr().out
+    assert "tottime" in out and "step" in out
+
+
+def test_cli_bench_runs_bench_env(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setattr(sys, "argv", ["bearing-env"])  # cli.main rewrites sys.argv
+    assert cli.SUBCOMMANDS["bench"][0] == "benchmarks.bench_env"
+    path = tmp_path / "cli.json"
+    cli.main(["bench", "--quick", "--sections", "single", "--landmarks", "4", "--json", str(path)])
+    results = json.loads(path.read_text())
+    assert [row["name"] for row in results["single"]] == [
+        "khepera",
+        "random_4",
+        "khepera_wrapped",
+    ]
+    assert "Targets:" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv", [["bench", "--slam"], ["bench-slam"]])
+def test_cli_reaches_the_world_model_bench(
+    argv: list[str], monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setattr(sys, "argv", ["bearing-env"])
+    cli.main([*argv, "--seconds", "0.01"])
+    out = capsys.readouterr().out
+    assert "update()" in out and "CartPole-v1" in out
