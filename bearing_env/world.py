@@ -14,7 +14,7 @@ the same generator state gives the same world, bit for bit.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -190,22 +190,33 @@ class NoiseModel:
             true_bearings: noise-free bearings (n,), radians.
             epsilon: the SLAM's error bound (radians), the default scale of the noise.
         """
-        size = true_bearings.shape[0]
+        return self.corrupt_rows([rng], true_bearings[None], epsilon)[0]
+
+    def corrupt_rows(
+        self, rngs: Sequence[np.random.Generator], true_bearings: FloatArray, epsilon: float
+    ) -> FloatArray:
+        """:meth:`corrupt` for many robots at once: row ``i`` of ``true_bearings`` (N, n)
+        draws from ``rngs[i]`` (one generator per row), in the order :meth:`corrupt` would."""
+        size = true_bearings.shape[1]
         if self.kind == "uniform":
             bound = epsilon if self.bound_deg is None else math.radians(self.bound_deg)
-            noisy = true_bearings + rng.uniform(-bound, bound, size)
+            noise = [rng.uniform(-bound, bound, size) for rng in rngs]
         elif self.kind == "gaussian":
             sigma = 0.5 * epsilon if self.sigma_deg is None else math.radians(self.sigma_deg)
-            noisy = true_bearings + rng.normal(0.0, sigma, size)
+            noise = [rng.normal(0.0, sigma, size) for rng in rngs]
         else:
-            noisy = np.array(true_bearings, dtype=np.float64)
-        if self.outlier_rate > 0.0:
-            # Both arrays are drawn in full, so the stream of draws does not depend on
-            # which landmarks turn out to be outliers.
-            is_outlier = rng.random(size) < self.outlier_rate
-            random_bearing = rng.uniform(-np.pi, np.pi, size)
-            noisy = np.where(is_outlier, random_bearing, noisy)
-        return wrap_angle(noisy)
+            noise = [np.zeros(size) for _ in rngs]
+        if self.outlier_rate == 0.0:
+            return wrap_angle(true_bearings + np.stack(noise))
+        # Each robot draws its noise, then both outlier arrays in full, so the stream of
+        # draws does not depend on which landmarks turn out to be outliers.
+        is_outlier = np.empty(true_bearings.shape, dtype=bool)
+        random_bearing = np.empty(true_bearings.shape)
+        for row, rng in enumerate(rngs):
+            is_outlier[row] = rng.random(size) < self.outlier_rate
+            random_bearing[row] = rng.uniform(-np.pi, np.pi, size)
+        noisy = true_bearings + np.stack(noise)
+        return wrap_angle(np.where(is_outlier, random_bearing, noisy))
 
 
 # --------------------------------------------------------------------------------------
@@ -378,26 +389,103 @@ class World:
 
     def move(self, length: float) -> MoveResult:
         """Move straight ahead by ``length`` metres, stopping at the wall margin."""
-        free = self.arena.free_distance(self.position, self.heading, self.arena.wall_margin)
-        if free < self.min_baseline:
-            # Against the wall (up to rounding): the robot does not move at all.
-            free = 0.0
-        travelled = min(float(length), free)
-        direction = np.array([math.cos(self.heading), math.sin(self.heading)])
-        new_position = self.position + travelled * direction
-        # Rounding can leave the robot a hair outside the margin; clamp so the invariant
-        # "always inside the margin" holds exactly.
-        margin = self.arena.wall_margin
-        new_position[0] = min(max(new_position[0], margin), self.arena.width - margin)
-        new_position[1] = min(max(new_position[1], margin), self.arena.height - margin)
-        self.position = new_position
-        return MoveResult(requested=float(length), travelled=travelled, blocked=free < length)
+        travelled, blocked, position = straight_moves(
+            self.arena,
+            self.position[None],
+            np.array([self.heading]),
+            np.array([float(length)]),
+            self.min_baseline,
+        )
+        self.position = position[0]
+        return MoveResult(float(length), float(travelled[0]), bool(blocked[0]))
 
     def true_bearings(self) -> FloatArray:
         """Noise-free bearings (n,) of all landmarks, relative to the heading, [-pi, pi)."""
-        delta = self.landmarks - self.position
-        return wrap_angle(np.arctan2(delta[:, 1], delta[:, 0]) - self.heading)
+        return true_bearings(self.landmarks[None], self.position[None], np.array([self.heading]))[0]
 
     def read_bearings(self, rng: np.random.Generator) -> FloatArray:
         """A panoramic reading: noisy bearings (n,) relative to the heading, [-pi, pi)."""
         return self.noise.corrupt(rng, self.true_bearings(), self.epsilon)
+
+
+# --------------------------------------------------------------------------------------
+# Many worlds at once (the batched vector env; a single world is a batch of one)
+# --------------------------------------------------------------------------------------
+
+
+def true_bearings(landmarks: FloatArray, positions: FloatArray, headings: FloatArray) -> FloatArray:
+    """Noise-free bearings (N, n) of landmarks (N, n, 2) from poses (N, 2), (N,)."""
+    delta = landmarks - positions[:, None, :]
+    return wrap_angle(np.arctan2(delta[..., 1], delta[..., 0]) - headings[:, None])
+
+
+def straight_moves(
+    arena: Arena,
+    positions: FloatArray,
+    headings: FloatArray,
+    lengths: FloatArray,
+    min_baseline: float,
+) -> tuple[FloatArray, NDArray[np.bool_], FloatArray]:
+    """Straight moves stopped at the wall margin: ``(travelled, blocked, new positions)``.
+
+    A robot that could not move at least ``min_baseline`` (against the wall, up to
+    rounding) does not move at all.
+    """
+    margin = arena.wall_margin
+    dx, dy = np.cos(headings), np.sin(headings)
+    x, y = positions[:, 0], positions[:, 1]
+    # Per axis: the wall the heading points at is the only one that can stop it.
+    room_x = np.where(dx > 0.0, arena.width - margin - x, np.where(dx < 0.0, margin - x, np.inf))
+    room_y = np.where(dy > 0.0, arena.height - margin - y, np.where(dy < 0.0, margin - y, np.inf))
+    free = np.maximum(
+        0.0,
+        np.minimum(room_x / np.where(dx == 0.0, 1.0, dx), room_y / np.where(dy == 0.0, 1.0, dy)),
+    )
+    free = np.where(free < min_baseline, 0.0, free)
+    travelled = np.minimum(lengths, free)
+    # Rounding can leave the robot a hair outside the margin; clamp so the invariant
+    # "always inside the margin" holds exactly.
+    new_x = np.minimum(np.maximum(x + travelled * dx, margin), arena.width - margin)
+    new_y = np.minimum(np.maximum(y + travelled * dy, margin), arena.height - margin)
+    return travelled, free < lengths, np.stack([new_x, new_y], axis=-1)
+
+
+@dataclass(frozen=True)
+class Moves:
+    """One movement of each of N worlds: turn, reading, straight move, reading."""
+
+    start_positions: FloatArray
+    start_bearings: FloatArray
+    end_bearings: FloatArray
+    requested: FloatArray
+    travelled: FloatArray
+    blocked: NDArray[np.bool_]
+
+
+def step_worlds(
+    worlds: Sequence[World],
+    turns: FloatArray,
+    lengths: FloatArray,
+    rngs: Sequence[np.random.Generator],
+) -> Moves:
+    """Move N worlds (same arena, noise model and landmark count) at once, in place.
+
+    World ``i`` turns by ``turns[i]``, reads its bearings, moves ``lengths[i]`` and reads
+    again, drawing its noise from ``rngs[i]``: exactly what :meth:`World.turn`,
+    :meth:`World.read_bearings` and :meth:`World.move` do one world at a time.
+    """
+    first = worlds[0]
+    headings = wrap_angle(np.array([world.heading for world in worlds]) + turns)
+    positions = np.stack([world.position for world in worlds])
+    landmarks = np.stack([world.landmarks for world in worlds])
+    noise, epsilon = first.noise, first.epsilon
+    start_truth = true_bearings(landmarks, positions, headings)
+    start_bearings = noise.corrupt_rows(rngs, start_truth, epsilon)
+    travelled, blocked, moved = straight_moves(
+        first.arena, positions, headings, lengths, first.min_baseline
+    )
+    end_bearings = noise.corrupt_rows(rngs, true_bearings(landmarks, moved, headings), epsilon)
+    for world, heading, position in zip(worlds, headings, moved, strict=True):
+        world.heading = float(heading)
+        world.position = position
+    return Moves(positions, start_bearings, end_bearings, lengths, travelled, blocked)

@@ -22,6 +22,7 @@ from bearing_env.world import (
     World,
     random_layout,
     random_start,
+    step_worlds,
 )
 
 FloatArray = NDArray[np.float64]
@@ -593,18 +594,34 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     def _move(self, turn: float, length: float) -> Movement:
         """The world half of a step: turn, read, move, read (the SLAM update comes next)."""
-        world, rng = self._world, self.np_random
-        assert world is not None
-        world.turn(turn)
-        start_position = world.position.copy()
-        start_bearings = world.read_bearings(rng)
-        move = world.move(length)
-        end_bearings = world.read_bearings(rng)
+        return self._move_batch([self], np.array([turn]), np.array([length]))[0]
+
+    @staticmethod
+    def _move_batch(
+        envs: Sequence[BearingSLAMEnv], turns: FloatArray, lengths: FloatArray
+    ) -> list[Movement]:
+        """:meth:`_move` for envs with equal settings and landmark counts, at once."""
+        worlds = [env._world for env in envs]
+        assert all(world is not None for world in worlds)
+        rngs = [env.np_random for env in envs]
+        moves = step_worlds(worlds, turns, lengths, rngs)  # type: ignore[arg-type]
         # A move that could not start took both readings from the same place: there is no
         # robot frame (R1 = R2), so the SLAM must not see it. The robot knows it did not
         # move (it is stuck against the wall).
-        changes_map = move.travelled >= world.min_baseline
-        return Movement(move, start_position, start_bearings, end_bearings, changes_map)
+        changes_map = moves.travelled >= worlds[0].min_baseline  # type: ignore[union-attr]
+        results = zip(
+            moves.requested.tolist(), moves.travelled.tolist(), moves.blocked.tolist(), strict=True
+        )
+        return [
+            Movement(
+                MoveResult(*result),
+                moves.start_positions[i],
+                moves.start_bearings[i],
+                moves.end_bearings[i],
+                bool(changes_map[i]),
+            )
+            for i, result in enumerate(results)
+        ]
 
     def _finish_step(
         self, movement: Movement, frame_changed: bool, inconsistent: int
@@ -726,6 +743,18 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         """The map for an episode with ``n_landmarks`` (the batched vector env overrides
         this per sub-env, to hand out rows of its shared batch)."""
         return PolygonSLAM(n_landmarks, self.epsilon, transfer=self.transfer)
+
+    def _decode_actions(self, actions: NDArray[Any]) -> tuple[FloatArray, FloatArray]:
+        """(turn angles, move lengths) from a batch of actions (N, 2), as
+        :meth:`_decode_action` computes them one at a time."""
+        values = np.asarray(actions, dtype=np.float64)
+        if not np.all(np.isfinite(values)):
+            raise ValueError(f"actions must be finite, got {actions!r}")
+        if np.any(np.abs(values) > 1.0 + 1e-6):
+            raise ValueError(f"actions {actions!r} are outside the action space [-1, 1]^2")
+        values = np.minimum(np.maximum(values, -1.0), 1.0)
+        lo, hi = self.move_length
+        return math.pi * values[:, 0], lo + 0.5 * (values[:, 1] + 1.0) * (hi - lo)
 
     def _decode_action(self, action: Any) -> tuple[float, float]:
         """(turn angle in radians, requested move length in metres) from an action."""

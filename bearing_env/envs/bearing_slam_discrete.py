@@ -8,13 +8,14 @@ from typing import Any
 
 import numpy as np
 from gymnasium import spaces
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.envs.bearing_slam import (
     DEFAULT_AREA_CAP,
     DEFAULT_MAX_MOVES,
     DEFAULT_TARGET_AREA,
     BearingSLAMEnv,
+    FloatArray,
     _int_at_least,
 )
 from bearing_env.world import Arena, NoiseModel, wrap_angle
@@ -132,6 +133,23 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
         self.turn_angles = wrap_angle(2.0 * math.pi * np.arange(self.n_turns) / self.n_turns)
         self.move_lengths = np.linspace(lo, hi, self.n_move_lengths)
         return spaces.Discrete(self.n_turns * self.n_move_lengths)
+
+    def _decode_actions(self, actions: NDArray[Any]) -> tuple[FloatArray, FloatArray]:
+        """(turn angles, move lengths) from a batch of action indices (N,)."""
+        values = np.asarray(actions)
+        if not np.issubdtype(values.dtype, np.integer):
+            as_float = values.astype(np.float64)
+            if not np.all(np.isfinite(as_float)) or np.any(as_float != np.round(as_float)):
+                raise ValueError(
+                    f"actions must be integers in [0, {self.action_space.n}), got {actions!r}"
+                )
+        index = values.astype(np.int64)
+        if np.any((index < 0) | (index >= self.action_space.n)):
+            raise ValueError(
+                f"actions {actions!r} are outside the action space Discrete({self.action_space.n})"
+            )
+        turn_index, length_index = np.divmod(index, self.n_move_lengths)
+        return self.turn_angles[turn_index], self.move_lengths[length_index]
 
     def _decode_action(self, action: Any) -> tuple[float, float]:
         values = np.asarray(action)

@@ -224,10 +224,17 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         resetting = self._autoreset_envs & (self.autoreset_mode == AutoresetMode.NEXT_STEP)
 
         # The world half of every stepping sub-env, then all SLAM updates at once.
+        stepping = np.flatnonzero(~resetting)
+        turns, lengths = np.zeros(n), np.zeros(n)
+        if stepping.size:
+            turns[stepping], lengths[stepping] = self.envs[0]._decode_actions(actions[stepping])
         movements: list[Movement | None] = [None] * n
-        for index in np.flatnonzero(~resetting):
-            env = self.envs[index]
-            movements[index] = env._move(*env._decode_action(actions[index]))
+        for group in self._groups_by_batch(stepping):
+            moved = self.single_env_class._move_batch(
+                [self.envs[i] for i in group], turns[group], lengths[group]
+            )
+            for index, movement in zip(group, moved, strict=True):
+                movements[index] = movement
         frame_changed, inconsistent = self._update_maps(movements)
 
         observations = np.zeros(self.observation_space.shape, dtype=np.float32)
