@@ -236,7 +236,10 @@ class KGon:
             raise ValueError(f"directions must be an even integer >= 8, got {directions!r}")
         self.k = directions
         self.theta = 2.0 * np.pi * np.arange(directions) / directions
-        self.normals = np.exp(1j * self.theta)
+        half = np.exp(1j * self.theta[: directions // 2])
+        # Exactly antipodal pairs u_{k + K/2} = -u_k: a support in -u is minus the
+        # minimum in u, which halves the transfer's products (see transfer_support).
+        self.normals = np.concatenate([half, -half])
         self._conj_normals = np.conj(self.normals)
         self._step_sin = np.sin(2.0 * np.pi / directions)
         # Real matrix for supports of point clouds: <u_k, p> = x cos + y sin.

@@ -221,14 +221,17 @@ def transfer_support(
     """
     n_rows, m, n_vert = regions.shape
     n_pairs, k = hyp.h1.shape[1], kgon.k
+    half = k // 2
     # <u_k, (z - h1) g> = Re(z) Re(conj(u) g) - Im(z) Im(conj(u) g) - Re(conj(u) g h1):
-    # one real matrix product over all (vertex, hypothesis, direction) triples.
-    rot = np.conj(kgon.normals)[:, None] * hyp.inv_d[:, None, :]  # (G, K, P)
-    basis = np.empty((n_rows, 3, k, n_pairs))
+    # one real matrix product over all (vertex, hypothesis, direction) triples, for the
+    # first half of the directions only: u_{k + K/2} = -u_k exactly, so the support in
+    # the other half is minus the minimum.
+    rot = np.conj(kgon.normals[:half])[:, None] * hyp.inv_d[:, None, :]  # (G, K/2, P)
+    basis = np.empty((n_rows, 3, half, n_pairs))
     basis[:, 0] = rot.real
     basis[:, 1] = rot.imag
     basis[:, 2] = (rot * hyp.h1[:, None, :]).real
-    basis = basis.reshape(n_rows, 3, k * n_pairs)
+    basis = basis.reshape(n_rows, 3, half * n_pairs)
     # Row 0 is R2 = 1; then the regions' vertices.
     coeff = np.empty((n_rows, 1 + m * n_vert, 3))
     coeff[:, 0] = (1.0, 0.0, -1.0)
@@ -238,13 +241,17 @@ def transfer_support(
     coeff[:, 1:, 2] = -1.0
     robot = np.empty((n_rows, k))
     landmarks = np.empty((n_rows, m, k))
-    step = max(1, _CHUNK_ELEMENTS // (coeff.shape[1] * k * n_pairs))
+    step = max(1, _CHUNK_ELEMENTS // (coeff.shape[1] * half * n_pairs))
     for lo in range(0, n_rows, step):
         chunk = slice(lo, lo + step)
-        values = coeff[chunk] @ basis[chunk]  # (c, 1 + m V, K P)
-        robot[chunk] = values[:, 0].reshape(-1, k, n_pairs).max(axis=-1)
+        values = coeff[chunk] @ basis[chunk]  # (c, 1 + m V, K/2 P)
+        robot_values = values[:, 0].reshape(-1, half, n_pairs)
+        robot[chunk, :half] = robot_values.max(axis=-1)
+        robot[chunk, half:] = -robot_values.min(axis=-1)
         # One reduction over vertices and hypotheses: faster than two.
-        landmarks[chunk] = values[:, 1:].reshape(-1, m, n_vert, k, n_pairs).max(axis=(2, 4))
+        landmark_values = values[:, 1:].reshape(-1, m, n_vert, half, n_pairs)
+        landmarks[chunk, :, :half] = landmark_values.max(axis=(2, 4))
+        landmarks[chunk, :, half:] = -landmark_values.min(axis=(2, 4))
     robot += hyp.inflation(np.ones((n_rows, 1, 1)))
     landmarks += hyp.inflation(regions)[..., None]
     return robot, landmarks
