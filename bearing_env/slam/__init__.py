@@ -6,6 +6,8 @@ robot as well as on the simulator's.
 Public API:
 
 * :class:`PolygonSLAM` and :class:`UpdateResult`: the map, fused over movements.
+* :class:`BatchedPolygonSLAM`: many maps updated in one computation (the engine under
+  every ``PolygonSLAM``, which is a batch of one, and under the batched vector env).
 * :func:`fr_region`: the FR region of one landmark from a bearing pair.
 * :func:`transfer_polygon` / :func:`transfer_point`: the FR -> FL transfer of a region
   or a point, as shapely geometry (one movement, for inspection and tests).
@@ -14,6 +16,7 @@ Public API:
 """
 
 from bearing_env.slam.api import fr_region, transfer_point, transfer_polygon
+from bearing_env.slam.batch import BatchedPolygonSLAM, BatchUpdateResult
 from bearing_env.slam.polygon_slam import (
     FRAME_L1_L2_OVERLAP,
     FRAME_L1_L2_TOO_CLOSE,
@@ -44,6 +47,8 @@ __all__ = [
     "LANDMARK_UNBOUNDED",
     "LANDMARK_UPDATED",
     "TRANSFERS",
+    "BatchUpdateResult",
+    "BatchedPolygonSLAM",
     "PolygonSLAM",
     "UpdateResult",
     "fl_to_world",
