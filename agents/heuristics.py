@@ -271,9 +271,8 @@ class GreedyOneStep(MovementPolicy):
     ``_allowed_turns``). Without that rule it got stuck in corners, bouncing between two
     walls with moves too short to change frames.
 
-    Scoring uses one ``PolygonSLAM.copy()`` and one ``update()`` per candidate (see
-    :func:`agents.planning.simulate_potentials`): each candidate has its own landmark
-    frame, which the public world-model API cannot batch.
+    Scoring fuses every candidate into its own copy of the map in one batched update
+    (``PolygonSLAM.replicate``; see :func:`agents.planning.simulate_potentials`).
 
     Args:
         env: the env it acts in (either id).

@@ -25,10 +25,13 @@ def uncertainty_potential(areas: NDArray[np.float64], area_cap: float) -> float:
 
 
 def bearings_from(
-    position: complex, heading: float, points: NDArray[np.complex128]
+    position: complex | NDArray[np.complex128],
+    heading: float | NDArray[np.float64],
+    points: NDArray[np.complex128],
 ) -> NDArray[np.float64]:
-    """Noise-free bearings of ``points`` (FL) from ``position`` facing ``heading``."""
-    angles = np.angle(points - position) - heading
+    """Noise-free bearings (..., n) of ``points`` (n,) in FL from ``position`` facing
+    ``heading`` (scalars, or arrays of one shape for many poses)."""
+    angles = np.angle(points - np.asarray(position)[..., None]) - np.asarray(heading)[..., None]
     return (angles + np.pi) % (2.0 * np.pi) - np.pi
 
 
@@ -60,24 +63,30 @@ def simulate_potentials(
         area_cap: the cap (and the value of an uninitialised landmark) of the potential.
         min_distance: a move shorter than this (FL units) does not update the map.
 
-    The PolygonSLAM API fuses one movement per ``update``, and the landmark frame of
-    every candidate differs, so the candidates are scored with one copy and one update
-    each (a batch across candidates would need the internals of the world model).
+    Every candidate is fused into its own copy of the map, all in one batched update.
     """
     current = uncertainty_potential(slam.areas, area_cap)
     known = np.isfinite(landmarks)
     targets = np.where(known, landmarks, 0.0)
-    potentials = np.empty(len(moves))
-    for index, move in enumerate(moves):
-        if move.distance < min_distance:
-            potentials[index] = current
-            continue
-        end = start + move.distance * complex(math.cos(move.heading), math.sin(move.heading))
-        bearings_start = bearings_from(start, move.heading, targets)
-        bearings_end = np.where(known, bearings_from(end, move.heading, targets), bearings_start)
-        trial = slam.copy()
-        trial.update(bearings_start, bearings_end)
-        potentials[index] = uncertainty_potential(trial.areas, area_cap)
+    potentials = np.full(len(moves), current)
+    moving = [index for index, move in enumerate(moves) if move.distance >= min_distance]
+    if not moving:
+        return potentials
+    headings = np.array([moves[index].heading for index in moving])
+    distances = np.array([moves[index].distance for index in moving])
+    # The same arithmetic as one candidate at a time, so decisions do not depend on batching.
+    ends = np.array(
+        [
+            start + distance * complex(math.cos(heading), math.sin(heading))
+            for heading, distance in zip(headings.tolist(), distances.tolist(), strict=True)
+        ]
+    )
+    bearings_start = bearings_from(start, headings, targets)
+    bearings_end = np.where(known, bearings_from(ends, headings, targets), bearings_start)
+    trials = slam.replicate(len(moving))
+    trials.update(bearings_start, bearings_end)
+    capped = np.clip(trials.areas, AREA_FLOOR, area_cap)
+    potentials[moving] = np.sum(np.log(capped), axis=-1)
     return potentials
 
 

@@ -189,8 +189,17 @@ class PolygonSLAM:
 
     def copy(self) -> PolygonSLAM:
         """An independent copy (for planning: simulate moves without touching the map)."""
+        return PolygonSLAM.view(self.replicate(1), 0)
+
+    def replicate(self, count: int) -> BatchedPolygonSLAM:
+        """``count`` independent copies of this map, as one batch.
+
+        For planning: score many candidate movements with one batched
+        :meth:`BatchedPolygonSLAM.update`, each candidate on its own copy.
+        """
         batch = self._batch
-        clone = PolygonSLAM(
+        copies = BatchedPolygonSLAM(
+            count,
             batch.n_landmarks,
             batch.epsilon,
             transfer=batch.transfer,
@@ -199,8 +208,8 @@ class PolygonSLAM:
             on_inconsistency=batch.on_inconsistency,
         )
         for name in STATE_ARRAYS:
-            getattr(clone._batch, name)[0] = getattr(batch, name)[self._index]
-        return clone
+            getattr(copies, name)[:] = getattr(batch, name)[self._index]
+        return copies
 
     @property
     def n_updates(self) -> int:
