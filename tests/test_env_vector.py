@@ -310,3 +310,27 @@ def test_views_share_their_batch_and_copies_do_not() -> None:
     assert clone.n_updates == 0 and clone.batch is not batch
     with pytest.raises(IndexError):
         PolygonSLAM.view(batch, 3)
+
+
+def test_replicated_maps_update_like_independent_copies() -> None:
+    rng = np.random.default_rng(8)
+    eps = np.deg2rad(2.0)
+    slam = PolygonSLAM(5, eps)
+    landmarks = rng.uniform(0, 10, 5) + 1j * rng.uniform(0, 10, 5)
+    position = 5.0 + 5.0j
+    for _ in range(3):  # give the map some history
+        step = 2.0 * np.exp(1j * rng.uniform(-np.pi, np.pi))
+        b1 = np.angle((landmarks - position) / (step / abs(step)))
+        b2 = np.angle((landmarks - position - step) / (step / abs(step)))
+        slam.update(b1, b2)
+        position += step
+    b1 = rng.uniform(-np.pi, np.pi, (6, 5))
+    b2 = b1 + rng.uniform(0.05, 0.4, (6, 5))
+    copies = slam.replicate(6)
+    copies.update(b1, b2)
+    for i in range(6):
+        expected = slam.copy()
+        expected.update(b1[i], b2[i])
+        assert np.array_equal(PolygonSLAM.view(copies, i).supports, expected.supports)
+        assert np.array_equal(copies.areas[i], expected.areas)
+    assert slam.n_updates == 3  # the original is untouched
