@@ -239,19 +239,27 @@ def transfer_support(
     coeff[:, 1:, 0] = flat.real
     coeff[:, 1:, 1] = -flat.imag
     coeff[:, 1:, 2] = -1.0
+    robot_values = (coeff[:, :1] @ basis).reshape(n_rows, half, n_pairs)
     robot = np.empty((n_rows, k))
+    robot[:, :half] = robot_values.max(axis=-1)
+    robot[:, half:] = -robot_values.min(axis=-1)
+    # Small products, by chunks of maps and of landmarks: they stay in the CPU cache and
+    # below the size where BLAS starts threads, which only contend with other envs.
+    # Chunks depend on one map's sizes only, so a map is cut the same way in any batch.
+    per_landmark = n_vert * half * n_pairs
+    landmark_step = max(1, _CHUNK_ELEMENTS // per_landmark)
+    map_step = max(1, _CHUNK_ELEMENTS // (m * per_landmark))
     landmarks = np.empty((n_rows, m, k))
-    step = max(1, _CHUNK_ELEMENTS // (coeff.shape[1] * half * n_pairs))
-    for lo in range(0, n_rows, step):
-        chunk = slice(lo, lo + step)
-        values = coeff[chunk] @ basis[chunk]  # (c, 1 + m V, K/2 P)
-        robot_values = values[:, 0].reshape(-1, half, n_pairs)
-        robot[chunk, :half] = robot_values.max(axis=-1)
-        robot[chunk, half:] = -robot_values.min(axis=-1)
-        # One reduction over vertices and hypotheses: faster than two.
-        landmark_values = values[:, 1:].reshape(-1, m, n_vert, half, n_pairs)
-        landmarks[chunk, :, :half] = landmark_values.max(axis=(2, 4))
-        landmarks[chunk, :, half:] = -landmark_values.min(axis=(2, 4))
+    for lo in range(0, n_rows, map_step):
+        maps = slice(lo, lo + map_step)
+        for first in range(0, m, landmark_step):
+            last = min(m, first + landmark_step)
+            rows = slice(1 + first * n_vert, 1 + last * n_vert)
+            values = coeff[maps, rows] @ basis[maps]  # (c, landmarks x V, K/2 x P)
+            # One reduction over vertices and hypotheses: faster than two.
+            values = values.reshape(-1, last - first, n_vert, half, n_pairs)
+            landmarks[maps, first:last, :half] = values.max(axis=(2, 4))
+            landmarks[maps, first:last, half:] = -values.min(axis=(2, 4))
     robot += hyp.inflation(np.ones((n_rows, 1, 1)))
     landmarks += hyp.inflation(regions)[..., None]
     return robot, landmarks
