@@ -168,6 +168,17 @@ def unbatch_infos(
             nested = unbatch_infos(value, num_envs)
             for index in indices:
                 per_env[index][key] = nested[index]
+        elif (
+            isinstance(value, np.ndarray)
+            and value.ndim >= 1
+            and len(value) == num_envs
+            and value.dtype != object
+        ):
+            # One conversion for all sub-envs (the per-element path costs a millisecond
+            # a step with 16 envs): Python scalars from 1-D arrays, rows of one copy else.
+            elements = value.tolist() if value.ndim == 1 else list(value.copy())
+            for index in indices:
+                per_env[index][key] = elements[index]
         else:
             for index in indices:
                 per_env[index][key] = _info_element(value, index, num_envs)
