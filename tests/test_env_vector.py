@@ -265,6 +265,28 @@ def test_attribute_access() -> None:
         env.set_attr("path_cost", [1.0])
 
 
+def test_sub_envs_with_settings_changed_by_set_attr_step_like_single_envs() -> None:
+    costs = [0.0, 2.0, 0.0, 5.0]
+    batched = BearingSLAMVectorEnv(4, scenario="khepera")
+    batched.set_attr("path_cost", costs)
+    singles = [gym.make("BearingSLAM-v0", scenario="khepera", path_cost=c) for c in costs]
+    batched.reset(seed=6)
+    for i, env in enumerate(singles):
+        env.reset(seed=6 + i)
+    actions = np.random.default_rng(2).uniform(-1, 1, (5, 4, 2)).astype(np.float32)
+    total_cost = np.zeros(4)
+    for step_actions in actions:
+        _, rewards, _, _, infos = batched.step(step_actions)
+        for i, env in enumerate(singles):
+            _, reward, _, _, info = env.step(step_actions[i])
+            assert rewards[i] == reward
+            assert infos["rewards"]["path_cost"][i] == info["rewards"]["path_cost"]
+        total_cost += infos["rewards"]["path_cost"]
+    # The costs really differ per sub-env (a batch using env 0's setting would give 0).
+    assert total_cost[0] == total_cost[2] == 0.0
+    assert total_cost[1] < 0.0 and total_cost[3] < 0.0
+
+
 # ----------------------------------------------------------------------------------------
 # The batched world model underneath
 # ----------------------------------------------------------------------------------------

@@ -729,6 +729,23 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     # Internals
     # ------------------------------------------------------------------------------------
 
+    def _batch_settings(self) -> tuple[Any, ...]:
+        """Every setting the batched step functions read from the first env of a batch:
+        envs stepped together must agree on all of them."""
+        return (
+            self.move_length,
+            self.path_cost,
+            self.move_cost,
+            self.target_area,
+            self.max_moves,
+            self.area_cap,
+            self.reward_kind,
+            self.max_landmarks,
+            self.arena,
+            self.noise,
+            self.epsilon,
+        )
+
     def _slam_rows(self) -> IntArray:
         """This env's row of its map batch, as an index array."""
         return self._slam.rows

@@ -134,6 +134,9 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
         self.move_lengths = np.linspace(lo, hi, self.n_move_lengths)
         return spaces.Discrete(self.n_turns * self.n_move_lengths)
 
+    def _batch_settings(self) -> tuple[Any, ...]:
+        return (*super()._batch_settings(), self.n_turns, self.n_move_lengths)
+
     def _decode_actions(self, actions: NDArray[Any]) -> tuple[FloatArray, FloatArray]:
         """(turn angles, move lengths) from a batch of action indices (N,)."""
         values = np.asarray(actions)

@@ -224,14 +224,13 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         resetting = self._autoreset_envs & (self.autoreset_mode == AutoresetMode.NEXT_STEP)
 
         # The world half of every stepping sub-env, then all SLAM updates at once.
-        stepping = np.flatnonzero(~resetting)
-        turns, lengths = np.zeros(n), np.zeros(n)
-        if stepping.size:
-            turns[stepping], lengths[stepping] = self.envs[0]._decode_actions(actions[stepping])
+        groups = self._groups(np.flatnonzero(~resetting))
         movements: list[Movement | None] = [None] * n
-        for group in self._groups_by_batch(stepping):
+        for group in groups:
+            first = self.envs[group[0]]
+            turns, lengths = first._decode_actions(actions[group])
             moved = self.single_env_class._move_batch(
-                [self.envs[i] for i in group], turns[group], lengths[group]
+                [self.envs[i] for i in group], turns, lengths
             )
             for index, movement in zip(group, moved, strict=True):
                 movements[index] = movement
@@ -242,7 +241,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         terminations = np.zeros(n, dtype=bool)
         truncations = np.zeros(n, dtype=bool)
         infos: dict[str, Any] = {}
-        for group in self._groups_by_batch(np.flatnonzero(~resetting)):
+        for group in groups:
             (
                 observations[group],
                 rewards[group],
@@ -322,11 +321,14 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             padded[key][..., : values.shape[-1]] = values
         return padded
 
-    def _groups_by_batch(self, indices: NDArray[np.int64]) -> list[NDArray[np.int64]]:
-        """Sub-envs grouped by the map batch they share (one group per landmark count)."""
-        groups: dict[int, list[int]] = {}
-        for index in indices:
-            groups.setdefault(self.envs[index].n_landmarks, []).append(int(index))
+    def _groups(self, indices: NDArray[np.int64]) -> list[NDArray[np.int64]]:
+        """Sub-envs that can be stepped as one batch: same landmark count (so one map
+        batch) and same settings. Sub-envs share their settings unless ``set_attr``
+        changed some; then each distinct setting gets its own batch, computed alike."""
+        groups: dict[tuple[Any, ...], list[int]] = {}
+        for index in indices.tolist():
+            env = self.envs[index]
+            groups.setdefault((env.n_landmarks, env._batch_settings()), []).append(index)
         return [np.array(group) for group in groups.values()]
 
     def _merge_rows(
