@@ -29,7 +29,11 @@ Sections:
   for each vec env kind (batched, subproc with spawn, dummy). The rate is env steps per
   second of wall time of ``model.learn()``, measured after a warm-up ``learn()`` of one
   rollout, so process start-up and torch initialisation are excluded. PPO always finishes
-  the rollout it starts, so ``--ppo-steps`` is rounded up to whole rollouts.
+  the rollout it starts, so ``--ppo-steps`` is rounded up to whole rollouts. All kinds
+  are built first, then timed in ``--ppo-rounds`` interleaved rounds (each round times
+  every kind once, in turn): a kind's rate is its median round and its ratio to
+  SubprocVecEnv the median of the per-round ratios, so that a machine whose speed drifts
+  during the run favours no kind.
 
 When the batched pieces are missing (no ``vector_entry_point`` on the spec, or no
 ``"batched"`` in ``train.train.VEC_ENV_KINDS``), the rows fall back to ``sync`` and
@@ -80,6 +84,8 @@ DEFAULT_JSON = Path(__file__).resolve().parent / "results" / "bench_env.json"
 DEFAULT_SECONDS = 2.0
 DEFAULT_PPO_ENVS = 16
 DEFAULT_PPO_STEPS = 4096
+#: Interleaved timed rounds per PPO kind (see :func:`bench_ppo`).
+DEFAULT_PPO_ROUNDS = 3
 JSON_FORMAT = 1
 
 #: Hyperparameter overrides of the ``--quick`` PPO runs: tiny rollouts, one epoch, and
@@ -386,15 +392,76 @@ def torch_threads(n: int) -> Iterator[None]:
         torch.set_num_threads(previous)
 
 
-def bench_ppo_kind(
+@dataclass
+class PPORun:
+    """One vec env kind's PPO model, built and warmed up, ready for timed rounds."""
+
+    kind: str
+    measured_with: str
+    model: Any
+    venv: Any
+    n_envs: int
+    total_steps: int
+    algorithm_kwargs: dict[str, Any]
+    normalize: dict[str, Any] | None
+    make_kwargs: dict[str, Any]
+    build_seconds: float
+    rounds: list[dict[str, Any]] = field(default_factory=list)
+
+    def timed_round(self, bench: Bench) -> dict[str, Any]:
+        before = int(self.model.num_timesteps)
+
+        def run() -> tuple[int, float]:
+            start = time.perf_counter()
+            self.model.learn(total_timesteps=self.total_steps, reset_num_timesteps=False)
+            return int(self.model.num_timesteps) - before, time.perf_counter() - start
+
+        figure = timed_figure(bench, run)
+        self.rounds.append(figure)
+        return figure
+
+    def close(self) -> None:
+        with contextlib.suppress(EOFError, BrokenPipeError, ConnectionError, OSError):
+            self.venv.close()
+
+    def row(self, bench: Bench) -> dict[str, Any]:
+        """The kind's figure: the median round (rates drift on a shared machine)."""
+        rates = [figure["steps_per_s"] for figure in self.rounds]
+        middle = self.rounds[len(self.rounds) // 2]
+        rate = float(np.median(rates))
+        return {
+            "kind": self.kind,
+            "measured_with": self.measured_with,
+            "fallback": self.measured_with != self.kind,
+            "n_envs": self.n_envs,
+            "rollout_steps": int(self.algorithm_kwargs.get("n_steps", 2048)) * self.n_envs,
+            "requested_steps": self.total_steps,
+            "normalize": self.normalize is not None,
+            "hyperparams": json_safe(self.algorithm_kwargs),
+            "env_kwargs": self.make_kwargs,
+            "setup_and_warmup_seconds": self.build_seconds,
+            "steps": int(sum(figure["steps"] for figure in self.rounds)),
+            "seconds": float(sum(figure["seconds"] for figure in self.rounds)),
+            "steps_per_s": rate,
+            "cartpole_reference": middle["cartpole_reference"],
+            "cartpole_steps_per_s": middle["cartpole_steps_per_s"],
+            "ratio_to_cartpole": float(
+                np.median([figure["ratio_to_cartpole"] for figure in self.rounds])
+            ),
+            "ratio_to_cartpole_start": rate / bench.references[0].steps_per_s,
+            "rounds": self.rounds,
+        }
+
+
+def build_ppo_run(
     bench: Bench,
     kind: str,
     n_envs: int,
     total_steps: int,
     env_kwargs: dict[str, Any],
     overrides: dict[str, Any],
-) -> dict[str, Any]:
-    """Build, warm up and time ``model.learn()`` of PPO on one vec env kind."""
+) -> PPORun:
+    """Build PPO on one vec env kind and warm it up (one rollout and one update)."""
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
 
@@ -409,34 +476,25 @@ def bench_ppo_kind(
         if normalize is not None:
             venv = VecNormalize(venv, **normalize)
         model = PPO(env=venv, seed=0, device="cpu", verbose=0, **algorithm_kwargs)
-        model.learn(total_timesteps=1)  # warm-up: one rollout and one update, not timed
-        build_seconds = time.perf_counter() - build_start
-        bench.measure_reference(f"ppo/{kind}")
-        timesteps_before = int(model.num_timesteps)
-
-        def run() -> tuple[int, float]:
-            start = time.perf_counter()
-            model.learn(total_timesteps=total_steps, reset_num_timesteps=False)
-            return int(model.num_timesteps) - timesteps_before, time.perf_counter() - start
-
-        figure = timed_figure(bench, run)
-    finally:
+        model.learn(total_timesteps=1)  # warm-up, not timed
+    except BaseException:
         with contextlib.suppress(EOFError, BrokenPipeError, ConnectionError, OSError):
             venv.close()
-    rollout = int(algorithm_kwargs.get("n_steps", 2048)) * n_envs
-    return {
-        "kind": kind,
-        "measured_with": measured_with,
-        "fallback": measured_with != kind,
-        "n_envs": n_envs,
-        "rollout_steps": rollout,
-        "requested_steps": total_steps,
-        "normalize": normalize is not None,
-        "hyperparams": json_safe(algorithm_kwargs),
-        "env_kwargs": make_kwargs,
-        "setup_and_warmup_seconds": build_seconds,
-        **figure,
-    }
+        raise
+    run = PPORun(
+        kind,
+        measured_with,
+        model,
+        venv,
+        n_envs,
+        total_steps,
+        algorithm_kwargs,
+        normalize,
+        make_kwargs,
+        time.perf_counter() - build_start,
+    )
+    bench.measure_reference(f"ppo/{kind}")
+    return run
 
 
 def bench_ppo(
@@ -446,21 +504,50 @@ def bench_ppo(
     total_steps: int,
     env_kwargs: dict[str, Any],
     overrides: dict[str, Any],
+    rounds: int = DEFAULT_PPO_ROUNDS,
 ) -> list[dict[str, Any]]:
+    """PPO throughput per vec env kind, in interleaved rounds.
+
+    Every kind is built and warmed up first; then each round times every kind once, in
+    turn, so that a drifting machine speed affects all kinds alike. A kind's rate is its
+    median round, and its ratio to SubprocVecEnv is the median of the per-round ratios.
+    """
     if "batched" in kinds and "batched" not in available_vec_env_kinds():
         log("  train.train.VEC_ENV_KINDS has no 'batched': that row uses dummy (fallback)")
-    rows = []
-    with torch_threads(1):  # as bearing-env train (--torch-threads 1)
-        for kind in kinds:
-            log(f"  ppo {kind}: building {n_envs} envs and warming up ...")
-            row = bench_ppo_kind(bench, kind, n_envs, total_steps, env_kwargs, overrides)
-            rows.append(row)
-            log(f"  ppo {ppo_label(row):<24} {row['steps_per_s']:10,.0f} env steps/s")
-    subproc = next((row for row in rows if row["kind"] == "subproc"), None)
-    for row in rows:
+    runs: list[PPORun] = []
+    try:
+        with torch_threads(1):  # as bearing-env train (--torch-threads 1)
+            for kind in kinds:
+                log(f"  ppo {kind}: building {n_envs} envs and warming up ...")
+                runs.append(build_ppo_run(bench, kind, n_envs, total_steps, env_kwargs, overrides))
+            for number in range(1, rounds + 1):
+                if number > 1:
+                    bench.measure_reference(f"ppo/round {number}")
+                for run in runs:
+                    figure = run.timed_round(bench)
+                    log(
+                        f"  ppo {run.kind:<8} round {number}/{rounds}: "
+                        f"{figure['steps_per_s']:10,.0f} env steps/s"
+                    )
+        rows = [run.row(bench) for run in runs]
+    finally:
+        for run in runs:
+            run.close()
+    subproc = next((run for run in runs if run.kind == "subproc"), None)
+    for run, row in zip(runs, rows, strict=True):
         row["ratio_to_subproc"] = (
-            row["steps_per_s"] / subproc["steps_per_s"] if subproc is not None else None
+            float(
+                np.median(
+                    [
+                        mine["steps_per_s"] / theirs["steps_per_s"]
+                        for mine, theirs in zip(run.rounds, subproc.rounds, strict=True)
+                    ]
+                )
+            )
+            if subproc is not None
+            else None
         )
+        log(f"  ppo {ppo_label(row):<24} {row['steps_per_s']:10,.0f} env steps/s (median)")
     return rows
 
 
@@ -690,7 +777,8 @@ def table_notes(results: dict[str, Any]) -> list[str]:
     if "ppo" in results:
         lines.append(
             "PPO: env steps per wall-second of model.learn() after a warm-up learn() "
-            "(process start-up and torch init excluded)."
+            "(process start-up and torch init excluded); the median of "
+            f"{results['settings'].get('ppo_rounds', 1)} interleaved rounds per kind."
         )
     return lines
 
@@ -869,6 +957,13 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"timed PPO env steps, rounded up to whole rollouts (default {DEFAULT_PPO_STEPS})",
     )
     add(
+        "--ppo-rounds",
+        type=int,
+        default=None,
+        help=f"interleaved timed rounds per PPO kind; the median counts "
+        f"(default {DEFAULT_PPO_ROUNDS}; --quick 1)",
+    )
+    add(
         "--ppo-kinds",
         nargs="+",
         default=[",".join(PPO_KINDS)],
@@ -910,6 +1005,7 @@ class Settings:
     env_kwargs: dict[str, Any]
     ppo_envs: int
     ppo_steps: int
+    ppo_rounds: int
     ppo_kinds: tuple[str, ...]
     ppo_overrides: dict[str, Any]
     quick: bool
@@ -939,8 +1035,11 @@ def settings_from_args(args: argparse.Namespace, parser: argparse.ArgumentParser
     ppo_steps = args.ppo_steps
     if ppo_steps is None:
         ppo_steps = 16 if quick else DEFAULT_PPO_STEPS
-    if ppo_envs < 1 or ppo_steps < 1:
-        parser.error("--ppo-envs and --ppo-steps must be >= 1")
+    ppo_rounds = args.ppo_rounds
+    if ppo_rounds is None:
+        ppo_rounds = 1 if quick else DEFAULT_PPO_ROUNDS
+    if ppo_envs < 1 or ppo_steps < 1 or ppo_rounds < 1:
+        parser.error("--ppo-envs, --ppo-steps and --ppo-rounds must be >= 1")
     if quick:
         quick_overrides = {**QUICK_PPO_OVERRIDES}
         quick_overrides["batch_size"] = int(overrides.get("n_steps", 8)) * ppo_envs
@@ -953,6 +1052,7 @@ def settings_from_args(args: argparse.Namespace, parser: argparse.ArgumentParser
         env_kwargs=env_kwargs,
         ppo_envs=ppo_envs,
         ppo_steps=ppo_steps,
+        ppo_rounds=ppo_rounds,
         ppo_kinds=tuple(kind for kind in PPO_KINDS if kind in kinds),
         ppo_overrides=overrides,
         quick=quick,
@@ -974,7 +1074,10 @@ def run(settings: Settings) -> dict[str, Any]:
         log(f"[vector] gym.make_vec, {settings.env_kwargs}, num_envs {settings.num_envs}")
         results["vector"] = bench_vector(bench, settings.num_envs, settings.env_kwargs)
     if "ppo" in settings.sections:
-        log(f"[ppo] SB3 PPO on {settings.ppo_envs} envs, {settings.ppo_steps} timed steps")
+        log(
+            f"[ppo] SB3 PPO on {settings.ppo_envs} envs, {settings.ppo_rounds} interleaved "
+            f"rounds of {settings.ppo_steps} timed steps"
+        )
         results["ppo"] = bench_ppo(
             bench,
             settings.ppo_kinds,
@@ -982,6 +1085,7 @@ def run(settings: Settings) -> dict[str, Any]:
             settings.ppo_steps,
             settings.env_kwargs,
             settings.ppo_overrides,
+            settings.ppo_rounds,
         )
     bench.measure_reference("end")
     return {
@@ -998,6 +1102,7 @@ def run(settings: Settings) -> dict[str, Any]:
             "env_kwargs": settings.env_kwargs,
             "ppo_envs": settings.ppo_envs,
             "ppo_steps": settings.ppo_steps,
+            "ppo_rounds": settings.ppo_rounds,
             "ppo_kinds": list(settings.ppo_kinds),
             "ppo_overrides": json_safe(settings.ppo_overrides),
             "quick": settings.quick,

@@ -232,3 +232,18 @@ def test_cli_reaches_the_world_model_bench(
     cli.main([*argv, "--seconds", "0.01"])
     out = capsys.readouterr().out
     assert "update()" in out and "CartPole-v1" in out
+
+
+def test_ppo_rounds_are_interleaved_and_the_median_counts(tmp_path: Path) -> None:
+    results, _ = run_quick(
+        tmp_path, "--sections", "ppo", "--ppo-kinds", "batched,dummy", "--ppo-rounds", "3"
+    )
+    assert results["settings"]["ppo_rounds"] == 3
+    labels = [ref["label"] for ref in results["cartpole_references"]]
+    assert {"ppo/round 2", "ppo/round 3"} <= set(labels)
+    for row in results["ppo"]:
+        rounds = row["rounds"]
+        assert len(rounds) == 3
+        assert row["steps"] == sum(figure["steps"] for figure in rounds)
+        rates = sorted(figure["steps_per_s"] for figure in rounds)
+        assert row["steps_per_s"] == pytest.approx(rates[1])
