@@ -617,7 +617,8 @@ def evaluate_targets(results: dict[str, Any]) -> list[dict[str, Any]]:
         targets.append(
             _target(
                 "d",
-                batched["steps_per_s"] / subproc["steps_per_s"],
+                # The median of the per-round ratios (rounds are interleaved), as in the table.
+                batched.get("ratio_to_subproc") or batched["steps_per_s"] / subproc["steps_per_s"],
                 note,
                 fallback=batched["fallback"],
             )
