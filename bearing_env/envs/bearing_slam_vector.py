@@ -66,10 +66,12 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
     ## Description
 
     `num_envs` copies of :class:`~bearing_env.envs.bearing_slam.BearingSLAMEnv` stepped
-    together. The SLAM updates of all sub-environments, which are most of the work of
-    a step, run as one batched numpy computation (:class:`BatchedPolygonSLAM`); the world
-    simulation, observations and infos reuse the single environment's code, so the two
-    cannot drift apart.
+    together, each step in one batched numpy computation per group of sub-envs with the
+    same landmark count and settings: all robots move at once (`step_worlds`), all maps
+    fuse their movement in one :class:`BatchedPolygonSLAM` update (most of the work), and
+    observations, rewards and infos are built as arrays. Only the noise draws loop over
+    sub-envs, because each owns its random generator. These are the single env's own
+    functions, which it runs with a batch of one, so the two cannot drift apart.
 
     For the same per-env seeds and actions it reproduces
     `gym.make_vec(id, num_envs, vectorization_mode="sync")` exactly: observations,
