@@ -150,6 +150,12 @@ def test_kgon_intersect_batched_and_special_cases():
     h2, empty2 = kgon.intersect(hc, hp)
     np.testing.assert_array_equal(empty2, empty)
     np.testing.assert_allclose(h2[~empty], h[~empty], atol=1e-12)
+    # Each pair's result is the one it gets alone, bit for bit, whatever else is batched.
+    for i in range(5):
+        alone, alone_empty = kgon.intersect(hp[i : i + 1], hc[i : i + 1])
+        assert alone_empty[0] == empty[i]
+        if not empty[i]:
+            np.testing.assert_array_equal(alone[0], h[i])
 
 
 @SETTINGS

@@ -234,7 +234,7 @@ class BatchedPolygonSLAM:
         inconsistent = np.zeros(new.shape[0], dtype=bool)
         if was_init.any():
             old = self.support[global_map[was_init], which_landmark[was_init]]
-            merged, empty = _intersect_rows(self.kgon, old, new[was_init])
+            merged, empty = self.kgon.intersect(old, new[was_init])
             fallback = old if self.on_inconsistency == "keep" else new[was_init]
             merged[empty] = fallback[empty]
             fused[was_init] = merged
@@ -300,20 +300,6 @@ def _take_plan(plan: FramePlan, index: IntArray) -> FramePlan:
         plan.longest1[index],
         plan.longest2[index],
     )
-
-
-def _intersect_rows(
-    kgon: KGon, old: FloatArray, new: FloatArray
-) -> tuple[FloatArray, NDArray[np.bool_]]:
-    """Row-wise K-gon intersection; nested rows skip the clipping (decided per row)."""
-    old_inside = np.all(old <= new, axis=-1)
-    new_inside = np.all(new < old, axis=-1)
-    merged = np.where(old_inside[:, None], old, new)
-    empty = np.zeros(old.shape[0], dtype=bool)
-    crossing = np.flatnonzero(~(old_inside | new_inside))
-    if crossing.size:
-        merged[crossing], empty[crossing] = kgon.intersect(old[crossing], new[crossing])
-    return merged, empty
 
 
 def _int_at_least(value: object, minimum: int, name: str, why: str = "") -> int:

@@ -297,10 +297,19 @@ class KGon:
         """
         owner_p = hp <= hc
         # Nested K-gons (common: a new movement's region often covers the map's) need no
-        # clipping: the inner one is the intersection, and it is tight.
+        # clipping: the inner one is the intersection, and it is tight. Decided per pair,
+        # so a pair's result does not depend on the others in its batch.
         p_inside = owner_p.all(axis=-1)
-        if np.all(p_inside | (~owner_p).all(axis=-1)):
-            return np.where(p_inside[..., None], hp, hc), np.zeros(p_inside.shape, dtype=bool)
+        h = np.where(p_inside[..., None], hp, hc)
+        empty = np.zeros(p_inside.shape, dtype=bool)
+        crossing = ~(p_inside | (~owner_p).all(axis=-1))
+        if crossing.any():
+            h[crossing], empty[crossing] = self._clip(hp[crossing], hc[crossing])
+        return h, empty
+
+    def _clip(self, hp: FloatArray, hc: FloatArray) -> tuple[FloatArray, BoolArray]:
+        """:meth:`intersect` for K-gons (N, K) whose boundaries cross."""
+        owner_p = hp <= hc
         vp, vc = self.vertices(hp), self.vertices(hc)
         h_own = np.where(owner_p, hp, hc)
         # Edge k runs from vertex k-1 to vertex k of its owner.
