@@ -150,6 +150,12 @@ class BatchedPolygonSLAM:
         rows = np.arange(self.num_maps) if maps is None else np.asarray(maps, dtype=np.int64)
         b1 = self._check_bearings(bearings_start, rows.size, "bearings_start")
         b2 = self._check_bearings(bearings_end, rows.size, "bearings_end")
+        return self._update_checked(b1, b2, rows)
+
+    def _update_checked(
+        self, b1: FloatArray, b2: FloatArray, rows: IntArray
+    ) -> BatchUpdateResult:
+        """:meth:`update` on bearings already checked (float arrays (len(rows), n))."""
         n_rows, n_mapped = rows.size, self.n_landmarks - 2
         self.n_updates[rows] += 1
         regions, fr_status = cone_intersections(b1, b2, self.epsilon)

@@ -241,7 +241,8 @@ class PolygonSLAM:
         """
         b1 = self._check_bearings(bearings_start, "bearings_start")
         b2 = self._check_bearings(bearings_end, "bearings_end")
-        result = self._batch.update(b1[None], b2[None], maps=self._rows)
+        # Checked above, for this map's shape; the batch need not check again.
+        result = self._batch._update_checked(b1[None], b2[None], self._rows)
         return UpdateResult(
             frame_changed=bool(result.frame_changed[0]),
             frame_status=FRAME_STATUSES[result.frame_status[0]],
