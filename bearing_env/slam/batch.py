@@ -216,7 +216,7 @@ class BatchedPolygonSLAM:
             hyp = sample_hypotheses(
                 regions[members, 0],
                 regions[members, 1],
-                _take_plan(plan, in_plan[group]),
+                plan.take(in_plan[group]),
                 per_edge,
                 conservative,
             )
@@ -296,16 +296,6 @@ STATE_ARRAYS = (
     "n_frame_changes",
     "n_inconsistent",
 )
-
-
-def _take_plan(plan: FramePlan, index: IntArray) -> FramePlan:
-    return FramePlan(
-        plan.status[index],
-        plan.distance[index],
-        plan.per_edge[index],
-        plan.longest1[index],
-        plan.longest2[index],
-    )
 
 
 def _int_at_least(value: object, minimum: int, name: str, why: str = "") -> int:

@@ -84,6 +84,16 @@ class FramePlan:
     longest1: FloatArray
     longest2: FloatArray
 
+    def take(self, index: NDArray[np.int64]) -> FramePlan:
+        """The plan of the movements ``index``."""
+        return FramePlan(
+            self.status[index],
+            self.distance[index],
+            self.per_edge[index],
+            self.longest1[index],
+            self.longest2[index],
+        )
+
 
 def plan_frame_changes(
     a1: ComplexArray, a2: ComplexArray, transfer: str, edge_samples: int
