@@ -12,7 +12,7 @@ import numpy as np
 from gymnasium import spaces
 from numpy.typing import ArrayLike, NDArray
 
-from bearing_env.slam import TRANSFERS, PolygonSLAM, fl_to_world, world_to_fl
+from bearing_env.slam import TRANSFERS, PolygonSLAM, fl_to_world
 from bearing_env.slam.batch import BatchedPolygonSLAM
 from bearing_env.world import (
     SCENARIOS,
@@ -354,8 +354,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
         self._slam = self._make_slam(self.n_landmarks)
         self._world: World | None = None
-        self._landmarks_fl = np.zeros((0, 2))
-        self._landmarks_fl_complex = np.zeros(0, dtype=complex)
+        #: True FL positions of landmarks 3.. (complex), fixed per episode, for info.
+        self._landmarks_fl = np.zeros(0, dtype=complex)
         self._frame_origin, self._frame_unit = 0j, 1 + 0j
         self._moves = 0
         self._potential = 0.0
@@ -555,10 +555,10 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         position, heading = random_start(rng, self.arena, landmarks)
         self._world = World(self.arena, landmarks, position, heading, self.noise, self.epsilon)
         # Landmarks do not move: their true FL positions (for info) are fixed per episode.
-        self._landmarks_fl = world_to_fl(landmarks[2:], landmarks[0], landmarks[1])
-        self._landmarks_fl_complex = self._landmarks_fl[:, 0] + 1j * self._landmarks_fl[:, 1]
         self._frame_origin = complex(*landmarks[0])
         self._frame_unit = complex(*landmarks[1]) - self._frame_origin
+        points = landmarks[2:, 0] + 1j * landmarks[2:, 1]
+        self._landmarks_fl = (points - self._frame_origin) / self._frame_unit
         self._slam.reset()
         self._moves = 0
         self._latest_bearings = self._world.read_bearings(rng)
@@ -931,7 +931,7 @@ def _batched_infos(
     """The envs' infos, batched along a first axis (see the env's Info section)."""
     initialised = batch.initialised[rows]
     areas = batch.areas[rows]
-    truth = np.stack([env._landmarks_fl_complex for env in envs])
+    truth = np.stack([env._landmarks_fl for env in envs])
     errors = np.where(
         initialised, np.abs(np.where(initialised, batch.centroids[rows] - truth, 0.0)), np.inf
     )
