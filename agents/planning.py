@@ -19,9 +19,10 @@ from bearing_env.envs.bearing_slam import AREA_FLOOR
 from bearing_env.slam import PolygonSLAM
 
 
-def uncertainty_potential(areas: NDArray[np.float64], area_cap: float) -> float:
-    """The env's default potential: sum of log areas, capped (uninitialised = cap)."""
-    return float(np.sum(np.log(np.clip(areas, AREA_FLOOR, area_cap))))
+def uncertainty_potential(areas: NDArray[np.float64], area_cap: float) -> NDArray[np.float64]:
+    """The env's default potential: sum of log areas, capped (uninitialised = cap), over
+    the last axis (one value per map for areas (..., n - 2))."""
+    return np.sum(np.log(np.clip(areas, AREA_FLOOR, area_cap)), axis=-1)
 
 
 def bearings_from(
@@ -85,8 +86,7 @@ def simulate_potentials(
     bearings_end = np.where(known, bearings_from(ends, headings, targets), bearings_start)
     trials = slam.replicate(len(moving))
     trials.update(bearings_start, bearings_end)
-    capped = np.clip(trials.areas, AREA_FLOOR, area_cap)
-    potentials[moving] = np.sum(np.log(capped), axis=-1)
+    potentials[moving] = uncertainty_potential(trials.areas, area_cap)
     return potentials
 
 
