@@ -84,8 +84,9 @@ def test_make_vec_returns_the_batched_env_with_the_spec_time_limit(env_id: str) 
         {"scenario": "khepera"},
         {"n_landmarks": 6, "transfer": "paper"},
         {"n_landmarks": 5, "noise": {"kind": "uniform", "bound_deg": 4.0}, "max_moves": 7},
+        {"scenario": "khepera", "noise": {"kind": "gaussian", "outlier_rate": 0.2}},
     ],
-    ids=["khepera", "random-paper", "random-outside-epsilon"],
+    ids=["khepera", "random-paper", "random-outside-epsilon", "gaussian-outliers"],
 )
 def test_reproduces_sync_vector_env_exactly(
     env_id: str, mode: AutoresetMode, kwargs: dict[str, Any]
@@ -205,6 +206,17 @@ def test_invalid_arguments_raise_clear_errors() -> None:
         env.step(np.full((2, 2), 3.0, dtype=np.float32))
     with pytest.raises(ValueError, match="seeds"):
         env.reset(seed=[1, 2, 3])
+
+
+def test_discrete_actions_must_be_integers_in_range() -> None:
+    env = BearingSLAMDiscreteVectorEnv(2, scenario="khepera")
+    env.reset(seed=0)
+    n_actions = env.single_action_space.n
+    with pytest.raises(ValueError, match="outside the action space"):
+        env.step(np.array([0, n_actions]))
+    with pytest.raises(ValueError, match="integers"):
+        env.step(np.array([0.0, 1.5]))
+    env.step(np.array([0.0, 3.0]))  # integral floats are fine, as in the single env
 
 
 def test_class_metadata_is_not_mutated() -> None:
