@@ -22,8 +22,8 @@ when they parse as one, strings otherwise.
 
 **Vectorisation** (``--vec-env``). ``batched`` runs the ``n_envs`` training envs as one
 Gymnasium vector env in this process, through ``train.vec_env``'s SB3 adapter: the id's
-natively batched ``vector_entry_point`` when it registers one (one numpy call steps every
-env), else a ``SyncVectorEnv`` of single envs. ``subproc`` runs one single env per worker
+natively batched ``vector_entry_point`` when it registers one (one batched computation
+steps every env), else a ``SyncVectorEnv`` of single envs. ``subproc`` runs one single env per worker
 process (spawn), ``dummy`` all of them in this process. ``auto``, the default, is
 ``batched`` when the id registers a batched vector env and ``subproc`` otherwise. Every
 kind seeds env ``i`` alike, so the kinds train on the same data when the batched env
@@ -413,7 +413,7 @@ def resolve_vec_env_kind(vec_env_kind: str, env_id: str) -> str:
     """The kind of :data:`VEC_ENV_KINDS` that ``vec_env_kind`` means for ``env_id``.
 
     ``auto`` is ``batched`` when the id registers a natively batched vector env, which
-    steps all envs in one numpy call, and ``subproc`` otherwise: a ``SyncVectorEnv``
+    steps all envs in one batched computation, and ``subproc`` otherwise: a ``SyncVectorEnv``
     fallback would step the envs one by one in this process, and processes are faster.
     """
     if vec_env_kind == "auto":

@@ -10,8 +10,9 @@ the sub-env is reset in the same ``step``, the returned observation is the reset
 and the last observation and info of the finished episode travel in
 ``infos["final_obs"]`` and ``infos["final_info"]``. :class:`GymnasiumVecEnv` therefore
 accepts only that mode and translates the rest, so any SAME_STEP vector env can train
-with SB3: a natively batched one (the point of this module: one numpy call steps every
-sub-env, instead of one Python call per sub-env), or Gymnasium's ``SyncVectorEnv``.
+with SB3: a natively batched one (the point of this module: one batched computation
+steps every sub-env, instead of one Python call per sub-env), or Gymnasium's
+``SyncVectorEnv``.
 
 :func:`make_batched_vec_env` builds the training env that ``bearing-env train`` uses:
 the id's registered ``vector_entry_point`` when it has one, else a ``SyncVectorEnv`` of

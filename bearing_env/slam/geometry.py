@@ -1,8 +1,8 @@
 """Batched convex geometry in pure numpy: bearing cones and fixed-normal convex polygons.
 
 Points are complex numbers (x + iy). Every function works on arrays with arbitrary
-leading batch dimensions, so one call handles all landmarks of a movement (and, later,
-many environments).
+leading batch dimensions, so one call handles all landmarks of a movement (and, through
+:class:`~bearing_env.slam.batch.BatchedPolygonSLAM`, many maps).
 
 Two polygon representations are used:
 
