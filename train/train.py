@@ -24,8 +24,9 @@ when they parse as one, strings otherwise.
 Gymnasium vector env in this process, through ``train.vec_env``'s SB3 adapter: the id's
 natively batched ``vector_entry_point`` when it registers one (one batched
 computation steps every env), else a ``SyncVectorEnv`` of single envs. ``subproc`` runs
-one single env per worker process (spawn), ``dummy`` all of them in this process. ``auto``, the default, is
-``batched`` when the id registers a batched vector env and ``subproc`` otherwise. Every
+one single env per worker process (spawn), ``dummy`` all of them in this process.
+``auto``, the default, is ``batched`` when the id registers a batched vector env and
+``subproc`` otherwise. Every
 kind seeds env ``i`` alike, so the kinds train on the same data when the batched env
 reproduces the single env; ``run.json`` records the kind used by each segment, and a run
 may be resumed with another kind.
