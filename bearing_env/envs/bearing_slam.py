@@ -935,11 +935,7 @@ def _batched_infos(
     errors = np.where(
         initialised, np.abs(np.where(initialised, batch.centroids[rows] - truth, 0.0)), np.inf
     )
-    contains = np.zeros(initialised.shape, dtype=bool)
-    if initialised.any():
-        contains[initialised] = batch.kgon.contains(
-            batch.support[rows][initialised], truth[initialised]
-        )
+    contains = batch.contains(truth, rows)
     robot_truth = np.array([env._robot_fl() for env in envs])
     robot_centroid = batch.robot_centroid[rows]
     robot_known = np.isfinite(robot_centroid)

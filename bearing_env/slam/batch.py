@@ -274,6 +274,28 @@ class BatchedPolygonSLAM:
             raise ValueError(f"{name} must be finite, got {arr.tolist()}")
         return arr
 
+    def contains(self, points: ArrayLike, maps: ArrayLike | None = None) -> NDArray[np.bool_]:
+        """Whether region ``i`` of each map contains FL point ``i`` (boundary counts).
+
+        Args:
+            points: complex FL points (len(maps), n_landmarks - 2).
+            maps: indices of the maps (default: all, in order).
+
+        Returns:
+            Bool (len(maps), n_landmarks - 2); False where a landmark is not initialised.
+        """
+        rows = np.arange(self.num_maps) if maps is None else np.asarray(maps, dtype=np.int64)
+        z = np.asarray(points, dtype=np.complex128)
+        if z.shape != (rows.size, self.n_landmarks - 2):
+            raise ValueError(
+                f"points must have shape ({rows.size}, {self.n_landmarks - 2}), got {z.shape}"
+            )
+        initialised = self.initialised[rows]
+        inside = np.zeros(z.shape, dtype=bool)
+        if initialised.any():
+            inside[initialised] = self.kgon.contains(self.support[rows][initialised], z[initialised])
+        return inside
+
     def copy_map(self, source: int, target: int) -> None:
         """Overwrite map ``target`` with map ``source`` (planning: clone a map in place)."""
         for name in STATE_ARRAYS:
