@@ -56,13 +56,22 @@ def readings(landmarks, r1: complex, r2: complex) -> tuple[np.ndarray, np.ndarra
 
 def state(slam: PolygonSLAM) -> dict:
     return {
-        "supports": slam.supports,
+        "vertices": slam_vertices(slam),
+        "counts": slam.batch.counts[slam.index].copy(),
         "areas": slam.areas,
         "estimates": slam.estimates,
         "initialised": slam.initialised,
         "robot": slam.robot_estimate,
         "n_inconsistent": slam.n_inconsistent,
     }
+
+
+def slam_vertices(slam: PolygonSLAM) -> np.ndarray:
+    """Each region's vertex array (zeros beyond its count), as a copy."""
+    vertices = slam.batch.vertices[slam.index].copy()
+    for j, n in enumerate(slam.batch.counts[slam.index]):
+        vertices[j, n:] = 0.0
+    return vertices
 
 
 def assert_same_state(a: dict, b: dict) -> None:
@@ -105,9 +114,8 @@ R1, R2 = 0.0 + 0.0j, 1.0 + 0.0j
         ({"epsilon": float("inf")}, r"epsilon.*inf"),
         ({"transfer": "vertices"}, r"transfer.*vertices"),
         ({"transfer": "Paper"}, r"transfer.*Paper"),
-        ({"directions": 7}, r"directions.*7"),
-        ({"directions": 4}, r"directions.*4"),
-        ({"directions": 0}, r"directions.*0"),
+        ({"edge_samples": 9}, r"edge_samples.*9"),
+        ({"edge_samples": 10**6}, r"edge_samples.*1000000"),
         ({"on_inconsistency": "vote"}, r"on_inconsistency.*vote"),
         ({"edge_samples": 0}, r"edge_samples.*0"),
     ],
@@ -121,8 +129,8 @@ def test_constructor_rejects_bad_values_and_names_them(kwargs, pattern):
 def test_constructor_accepts_the_documented_choices():
     for transfer in ("paper", "conservative"):
         for policy in INCONSISTENCY_POLICIES:
-            slam = PolygonSLAM(3, 1e-3, transfer=transfer, on_inconsistency=policy, directions=8)
-            assert slam.supports.shape == (1, 8)
+            slam = PolygonSLAM(3, 1e-3, transfer=transfer, on_inconsistency=policy)
+            assert slam.polygons == [None]
     # Default: the conservative transfer (DESIGN.md: the environment's default must be).
     assert PolygonSLAM(4, EPS).transfer == "conservative"
 
@@ -232,13 +240,13 @@ def test_frame_failure_on_a_fresh_map_leaves_it_empty():
 def test_a_landmark_on_the_line_of_motion_is_left_alone(where):
     slam = PolygonSLAM(4, EPS)
     slam.update(*readings(GOOD, -0.5 + 0.5j, 0.5 - 0.3j))
-    before = slam.supports[1].copy()
+    before = slam_vertices(slam)[1].copy()
     b1, b2 = readings([L1, L2, L3, where], R1, R2)
     assert abs(abs(b1[3]) - abs(b2[3])) < 1e-12 and abs(b1[3]) in (0.0, np.pi)
     res = slam.update(b1, b2)
     assert res.frame_changed
     assert res.landmark_status.tolist() == [LANDMARK_UPDATED, LANDMARK_UNBOUNDED]
-    np.testing.assert_array_equal(slam.supports[1], before)
+    np.testing.assert_array_equal(slam_vertices(slam)[1], before)
     # On a fresh map, the same move leaves that landmark uninitialised.
     fresh = PolygonSLAM(4, EPS)
     fresh.update(b1, b2)
@@ -250,7 +258,7 @@ def test_cones_that_miss_each_other_are_counted_as_inconsistent():
     slam = PolygonSLAM(5, EPS)
     world = np.array([L1, L2, L3, L4, 0.5 + 2.0j])
     slam.update(*readings(world, -0.5 + 0.5j, 0.5 - 0.3j))
-    before = slam.supports
+    before = slam_vertices(slam)
     b1, b2 = readings(world, R1, R2)
     b1[4], b2[4] = np.pi / 2, -np.pi / 2  # up from R1, down from R2: no intersection
     res = slam.update(b1, b2)
@@ -262,7 +270,7 @@ def test_cones_that_miss_each_other_are_counted_as_inconsistent():
     ]
     assert res.n_inconsistent == 1 and slam.n_inconsistent == 1
     # That landmark's region is untouched (its movement region does not exist).
-    np.testing.assert_array_equal(slam.supports[2], before[2])
+    np.testing.assert_array_equal(slam_vertices(slam)[2], before[2])
     assert_no_nan(slam)
 
 
@@ -292,12 +300,12 @@ def test_on_inconsistency_keep_leaves_the_old_region(transfer):
     (a1, a2), (b1, b2) = contradicting_moves(transfer)
     slam = PolygonSLAM(4, EPS_FINE, transfer=transfer, on_inconsistency="keep")
     slam.update(a1, a2)
-    old = slam.supports
+    old = slam_vertices(slam)
     old_area, old_est = slam.areas, slam.estimates
     res = slam.update(b1, b2)
     assert res.landmark_status.tolist() == [LANDMARK_INCONSISTENT, LANDMARK_UPDATED]
     assert res.n_inconsistent == 1 and slam.n_inconsistent == 1
-    np.testing.assert_array_equal(slam.supports[0], old[0])
+    np.testing.assert_array_equal(slam_vertices(slam)[0], old[0])
     assert slam.areas[0] == old_area[0]
     np.testing.assert_array_equal(slam.estimates[0], old_est[0])
     # The consistent landmark was still fused (it can only shrink).
@@ -315,7 +323,9 @@ def test_on_inconsistency_restart_takes_the_new_region(transfer):
     assert res.n_inconsistent == 1 and slam.n_inconsistent == 1
     only_new = PolygonSLAM(4, EPS_FINE, transfer=transfer)
     only_new.update(b1, b2)
-    np.testing.assert_allclose(slam.supports[0], only_new.supports[0], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(
+        slam_vertices(slam)[0], slam_vertices(only_new)[0], rtol=1e-12, atol=1e-12
+    )
     assert slam.areas[0] == pytest.approx(only_new.areas[0], rel=1e-12)
     # The new region holds the (fake) reported position; L4 is fused as usual.
     fake = to_xy(fl(L3 + 0.6, L1, L2))
@@ -358,7 +368,7 @@ def test_coincident_landmarks(transfer):
     for r1, r2 in [(R1, R2), (-0.5 + 0.5j, 0.5 - 0.3j), (1.2 + 0.2j, 0.2 + 0.6j)]:
         slam.update(*readings(world, r1, r2))
         assert_no_nan(slam)
-    np.testing.assert_array_equal(slam.supports[0], slam.supports[1])
+    np.testing.assert_array_equal(slam_vertices(slam)[0], slam_vertices(slam)[1])
     assert slam.initialised.all()
     if transfer == "conservative":
         assert slam.contains(to_xy(fl(world[2:], L1, L2))).all()
@@ -400,7 +410,7 @@ def test_bearings_of_plus_and_minus_pi_are_the_same_direction(transfer):
         slam.update(*readings(world, -0.5 + 0.5j, 0.5 - 0.3j))
         res = slam.update(c1, c2)
         assert_no_nan(slam)
-        results.append((res.landmark_status.tolist(), slam.supports))
+        results.append((res.landmark_status.tolist(), slam_vertices(slam)))
     assert results[0][0] == results[1][0]
     # L3 behind on the line: unbounded; L4 between R1 and R2: a bounded diamond.
     assert results[0][0] == [LANDMARK_UNBOUNDED, LANDMARK_UPDATED]
@@ -478,7 +488,7 @@ def test_copy_is_independent():
         slam.update(b1, b2)
     assert_same_state(state(clone), state(slam))
     # Mutating returned arrays does not reach into the map.
-    slam.supports[:] = 0.0
+    slam.polygons[0][:] = 0.0
     slam.areas[:] = 0.0
     assert_same_state(state(clone), state(slam))
 

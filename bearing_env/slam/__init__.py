@@ -1,4 +1,4 @@
-"""The world model: the paper's bearing-only polygon SLAM, as a pure numpy library.
+"""The world model: the paper's bearing-only polygon SLAM, as a compiled library.
 
 This package imports neither gymnasium nor pygame: it runs on bearings logged by a real
 robot as well as on the simulator's.

@@ -1,6 +1,6 @@
 """One-movement functions returning shapely geometry: for inspection, plots and tests.
 
-The map (:class:`~bearing_env.slam.PolygonSLAM`) uses the batched kernels directly;
+The map (:class:`~bearing_env.slam.PolygonSLAM`) calls the compiled kernels directly;
 these wrappers give the exact polygons of a single movement.
 """
 
@@ -10,18 +10,16 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from bearing_env.slam.geometry import FR_BOUNDED, cone_intersections
-from bearing_env.slam.transfer import transfer_points_fl
+from bearing_env.slam.geometry import FR_BOUNDED, cone_region
+from bearing_env.slam.transfer import transfer_vertices
 
 
 def fr_region(bearing_start: float, bearing_end: float, epsilon: float) -> shapely.Polygon | None:
     """Region of one landmark in FR (R1 = (0, 0), R2 = (1, 0)); None if unbounded or empty."""
-    verts, status = cone_intersections(
-        np.array([bearing_start], float), np.array([bearing_end], float), float(epsilon)
-    )
-    if status[0] != FR_BOUNDED:
+    verts, status = cone_region(bearing_start, bearing_end, epsilon)
+    if status != FR_BOUNDED:
         return None
-    return _polygon(verts[0])
+    return _polygon(verts)
 
 
 def transfer_polygon(
@@ -30,23 +28,20 @@ def transfer_polygon(
     l2_fr: shapely.Polygon | ArrayLike,
     transfer: str = "conservative",
     edge_samples: int = 3,
-) -> shapely.Polygon | None:
+) -> shapely.Geometry | None:
     """The FL region of an FR region given the FR regions of L1 and L2.
 
-    ``"paper"`` returns exactly the convex hull of the vertex-hypothesis images;
-    ``"conservative"`` returns the sampled hull grown (mitred, so never inside the true
-    offset) by the bound of :mod:`bearing_env.slam.transfer`. None when L1 and L2 overlap.
+    ``"paper"`` returns exactly the convex hull of the vertex-hypothesis images (a point
+    or a segment if they have no area: exact L1, L2 and target); ``"conservative"``
+    returns the sampled hull with every edge moved outward by the bound of
+    :mod:`bearing_env.slam.transfer`. None when the frame cannot be changed.
     """
-    out = transfer_points_fl(
+    verts = transfer_vertices(
         _vertices(region_fr), _vertices(l1_fr), _vertices(l2_fr), transfer, edge_samples
     )
-    if out is None:
+    if isinstance(verts, str):
         return None
-    cloud, radius = out
-    hull = shapely.convex_hull(shapely.multipoints(np.stack([cloud.real, cloud.imag], -1)))
-    if radius > 0:
-        hull = shapely.buffer(hull, radius, join_style="mitre", mitre_limit=1e6)
-    return hull
+    return _polygon(verts)
 
 
 def transfer_point(
@@ -55,7 +50,7 @@ def transfer_point(
     l2_fr: shapely.Polygon | ArrayLike,
     transfer: str = "conservative",
     edge_samples: int = 3,
-) -> shapely.Polygon | None:
+) -> shapely.Geometry | None:
     """The FL region of an FR point (e.g. R1 = (0, 0) or R2 = (1, 0))."""
     p = np.asarray(point_fr, dtype=float).reshape(1, 2)
     return transfer_polygon(p, l1_fr, l2_fr, transfer, edge_samples)
@@ -71,6 +66,9 @@ def _vertices(region: shapely.Polygon | ArrayLike) -> np.ndarray:
     return xy[:, 0] + 1j * xy[:, 1]
 
 
-def _polygon(verts: np.ndarray) -> shapely.Polygon:
+def _polygon(verts: np.ndarray) -> shapely.Geometry:
+    """The polygon of CCW vertices; a point or a segment when it has no area."""
     xy = np.stack([verts.real, verts.imag], -1)
+    if verts.size >= 3:
+        return shapely.Polygon(xy)
     return shapely.convex_hull(shapely.multipoints(xy))

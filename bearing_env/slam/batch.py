@@ -1,34 +1,30 @@
-"""Many maps updated in one batched computation: the engine under every PolygonSLAM.
+"""Many maps updated in one compiled call: the engine under every PolygonSLAM.
 
 :class:`BatchedPolygonSLAM` holds ``num_maps`` independent maps with the same number of
 landmarks and the same settings, as arrays with a leading map axis, and fuses one
-movement per map in a single numpy computation. :class:`~bearing_env.slam.PolygonSLAM`
+movement per map in one call of the compiled kernel
+:func:`~bearing_env.slam.kernels.update_maps`. :class:`~bearing_env.slam.PolygonSLAM`
 is a batch of one; the batched vector environment steps all its sub-environments'
 maps at once.
 
-A map's result never depends on which other maps share its batch: every operation is
-elementwise or a reduction within one map's rows, and data-dependent choices (how
-finely to sample the hypotheses, whether two K-gons are nested) are made per map.
-That is what lets the vector environment reproduce the single environment bit for bit.
+Each region is an exact convex polygon: up to :data:`~bearing_env.slam.kernels.CAPACITY`
+vertices in ``vertices[map, landmark]``, of which the first ``counts[map, landmark]``
+are used (0: not initialised). A map's result never depends on which other maps share
+its batch, because the kernel updates each map on its own; that is what lets the vector
+environment reproduce the single environment bit for bit.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from bearing_env.slam.geometry import FR_BOUNDED, FR_EMPTY, KGon, cone_intersections
-from bearing_env.slam.transfer import (
-    PLAN_OVERLAP,
-    PLAN_TOO_CLOSE,
-    TRANSFERS,
-    FramePlan,
-    plan_frame_changes,
-    sample_hypotheses,
-    transfer_support,
-)
+from bearing_env.slam import kernels
+from bearing_env.slam.transfer import TRANSFERS
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -49,6 +45,10 @@ LANDMARK_CODE = {name: code for code, name in enumerate(LANDMARK_STATUSES)}
 
 INCONSISTENCY_POLICIES = ("restart", "keep")
 
+#: How far outside a region a point may lie and still count as inside, relative to the
+#: region's size: far above rounding, far below any bearing error.
+CONTAINMENT_TOLERANCE = 1e-9
+
 
 @dataclass(frozen=True)
 class BatchUpdateResult:
@@ -68,6 +68,13 @@ class BatchedPolygonSLAM:
     """``num_maps`` independent polygon-SLAM maps, updated together.
 
     Args mirror :class:`~bearing_env.slam.PolygonSLAM`, plus ``num_maps``.
+
+    The state is public, as arrays with the map axis first (read them; write them only
+    through :meth:`update` and :meth:`reset`): ``vertices`` (maps, landmarks, CAPACITY)
+    complex and ``counts`` (maps, landmarks) for the regions of landmarks 3..n,
+    ``areas`` and ``centroids`` (complex), ``robot_vertices``/``robot_counts``,
+    ``robot_area``, ``robot_centroid`` and ``robot_heading`` for the robot, and the
+    counters ``n_updates``, ``n_frame_changes`` and ``n_inconsistent``.
     """
 
     def __init__(
@@ -76,14 +83,15 @@ class BatchedPolygonSLAM:
         n_landmarks: int,
         epsilon: float,
         transfer: str = "conservative",
-        directions: int = 32,
         edge_samples: int = 3,
         on_inconsistency: str = "restart",
     ) -> None:
         self.num_maps = _int_at_least(num_maps, 1, "num_maps")
         self.n_landmarks = _int_at_least(n_landmarks, 3, "n_landmarks", "(L1, L2 and one more)")
+        if isinstance(epsilon, bool) or not isinstance(epsilon, (float, int, np.number)):
+            raise TypeError(f"epsilon must be a number of radians, got {epsilon!r}")
         epsilon = float(epsilon)
-        if not 0.0 < epsilon < np.pi / 2:
+        if not 0.0 < epsilon < math.pi / 2:
             raise ValueError(f"epsilon must be in (0, pi/2) radians, got {epsilon!r}")
         if transfer not in TRANSFERS:
             raise ValueError(f"transfer must be one of {TRANSFERS}, got {transfer!r}")
@@ -95,34 +103,43 @@ class BatchedPolygonSLAM:
         self.epsilon = epsilon
         self.transfer = transfer
         self.edge_samples = _int_at_least(edge_samples, 1, "edge_samples")
+        if self.edge_samples > kernels.MAX_EDGE_SAMPLES:
+            raise ValueError(
+                f"edge_samples must be <= {kernels.MAX_EDGE_SAMPLES}, got {edge_samples!r}"
+            )
         self.on_inconsistency = on_inconsistency
-        if isinstance(directions, bool) or not isinstance(directions, (int, np.integer)):
-            raise TypeError(f"directions must be an int, got {directions!r}")
-        self.kgon = KGon(int(directions))
-        n, m, k = self.num_maps, self.n_landmarks - 2, self.kgon.k
-        self.support = np.empty((n, m, k))
-        self.initialised = np.empty((n, m), dtype=bool)
+        n, m, cap = self.num_maps, self.n_landmarks - 2, kernels.CAPACITY
+        self.vertices = np.zeros((n, m, cap), dtype=np.complex128)
+        self.counts = np.zeros((n, m), dtype=np.int64)
         self.areas = np.empty((n, m))
-        self.centroids = np.empty((n, m), dtype=complex)
-        self.robot_support = np.empty((n, k))
-        self.has_robot = np.empty(n, dtype=bool)
+        self.centroids = np.empty((n, m), dtype=np.complex128)
+        self.robot_vertices = np.zeros((n, cap), dtype=np.complex128)
+        self.robot_counts = np.zeros(n, dtype=np.int64)
         self.robot_area = np.empty(n)
-        self.robot_centroid = np.empty(n, dtype=complex)
+        self.robot_centroid = np.empty(n, dtype=np.complex128)
         self.robot_heading = np.empty(n)
         self.n_updates = np.empty(n, dtype=np.int64)
         self.n_frame_changes = np.empty(n, dtype=np.int64)
         self.n_inconsistent = np.empty(n, dtype=np.int64)
         self.reset()
 
+    @property
+    def initialised(self) -> NDArray[np.bool_]:
+        """Bool (maps, landmarks): the landmark has a region."""
+        return self.counts > 0
+
+    @property
+    def has_robot(self) -> NDArray[np.bool_]:
+        """Bool (maps,): the robot has a region (a movement has changed frames)."""
+        return self.robot_counts > 0
+
     def reset(self, maps: ArrayLike | None = None) -> None:
         """Forget everything in the given maps (indices or a mask; default all)."""
         rows = slice(None) if maps is None else np.asarray(maps)
-        self.support[rows] = np.inf
-        self.initialised[rows] = False
+        self.counts[rows] = 0
         self.areas[rows] = np.inf
         self.centroids[rows] = complex(np.nan, np.nan)
-        self.robot_support[rows] = np.inf
-        self.has_robot[rows] = False
+        self.robot_counts[rows] = 0
         self.robot_area[rows] = np.inf
         self.robot_centroid[rows] = complex(np.nan, np.nan)
         self.robot_heading[rows] = np.nan
@@ -142,12 +159,14 @@ class BatchedPolygonSLAM:
             bearings_start: bearings (len(maps), n_landmarks) at R1, radians CCW from the
                 direction of motion; column 0 is L1, column 1 is L2.
             bearings_end: bearings at R2, same shape.
-            maps: indices of the maps to update (default: all, in order).
+            maps: distinct indices of the maps to update (default: all, in order).
 
         Raises:
-            ValueError: on a wrong shape or a non-finite bearing.
+            TypeError: on non-numeric bearings or map indices.
+            ValueError: on a wrong shape, a non-finite bearing, or map indices that are
+                out of range or repeated.
         """
-        rows = np.arange(self.num_maps) if maps is None else np.asarray(maps, dtype=np.int64)
+        rows = self._check_maps(maps)
         b1 = self._check_bearings(bearings_start, rows.size, "bearings_start")
         b2 = self._check_bearings(bearings_end, rows.size, "bearings_end")
         return self._update_checked(b1, b2, rows)
@@ -155,124 +174,36 @@ class BatchedPolygonSLAM:
     def _update_checked(
         self, b1: FloatArray, b2: FloatArray, rows: IntArray
     ) -> BatchUpdateResult:
-        """:meth:`update` on bearings already checked (float arrays (len(rows), n))."""
+        """:meth:`update` on checked input (float arrays (len(rows), n), distinct rows)."""
         n_rows, n_mapped = rows.size, self.n_landmarks - 2
-        self.n_updates[rows] += 1
-        regions, fr_status = cone_intersections(b1, b2, self.epsilon)
-
-        frame = np.full(n_rows, FRAME_CODE["ok"], dtype=np.int8)
-        frame[fr_status[:, 1] != FR_BOUNDED] = FRAME_CODE["l2_unbounded"]
-        frame[fr_status[:, 0] != FR_BOUNDED] = FRAME_CODE["l1_unbounded"]
-        bounded = np.flatnonzero(frame == FRAME_CODE["ok"])
-        plan = plan_frame_changes(
-            regions[bounded, 0], regions[bounded, 1], self.transfer, self.edge_samples
+        frame = np.empty(n_rows, dtype=np.int8)
+        landmark = np.empty((n_rows, n_mapped), dtype=np.int8)
+        bad = np.empty(n_rows, dtype=np.int64)
+        kernels.update_maps(
+            b1,
+            b2,
+            rows,
+            self.epsilon,
+            self.transfer == "conservative",
+            self.edge_samples,
+            self.on_inconsistency == "keep",
+            self.vertices,
+            self.counts,
+            self.areas,
+            self.centroids,
+            self.robot_vertices,
+            self.robot_counts,
+            self.robot_area,
+            self.robot_centroid,
+            self.robot_heading,
+            self.n_updates,
+            self.n_frame_changes,
+            self.n_inconsistent,
+            frame,
+            landmark,
+            bad,
         )
-        frame[bounded[plan.status == PLAN_OVERLAP]] = FRAME_CODE["l1_l2_overlap"]
-        frame[bounded[plan.status == PLAN_TOO_CLOSE]] = FRAME_CODE["l1_l2_too_close"]
-
-        landmark = np.full((n_rows, n_mapped), LANDMARK_CODE["skipped"], dtype=np.int8)
-        changed = frame == FRAME_CODE["ok"]
-        ok = np.flatnonzero(changed)
-        if ok.size:
-            landmark[ok] = np.where(
-                fr_status[ok, 2:] == FR_EMPTY,
-                LANDMARK_CODE["inconsistent"],
-                LANDMARK_CODE["unbounded"],
-            )
-            self._fuse(rows, ok, regions, fr_status, plan, bounded, landmark)
-        bad = np.count_nonzero(landmark == LANDMARK_CODE["inconsistent"], axis=-1)
-        self.n_inconsistent[rows] += bad
-        return BatchUpdateResult(changed, frame, landmark, bad)
-
-    def _fuse(
-        self,
-        rows: IntArray,
-        ok: IntArray,
-        regions: NDArray[np.complex128],
-        fr_status: NDArray[np.int8],
-        plan: FramePlan,
-        bounded: IntArray,
-        landmark: NDArray[np.int8],
-    ) -> None:
-        """Transfer and intersect the regions of the movements ``ok`` (indices into ``rows``)."""
-        k = self.kgon.k
-        n_mapped = self.n_landmarks - 2
-        robot_new = np.empty((ok.size, k))
-        landmark_new = np.empty((ok.size, n_mapped, k))
-        conservative = self.transfer == "conservative"
-        in_plan = np.searchsorted(bounded, ok)  # every movement in ok is in the plan
-        per_edge_of = plan.per_edge[in_plan]
-        # Maps needing the same sampling are transferred together; each map's sampling
-        # depends on its own regions only.
-        if np.all(per_edge_of == per_edge_of[0]):
-            groups = [(int(per_edge_of[0]), np.arange(ok.size))]
-        else:
-            groups = [
-                (int(per_edge), np.flatnonzero(per_edge_of == per_edge))
-                for per_edge in np.unique(per_edge_of)
-            ]
-        for per_edge, group in groups:
-            members = ok[group]
-            hyp = sample_hypotheses(
-                regions[members, 0],
-                regions[members, 1],
-                plan.take(in_plan[group]),
-                per_edge,
-                conservative,
-            )
-            targets = regions[members, 2:]
-            usable = fr_status[members, 2:] == FR_BOUNDED
-            # Unbounded targets hold nan vertices; any finite stand-in keeps the arithmetic
-            # quiet, and their results are discarded below.
-            targets = np.where(usable[..., None], targets, 0.0)
-            robot, landmarks = transfer_support(self.kgon, hyp, targets)
-            robot_new[group] = robot
-            landmark_new[group] = landmarks
-
-        targets_ok = fr_status[ok, 2:] == FR_BOUNDED
-        update = targets_ok & np.all(np.isfinite(landmark_new), axis=-1)
-        map_rows = rows[ok]
-        which_map, which_landmark = np.nonzero(update)
-        new = landmark_new[which_map, which_landmark]
-        global_map = map_rows[which_map]
-        was_init = self.initialised[global_map, which_landmark]
-        fused = new.copy()
-        inconsistent = np.zeros(new.shape[0], dtype=bool)
-        if was_init.any():
-            old = self.support[global_map[was_init], which_landmark[was_init]]
-            merged, empty = self.kgon.intersect(old, new[was_init])
-            fallback = old if self.on_inconsistency == "keep" else new[was_init]
-            merged[empty] = fallback[empty]
-            fused[was_init] = merged
-            inconsistent[np.flatnonzero(was_init)[empty]] = True
-        landmark[ok[which_map], which_landmark] = np.where(
-            inconsistent, LANDMARK_CODE["inconsistent"], LANDMARK_CODE["updated"]
-        )
-        self.support[global_map, which_landmark] = fused
-        self.initialised[global_map, which_landmark] = True
-        area, centroid = self.kgon.area_centroid(fused)
-        self.areas[global_map, which_landmark] = area
-        self.centroids[global_map, which_landmark] = centroid
-
-        self.robot_support[map_rows] = robot_new
-        self.has_robot[map_rows] = True
-        robot_area, robot_centroid = self.kgon.area_centroid(robot_new)
-        self.robot_area[map_rows] = robot_area
-        self.robot_centroid[map_rows] = robot_centroid
-        # Heading: the FR x-axis seen through T at the vertex means of A_L1 and A_L2.
-        means = regions[ok, :2].mean(axis=-1)
-        self.robot_heading[map_rows] = -np.angle(means[:, 1] - means[:, 0])
-        self.n_frame_changes[map_rows] += 1
-
-    def _check_bearings(self, bearings: ArrayLike, n_rows: int, name: str) -> FloatArray:
-        arr = np.asarray(bearings, dtype=np.float64)
-        if arr.shape != (n_rows, self.n_landmarks):
-            raise ValueError(
-                f"{name} must have shape ({n_rows}, {self.n_landmarks}), got {arr.shape}"
-            )
-        if not np.all(np.isfinite(arr)):
-            raise ValueError(f"{name} must be finite, got {arr.tolist()}")
-        return arr
+        return BatchUpdateResult(frame == FRAME_CODE["ok"], frame, landmark, bad)
 
     def contains(self, points: ArrayLike, maps: ArrayLike | None = None) -> NDArray[np.bool_]:
         """Whether region ``i`` of each map contains FL point ``i`` (boundary counts).
@@ -284,33 +215,61 @@ class BatchedPolygonSLAM:
         Returns:
             Bool (len(maps), n_landmarks - 2); False where a landmark is not initialised.
         """
-        rows = np.arange(self.num_maps) if maps is None else np.asarray(maps, dtype=np.int64)
+        rows = self._check_maps(maps, distinct=False)
         z = np.asarray(points, dtype=np.complex128)
         if z.shape != (rows.size, self.n_landmarks - 2):
             raise ValueError(
                 f"points must have shape ({rows.size}, {self.n_landmarks - 2}), got {z.shape}"
             )
-        initialised = self.initialised[rows]
-        inside = np.zeros(z.shape, dtype=bool)
-        if initialised.any():
-            inside[initialised] = self.kgon.contains(self.support[rows][initialised], z[initialised])
+        inside = np.empty(z.shape, dtype=bool)
+        kernels.contains_points(
+            self.vertices, self.counts, rows, z, CONTAINMENT_TOLERANCE, inside
+        )
         return inside
 
-    def copy_map(self, source: int, target: int) -> None:
-        """Overwrite map ``target`` with map ``source`` (planning: clone a map in place)."""
-        for name in STATE_ARRAYS:
-            array = getattr(self, name)
-            array[target] = array[source]
+    def polygon(self, map_index: int, landmark: int) -> NDArray[np.complex128]:
+        """The vertices (CCW) of one region; empty if the landmark is not initialised."""
+        return self.vertices[map_index, landmark, : self.counts[map_index, landmark]].copy()
+
+    def robot_polygon(self, map_index: int) -> NDArray[np.complex128]:
+        """The vertices (CCW) of a map's robot region; empty before any frame change."""
+        return self.robot_vertices[map_index, : self.robot_counts[map_index]].copy()
+
+    def _check_maps(self, maps: ArrayLike | None, distinct: bool = True) -> IntArray:
+        if maps is None:
+            return np.arange(self.num_maps)
+        raw = np.asarray(maps)
+        if raw.dtype.kind not in "iu" or raw.ndim != 1:
+            raise TypeError(f"maps must be a 1-D array of int map indices, got {maps!r}")
+        rows = raw.astype(np.int64)
+        if rows.size and (rows.min() < 0 or rows.max() >= self.num_maps):
+            raise ValueError(
+                f"maps must be indices in [0, {self.num_maps}), got {rows.tolist()}"
+            )
+        if distinct and np.unique(rows).size != rows.size:
+            raise ValueError(f"maps must not repeat a map, got {rows.tolist()}")
+        return rows
+
+    def _check_bearings(self, bearings: ArrayLike, n_rows: int, name: str) -> FloatArray:
+        return check_bearings(bearings, (n_rows, self.n_landmarks), name)
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        # Out-of-band pickles (Ray's object store) hand back read-only buffers; the
+        # kernel writes the state in place.
+        for key, value in state.items():
+            if isinstance(value, np.ndarray) and not value.flags.writeable:
+                state[key] = value.copy()
+        self.__dict__.update(state)
 
 
 #: The per-map state, every array with the map axis first.
 STATE_ARRAYS = (
-    "support",
-    "initialised",
+    "vertices",
+    "counts",
     "areas",
     "centroids",
-    "robot_support",
-    "has_robot",
+    "robot_vertices",
+    "robot_counts",
     "robot_area",
     "robot_centroid",
     "robot_heading",
@@ -318,6 +277,19 @@ STATE_ARRAYS = (
     "n_frame_changes",
     "n_inconsistent",
 )
+
+
+def check_bearings(bearings: ArrayLike, shape: tuple[int, ...], name: str) -> FloatArray:
+    """Bearings as a float array of ``shape``, or a clear error naming the value."""
+    raw = np.asarray(bearings)
+    if raw.dtype.kind not in "iuf":
+        raise TypeError(f"{name} must be numbers (radians), got {bearings!r}")
+    arr = raw.astype(np.float64, copy=False)
+    if arr.shape != shape:
+        raise ValueError(f"{name} must have shape {shape}, got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
+    return np.ascontiguousarray(arr)
 
 
 def _int_at_least(value: object, minimum: int, name: str, why: str = "") -> int:

@@ -8,14 +8,16 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
 
+from bearing_env.slam import kernels
 from bearing_env.slam.batch import (
+    CONTAINMENT_TOLERANCE,
     FRAME_STATUSES,
     INCONSISTENCY_POLICIES,
     LANDMARK_STATUSES,
     STATE_ARRAYS,
     BatchedPolygonSLAM,
+    check_bearings,
 )
-from bearing_env.slam.geometry import KGon
 
 FRAME_OK, FRAME_L1_UNBOUNDED, FRAME_L2_UNBOUNDED, FRAME_L1_L2_OVERLAP, FRAME_L1_L2_TOO_CLOSE = (
     FRAME_STATUSES
@@ -100,21 +102,18 @@ class PolygonSLAM:
     landmark ``i >= 3``, the intersection of its FL regions over all movements that could
     change frames, and the robot's region at the end of the last such movement.
 
-    The map stores each region as a circumscribed K-gon with ``directions`` fixed
-    normals (see :mod:`bearing_env.slam.geometry`). That makes fusion exact and every
-    update one batched numpy computation; the price is that a region is the K-gon around
-    the transferred hull, slightly larger than the hull itself (never smaller, so
-    containment is preserved).
+    Each region is an exact convex polygon (see :mod:`bearing_env.slam.kernels`), and
+    every update runs in compiled code. With ``transfer="paper"`` a landmark's region is
+    exactly the intersection of the vertex hulls of its movements, as in the paper.
 
     Args:
         n_landmarks: number of landmarks, >= 3; landmark 0 is L1, landmark 1 is L2.
         epsilon: bearing error bound, radians, in (0, pi/2).
         transfer: ``"conservative"`` (regions contain the truth whenever the bearing
             noise is within +-epsilon) or ``"paper"`` (vertex hypotheses + hull).
-        directions: number K of normals of the region K-gons (even, >= 8).
-        edge_samples: samples per edge of A_L1 and A_L2 for the conservative transfer
-            (more are used, up to 8, when L1's and L2's regions are close relative to
-            their size).
+        edge_samples: samples per edge of A_L1 and A_L2 for the conservative transfer,
+            1..8 (more are used, up to 8, when L1's and L2's regions are close relative
+            to their size).
         on_inconsistency: what a landmark's region becomes when a movement's region
             misses it (the observations contradict epsilon): ``"restart"`` replaces it by
             the movement's region (the newest evidence; the old intersection is known to
@@ -126,7 +125,6 @@ class PolygonSLAM:
         n_landmarks: int,
         epsilon: float,
         transfer: str = "conservative",
-        directions: int = 32,
         edge_samples: int = 3,
         on_inconsistency: str = "restart",
     ) -> None:
@@ -135,7 +133,6 @@ class PolygonSLAM:
             n_landmarks,
             epsilon,
             transfer=transfer,
-            directions=directions,
             edge_samples=edge_samples,
             on_inconsistency=on_inconsistency,
         )
@@ -150,7 +147,6 @@ class PolygonSLAM:
         self.transfer = batch.transfer
         self.edge_samples = batch.edge_samples
         self.on_inconsistency = batch.on_inconsistency
-        self.kgon = batch.kgon
 
     @classmethod
     def view(cls, batch: BatchedPolygonSLAM, index: int) -> PolygonSLAM:
@@ -203,7 +199,6 @@ class PolygonSLAM:
             batch.n_landmarks,
             batch.epsilon,
             transfer=batch.transfer,
-            directions=batch.kgon.k,
             edge_samples=batch.edge_samples,
             on_inconsistency=batch.on_inconsistency,
         )
@@ -251,14 +246,7 @@ class PolygonSLAM:
         )
 
     def _check_bearings(self, bearings: ArrayLike, name: str) -> NDArray[np.float64]:
-        arr = np.asarray(bearings, dtype=np.float64)
-        if arr.shape != (self.n_landmarks,):
-            raise ValueError(
-                f"{name} must have shape ({self.n_landmarks},), got {arr.shape}"
-            )
-        if not np.all(np.isfinite(arr)):
-            raise ValueError(f"{name} must be finite, got {arr.tolist()}")
-        return arr
+        return check_bearings(bearings, (self.n_landmarks,), name)
 
     # -- queries -----------------------------------------------------------------------------
 
@@ -279,20 +267,12 @@ class PolygonSLAM:
         return np.stack([centroids.real, centroids.imag], axis=-1)
 
     @property
-    def supports(self) -> NDArray[np.float64]:
-        """Raw K-gon support values (n_landmarks - 2, K); ``inf`` rows if not initialised."""
-        return self._batch.support[self._index].copy()
-
-    @property
     def polygons(self) -> list[NDArray[np.float64] | None]:
         """Region vertices (k, 2) counter-clockwise in FL per landmark, or None."""
+        batch, index = self._batch, self._index
         return [
-            _kgon_vertices_xy(self.kgon, h) if ok else None
-            for h, ok in zip(
-                self._batch.support[self._index],
-                self._batch.initialised[self._index],
-                strict=True,
-            )
+            _xy(batch.polygon(index, j)) if batch.counts[index, j] else None
+            for j in range(self.n_landmarks - 2)
         ]
 
     @property
@@ -303,9 +283,9 @@ class PolygonSLAM:
     @property
     def robot_polygon(self) -> NDArray[np.float64] | None:
         """The robot's current region (R2 of the last frame-changing move) as vertices."""
-        if not self._batch.has_robot[self._index]:
+        if not self._batch.robot_counts[self._index]:
             return None
-        return _kgon_vertices_xy(self.kgon, self._batch.robot_support[self._index])
+        return _xy(self._batch.robot_polygon(self._index))
 
     @property
     def robot_region(self) -> shapely.Polygon | None:
@@ -334,27 +314,27 @@ class PolygonSLAM:
         False for landmarks that are not initialised.
         """
         z = _to_complex(points_fl)
-        ok = self._batch.initialised[self._index]
-        if z.shape != ok.shape:
+        if z.shape != (self.n_landmarks - 2,):
             raise ValueError(
                 f"points_fl must have shape ({self.n_landmarks - 2}, 2), got {np.shape(points_fl)}"
             )
-        inside = np.zeros(z.shape, dtype=bool)
-        inside[ok] = self.kgon.contains(self._batch.support[self._index][ok], z[ok])
-        return inside
+        return self._batch.contains(z[None], self._rows)[0]
 
     def robot_contains(self, point_fl: ArrayLike) -> bool:
         """Whether the robot's region contains ``point_fl`` (2,)."""
-        if not self._batch.has_robot[self._index]:
+        batch, index = self._batch, self._index
+        if not batch.robot_counts[index]:
             return False
-        support = self._batch.robot_support[self._index]
-        return bool(self.kgon.contains(support, _to_complex(point_fl)))
+        polygon = batch.robot_vertices[index]
+        return bool(
+            kernels.contains_point(
+                polygon,
+                int(batch.robot_counts[index]),
+                complex(_to_complex(point_fl)),
+                CONTAINMENT_TOLERANCE,
+            )
+        )
 
 
-def _kgon_vertices_xy(kgon: KGon, h: NDArray[np.float64]) -> NDArray[np.float64]:
-    v = kgon.vertices(h)
-    # Drop the zero-length edges that tightness leaves at sharp corners.
-    keep = np.abs(v - np.roll(v, 1)) > 1e-12 * (1.0 + np.abs(v).max())
-    if keep.sum() >= 3:
-        v = v[keep]
-    return np.stack([v.real, v.imag], axis=-1)
+def _xy(points: NDArray[np.complex128]) -> NDArray[np.float64]:
+    return np.stack([points.real, points.imag], axis=-1)
