@@ -118,70 +118,111 @@ def convex_hull(points: np.ndarray, n_points: int, out: np.ndarray) -> int:
     """Convex hull of ``points[:n_points]`` into ``out`` (CCW, no repeated or collinear
     vertices); returns its vertex count. ``out`` must hold ``n_points + 1`` points.
 
-    Andrew's monotone chain, after an Akl-Toussaint filter: points strictly inside the
-    octagon of the extreme points in eight directions cannot be hull vertices.
+    Quickhull, which costs about n log h for h hull vertices: the conservative transfer's
+    clouds have hundreds of points but a few dozen hull vertices. A chain from ``a`` to
+    ``b`` owns the points strictly to the right of ``a -> b`` (outside the hull so far);
+    its farthest point ``c`` is a hull vertex, and the chains ``a -> c`` and ``c -> b``
+    own what lies right of them. Points on a line through two hull vertices are dropped.
     """
-    if n_points <= 2:
-        for i in range(n_points):
-            out[i] = points[i]
-        if n_points == 2 and points[0] == points[1]:
-            return 1
-        return n_points
-    extreme = np.empty(8, dtype=np.int64)
-    best = np.empty(8)
-    for d in range(8):
-        extreme[d] = 0
-        best[d] = -np.inf
-    for i in range(n_points):
-        x, y = points[i].real, points[i].imag
-        # Outward normals at 180, 225, 270, 315, 0, 45, 90 and 135 degrees: CCW order.
-        values = (-x, -x - y, -y, x - y, x, x + y, y, y - x)
-        for d in range(8):
-            if values[d] > best[d]:
-                best[d] = values[d]
-                extreme[d] = i
-    keep = np.empty(n_points, dtype=np.int64)
-    n_keep = 0
-    for i in range(n_points):
+    if n_points == 0:
+        return 0
+    first = last = 0
+    for i in range(1, n_points):
         p = points[i]
-        inside = False  # strictly inside every edge of a non-degenerate octagon
-        for d in range(8):
-            a = points[extreme[d]]
-            b = points[extreme[(d + 1) % 8]]
-            if a == b:
-                continue
-            if not cross(b - a, p - a) > 0.0:
-                inside = False
-                break
-            inside = True
-        if not inside:
-            keep[n_keep] = i
-            n_keep += 1
-    xs = np.empty(n_keep)
-    ys = np.empty(n_keep)
-    for j in range(n_keep):
-        xs[j] = points[keep[j]].real
-        ys[j] = points[keep[j]].imag
-    by_y = np.argsort(ys, kind="mergesort")
-    order = by_y[np.argsort(xs[by_y], kind="mergesort")]
-    k = 0
-    for j in range(n_keep):  # lower chain
-        p = points[keep[order[j]]]
-        while k >= 2 and cross(out[k - 1] - out[k - 2], p - out[k - 2]) <= 0.0:
-            k -= 1
-        out[k] = p
-        k += 1
-    lower = k + 1
-    for j in range(n_keep - 2, -1, -1):  # upper chain
-        p = points[keep[order[j]]]
-        while k >= lower and cross(out[k - 1] - out[k - 2], p - out[k - 2]) <= 0.0:
-            k -= 1
-        out[k] = p
-        k += 1
-    k -= 1  # the last point repeats the first
-    if k == 2 and out[0] == out[1]:
+        lo, hi = points[first], points[last]
+        if p.real < lo.real or (p.real == lo.real and p.imag < lo.imag):
+            first = i
+        if p.real > hi.real or (p.real == hi.real and p.imag > hi.imag):
+            last = i
+    a, b = points[first], points[last]
+    out[0] = a
+    if a == b:
         return 1
-    return max(k, 1)
+    # Candidate indices, the lower side (right of a -> b) first, then the upper side.
+    index = np.empty(n_points, dtype=np.int64)
+    n_lower = 0
+    n_upper = 0
+    for i in range(n_points):
+        side = cross(b - a, points[i] - a)
+        if side < 0.0:
+            index[n_lower] = i
+            n_lower += 1
+    for i in range(n_points):
+        side = cross(b - a, points[i] - a)
+        if side > 0.0:
+            index[n_lower + n_upper] = i
+            n_upper += 1
+    # A stack of tasks: (kind, start, end, from, to); kind 0 = hull the chain from point
+    # `from` to point `to` over candidates index[start:end]; kind 1 = emit point `from`.
+    stack = np.empty((2 * n_points + 4, 5), dtype=np.int64)
+    top = 0
+    stack[top] = (0, n_lower, n_lower + n_upper, last, first)
+    top += 1
+    stack[top] = (1, 0, 0, last, 0)
+    top += 1
+    stack[top] = (0, 0, n_lower, first, last)
+    top += 1
+    k = 1
+    while top > 0:
+        top -= 1
+        kind, start, end, i_from, i_to = stack[top]
+        if kind == 1:
+            out[k] = points[i_from]
+            k += 1
+            continue
+        if end <= start:
+            continue
+        a, b = points[i_from], points[i_to]
+        far = start
+        far_side = 0.0
+        for j in range(start, end):
+            side = cross(b - a, points[index[j]] - a)
+            if side < far_side:
+                far_side = side
+                far = j
+        i_far = index[far]
+        c = points[i_far]
+        # Right of a -> c to the front, then right of c -> b; the rest is inside.
+        n_left = 0
+        for j in range(start, end):
+            if cross(c - a, points[index[j]] - a) < 0.0:
+                index[start + n_left], index[j] = index[j], index[start + n_left]
+                n_left += 1
+        n_right = 0
+        for j in range(start + n_left, end):
+            if cross(b - c, points[index[j]] - c) < 0.0:
+                slot = start + n_left + n_right
+                index[slot], index[j] = index[j], index[slot]
+                n_right += 1
+        mid = start + n_left
+        stack[top] = (0, mid, mid + n_right, i_far, i_to)
+        top += 1
+        stack[top] = (1, 0, 0, i_far, 0)
+        top += 1
+        stack[top] = (0, start, mid, i_from, i_far)
+        top += 1
+    return _convexify(out, k)
+
+
+@njit(**_JIT)
+def _convexify(poly: np.ndarray, n: int) -> int:
+    """Drop the vertices where a nearly convex CCW polygon does not turn left, in place.
+
+    Quickhull decides sides with rounded cross products; among nearly collinear points it
+    can emit one out of order, a spike of zero width. ``poly[0]`` is the leftmost point,
+    a true hull vertex, so one stack pass (as in Graham's scan) repairs the order.
+    """
+    if n < 3:
+        return n
+    k = 1
+    for i in range(1, n + 1):
+        p = poly[i % n]
+        while k >= 2 and cross(poly[k - 1] - poly[k - 2], p - poly[k - 2]) <= 0.0:
+            k -= 1
+        if i < n:
+            poly[k] = p
+            k += 1
+    return k
 
 
 # --------------------------------------------------------------------------------------
@@ -655,6 +696,10 @@ def transfer_region(
             cloud[k] = (z - h1[p]) * inv_d[p]
             k += 1
     n = convex_hull(cloud, k, hull)
+    # Rounding can leave hull vertices a hair apart or off their neighbours' line; their
+    # edge directions would be noise, and the offset needs true ones.
+    size, magnitude = scale_of(hull, n)
+    n = simplify(hull, n, tolerance_of(size, magnitude))
     if conservative:
         v1 = 0.0
         v2 = 0.0
