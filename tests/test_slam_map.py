@@ -5,6 +5,8 @@ promise that the world model imports neither gymnasium nor pygame.
 
 from __future__ import annotations
 
+import pickle
+import re
 import subprocess
 import sys
 import textwrap
@@ -25,6 +27,7 @@ from bearing_env.slam import (
     LANDMARK_SKIPPED,
     LANDMARK_UNBOUNDED,
     LANDMARK_UPDATED,
+    BatchedPolygonSLAM,
     PolygonSLAM,
     UpdateResult,
     world_to_fl,
@@ -658,3 +661,59 @@ def test_world_to_fl_is_exported_and_agrees_with_the_simulator():
     got = world_to_fl(pts, pts[0], pts[1])
     z = pts[:, 0] + 1j * pts[:, 1]
     np.testing.assert_allclose(got, to_xy(fl(z, z[0], z[1])), atol=1e-12)
+
+
+# --------------------------------------------------------------------------------------
+# Input types, map indices, and pickles with read-only buffers
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("epsilon", ["0.1", None, True, 1j, [0.1]])
+def test_epsilon_must_be_a_number(epsilon):
+    with pytest.raises(TypeError, match=rf"epsilon.*{re.escape(repr(epsilon))}"):
+        PolygonSLAM(4, epsilon)
+
+
+@pytest.mark.parametrize("bearings", [["0.1", "0.2", "0.3", "0.4"], np.array(["1"] * 4), [1j] * 4])
+def test_bearings_must_be_numbers(bearings):
+    slam = PolygonSLAM(4, EPS)
+    good = readings(GOOD, R1, R2)[0]
+    with pytest.raises(TypeError, match="bearings_start must be numbers"):
+        slam.update(bearings, good)
+
+
+@pytest.mark.parametrize(
+    ("maps", "error", "pattern"),
+    [
+        ([-1, 0], ValueError, r"\[-1, 0\]"),
+        ([0, 3], ValueError, r"\[0, 3\]"),
+        ([1, 1], ValueError, r"repeat.*\[1, 1\]"),
+        ([1.7, 0.0], TypeError, r"1\.7"),
+        ([True, False], TypeError, r"True"),
+    ],
+)
+def test_batched_update_rejects_bad_map_indices(maps, error, pattern):
+    batch = BatchedPolygonSLAM(3, 4, EPS)
+    b1, b2 = readings(GOOD, R1, R2)
+    with pytest.raises(error, match=pattern):
+        batch.update(np.stack([b1, b1]), np.stack([b2, b2]), maps=maps)
+    assert batch.n_updates.tolist() == [0, 0, 0]  # nothing was half-done
+
+
+def read_only_round_trip(obj):
+    """Pickle out of band, as Ray's object store does, and hand back read-only buffers."""
+    buffers: list[pickle.PickleBuffer] = []
+    data = pickle.dumps(obj, protocol=5, buffer_callback=buffers.append)
+    return pickle.loads(data, buffers=[memoryview(b).toreadonly() for b in buffers])
+
+
+def test_a_map_from_read_only_buffers_still_updates_and_matches_the_original():
+    moves = random_episode(np.random.default_rng(3), 5, 6).readings(EPS)
+    slam = PolygonSLAM(5, EPS)
+    for b1, b2 in moves[:3]:
+        slam.update(b1, b2)
+    copy = read_only_round_trip(slam)
+    for b1, b2 in moves[3:]:
+        slam.update(b1, b2)
+        copy.update(b1, b2)
+    assert_same_state(state(slam), state(copy))

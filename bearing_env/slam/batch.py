@@ -281,6 +281,14 @@ STATE_ARRAYS = (
 
 def check_bearings(bearings: ArrayLike, shape: tuple[int, ...], name: str) -> FloatArray:
     """Bearings as a float array of ``shape``, or a clear error naming the value."""
+    if (
+        type(bearings) is np.ndarray
+        and bearings.dtype == np.float64
+        and bearings.shape == shape
+        and bearings.flags.c_contiguous
+        and kernels.all_finite(bearings)
+    ):
+        return bearings  # the common case, checked without temporaries
     raw = np.asarray(bearings)
     if raw.dtype.kind not in "iuf":
         raise TypeError(f"{name} must be numbers (radians), got {bearings!r}")

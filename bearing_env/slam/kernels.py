@@ -857,6 +857,15 @@ def update_maps(
 
 
 @njit(**_JIT)
+def all_finite(values: np.ndarray) -> bool:
+    """Whether every element of a float array is finite (one pass, no temporaries)."""
+    for value in values.ravel():
+        if not np.isfinite(value):
+            return False
+    return True
+
+
+@njit(**_JIT)
 def contains_points(
     vertices: np.ndarray, counts: np.ndarray, rows: np.ndarray, points: np.ndarray,
     relative: float, out: np.ndarray,
