@@ -85,7 +85,7 @@ def simulate_potentials(
     bearings_start = bearings_from(start, headings, targets)
     bearings_end = np.where(known, bearings_from(ends, headings, targets), bearings_start)
     trials = slam.replicate(len(moving))
-    trials.update(bearings_start, bearings_end)
+    trials.update(bearings_start, bearings_end, robot=False)  # scores need areas only
     potentials[moving] = uncertainty_potential(trials.areas, area_cap)
     return potentials
 

@@ -717,3 +717,18 @@ def test_a_map_from_read_only_buffers_still_updates_and_matches_the_original():
         slam.update(b1, b2)
         copy.update(b1, b2)
     assert_same_state(state(slam), state(copy))
+
+
+def test_an_update_without_the_robot_maps_the_same_landmarks_and_keeps_the_old_robot():
+    moves = random_episode(np.random.default_rng(11), 6, 8).readings(EPS)
+    full, lean = BatchedPolygonSLAM(1, 6, EPS), BatchedPolygonSLAM(1, 6, EPS)
+    for b1, b2 in moves:
+        robot_before = (lean.robot_counts.copy(), lean.robot_area.copy())
+        a = full.update(b1[None], b2[None])
+        b = lean.update(b1[None], b2[None], robot=False)
+        np.testing.assert_array_equal(a.landmark_status, b.landmark_status)
+        np.testing.assert_array_equal(full.areas, lean.areas)
+        np.testing.assert_array_equal(full.vertices, lean.vertices)
+        np.testing.assert_array_equal(lean.robot_counts, robot_before[0])
+        np.testing.assert_array_equal(lean.robot_area, robot_before[1])
+    assert full.robot_counts[0] > 0 and lean.robot_counts[0] == 0

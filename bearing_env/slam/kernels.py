@@ -152,55 +152,64 @@ def convex_hull(points: np.ndarray, n_points: int, out: np.ndarray) -> int:
         if side > 0.0:
             index[n_lower + n_upper] = i
             n_upper += 1
-    # A stack of tasks: (kind, start, end, from, to); kind 0 = hull the chain from point
-    # `from` to point `to` over candidates index[start:end]; kind 1 = emit point `from`.
-    stack = np.empty((2 * n_points + 4, 5), dtype=np.int64)
-    top = 0
-    stack[top] = (0, n_lower, n_lower + n_upper, last, first)
-    top += 1
-    stack[top] = (1, 0, 0, last, 0)
-    top += 1
-    stack[top] = (0, 0, n_lower, first, last)
-    top += 1
+    # A stack of tasks: hull the chain from point `chain_from` to `chain_to` over the
+    # candidates index[start:end]; a task with start < 0 emits point `chain_from` instead.
+    size = 2 * n_points + 4
+    task_start = np.empty(size, dtype=np.int64)
+    task_end = np.empty(size, dtype=np.int64)
+    chain_from = np.empty(size, dtype=np.int64)
+    chain_to = np.empty(size, dtype=np.int64)
+    task_start[0], task_end[0], chain_from[0], chain_to[0] = n_lower, n_lower + n_upper, last, first
+    task_start[1], chain_from[1] = -1, last
+    task_start[2], task_end[2], chain_from[2], chain_to[2] = 0, n_lower, first, last
+    top = 3
     k = 1
     while top > 0:
         top -= 1
-        kind, start, end, i_from, i_to = stack[top]
-        if kind == 1:
+        start, end, i_from, i_to = task_start[top], task_end[top], chain_from[top], chain_to[top]
+        if start < 0:
             out[k] = points[i_from]
             k += 1
             continue
         if end <= start:
             continue
-        a, b = points[i_from], points[i_to]
+        ax, ay = points[i_from].real, points[i_from].imag
+        bx, by = points[i_to].real - ax, points[i_to].imag - ay
         far = start
         far_side = 0.0
         for j in range(start, end):
-            side = cross(b - a, points[index[j]] - a)
+            p = points[index[j]]
+            side = bx * (p.imag - ay) - by * (p.real - ax)
             if side < far_side:
                 far_side = side
                 far = j
         i_far = index[far]
-        c = points[i_far]
+        cx, cy = points[i_far].real, points[i_far].imag
         # Right of a -> c to the front, then right of c -> b; the rest is inside.
+        ux, uy = cx - ax, cy - ay
         n_left = 0
         for j in range(start, end):
-            if cross(c - a, points[index[j]] - a) < 0.0:
+            p = points[index[j]]
+            if ux * (p.imag - ay) - uy * (p.real - ax) < 0.0:
                 index[start + n_left], index[j] = index[j], index[start + n_left]
                 n_left += 1
+        vx, vy = points[i_to].real - cx, points[i_to].imag - cy
         n_right = 0
         for j in range(start + n_left, end):
-            if cross(b - c, points[index[j]] - c) < 0.0:
+            p = points[index[j]]
+            if vx * (p.imag - cy) - vy * (p.real - cx) < 0.0:
                 slot = start + n_left + n_right
                 index[slot], index[j] = index[j], index[slot]
                 n_right += 1
         mid = start + n_left
-        stack[top] = (0, mid, mid + n_right, i_far, i_to)
-        top += 1
-        stack[top] = (1, 0, 0, i_far, 0)
-        top += 1
-        stack[top] = (0, start, mid, i_from, i_far)
-        top += 1
+        task_start[top], task_end[top], chain_from[top], chain_to[top] = (
+            mid, mid + n_right, i_far, i_to
+        )
+        task_start[top + 1], chain_from[top + 1] = -1, i_far
+        task_start[top + 2], task_end[top + 2], chain_from[top + 2], chain_to[top + 2] = (
+            start, mid, i_from, i_far
+        )
+        top += 3
     return _convexify(out, k)
 
 
@@ -733,6 +742,7 @@ def update_maps(
     conservative: bool,
     edge_samples: int,
     keep_on_inconsistency: bool,
+    with_robot: bool,
     vertices: np.ndarray,
     counts: np.ndarray,
     areas: np.ndarray,
@@ -752,8 +762,9 @@ def update_maps(
     """Fuse one movement into each map ``rows[i]`` (bearings row ``i``), in place.
 
     A map's state is its regions (``vertices[map, j, :counts[map, j]]``; count 0 means
-    not initialised), their areas and centroids, and the robot's region. Each map is
-    updated on its own, so its result never depends on the other maps of the batch.
+    not initialised), their areas and centroids, and the robot's region and heading
+    (left as they were when ``with_robot`` is False). Each map is updated on its own, so
+    its result never depends on the other maps of the batch.
     """
     n_landmarks = bearings_start.shape[1]
     fr = np.empty((n_landmarks, FR_VERTICES), dtype=np.complex128)
@@ -827,6 +838,15 @@ def update_maps(
             area, centroid = area_centroid(vertices[row, slot], n_result)
             areas[row, slot] = area
             centroids[row, slot] = centroid
+        n_frame_changes[row] += 1
+        bad = 0
+        for j in range(n_landmarks - 2):
+            if landmark_status[i, j] == LANDMARK_INCONSISTENT:
+                bad += 1
+        inconsistent_now[i] = bad
+        n_inconsistent[row] += bad
+        if not with_robot:
+            continue
         n_robot = transfer_region(
             robot_point, 1, a1, n1, a2, n2, h1, inv_d, n_pairs, conservative,
             distance, delta1, delta2, cloud, hull, fresh,
@@ -847,13 +867,6 @@ def update_maps(
             mean2 += a2[v]
         chord = mean2 / n2 - mean1 / n1
         robot_heading[row] = -math.atan2(chord.imag, chord.real)
-        n_frame_changes[row] += 1
-        bad = 0
-        for j in range(n_landmarks - 2):
-            if landmark_status[i, j] == LANDMARK_INCONSISTENT:
-                bad += 1
-        inconsistent_now[i] = bad
-        n_inconsistent[row] += bad
 
 
 @njit(**_JIT)
