@@ -247,3 +247,23 @@ def test_ppo_rounds_are_interleaved_and_the_median_counts(tmp_path: Path) -> Non
         assert row["steps"] == sum(figure["steps"] for figure in rounds)
         rates = sorted(figure["steps_per_s"] for figure in rounds)
         assert row["steps_per_s"] == pytest.approx(rates[1])
+
+
+def test_quick_slam_and_startup(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    results, _ = run_quick(tmp_path, "--sections", "slam,startup")
+    check_common(results, {"slam", "startup"})
+    rows = {(row["transfer"], row["n_landmarks"]): row for row in results["slam"]}
+    assert set(rows) == {(t, n) for t in ("conservative", "paper") for n in (4, 64)}
+    for row in rows.values():
+        assert positive_finite(row["steps_per_s"]) and positive_finite(row["ratio_to_cartpole"])
+    startup = results["startup"]
+    assert len(startup["warm_runs_s"]) == bench_env.STARTUP_WARM_RUNS
+    assert startup["warm_first_step_s"] == sorted(startup["warm_runs_s"])[1]
+    # Compiling from an empty cache takes longer than loading it (by far: seconds vs ~1).
+    assert startup["cold_first_step_s"] > startup["warm_first_step_s"]
+    targets = {target["id"]: target for target in results["targets"]}
+    assert targets["e"]["value"] == rows[("conservative", 4)]["ratio_to_cartpole"]
+    assert targets["f"]["value"] == startup["warm_first_step_s"]
+    assert targets["f"]["met"] == (startup["warm_first_step_s"] <= 1.5)
+    out = capsys.readouterr().out
+    assert "update(), conservative, 4 landmarks" in out and "Start-up" in out
