@@ -30,8 +30,10 @@ from bearing_env.slam import (
     BatchedPolygonSLAM,
     PolygonSLAM,
     UpdateResult,
+    kernels,
     world_to_fl,
 )
+from bearing_env.slam.batch import STATE_ARRAYS
 from tests.slam_sim import Episode, fl, random_episode, run, to_xy, true_bearings
 
 EPS = np.deg2rad(2.0)
@@ -732,3 +734,34 @@ def test_an_update_without_the_robot_maps_the_same_landmarks_and_keeps_the_old_r
         np.testing.assert_array_equal(lean.robot_counts, robot_before[0])
         np.testing.assert_array_equal(lean.robot_area, robot_before[1])
     assert full.robot_counts[0] > 0 and lean.robot_counts[0] == 0
+
+
+@pytest.mark.parametrize("transfer", ["conservative", "paper"])
+def test_the_threaded_kernel_gives_the_serial_kernels_maps_bit_for_bit(transfer):
+    episodes = [random_episode(np.random.default_rng(40 + i), 5, 8) for i in range(16)]
+    readings = [episode.readings(EPS) for episode in episodes]
+    serial = BatchedPolygonSLAM(16, 5, EPS, transfer=transfer)
+    threaded = BatchedPolygonSLAM(16, 5, EPS, transfer=transfer)
+    rows = np.arange(16)
+    for move in range(8):
+        b1 = np.array([r[move][0] for r in readings])
+        b2 = np.array([r[move][1] for r in readings])
+        outputs = []
+        for batch, threads in ((serial, 0), (threaded, 4)):
+            frame = np.empty(16, dtype=np.int8)
+            landmark = np.empty((16, 3), dtype=np.int8)
+            bad = np.empty(16, dtype=np.int64)
+            arguments = (
+                b1, b2, rows, EPS, transfer == "conservative", 3, False, True,
+                *(getattr(batch, name) for name in STATE_ARRAYS), frame, landmark, bad,
+            )
+            if threads:
+                kernels.update_maps_parallel(threads, *arguments)  # 4 blocks, any cores
+            else:
+                kernels.update_maps(*arguments)
+            outputs.append((frame, landmark, bad))
+        for mine, theirs in zip(*outputs, strict=True):
+            np.testing.assert_array_equal(mine, theirs)
+    for name in STATE_ARRAYS:
+        np.testing.assert_array_equal(getattr(serial, name), getattr(threaded, name), name)
+    assert serial.n_frame_changes.sum() > 16  # real fusions were compared

@@ -45,6 +45,10 @@ LANDMARK_CODE = {name: code for code, name in enumerate(LANDMARK_STATUSES)}
 
 INCONSISTENCY_POLICIES = ("restart", "keep")
 
+#: Batches of at least this many maps are updated on all of numba's threads
+#: (``NUMBA_NUM_THREADS``; see :func:`bearing_env.slam.kernels.threads`).
+PARALLEL_MIN_MAPS = 8
+
 #: How far outside a region a point may lie and still count as inside, relative to the
 #: region's size: far above rounding, far below any bearing error.
 CONTAINMENT_TOLERANCE = 1e-9
@@ -183,7 +187,7 @@ class BatchedPolygonSLAM:
         frame = np.empty(n_rows, dtype=np.int8)
         landmark = np.empty((n_rows, n_mapped), dtype=np.int8)
         bad = np.empty(n_rows, dtype=np.int64)
-        kernels.update_maps(
+        arguments = (
             b1,
             b2,
             rows,
@@ -192,22 +196,16 @@ class BatchedPolygonSLAM:
             self.edge_samples,
             self.on_inconsistency == "keep",
             bool(robot),
-            self.vertices,
-            self.counts,
-            self.areas,
-            self.centroids,
-            self.robot_vertices,
-            self.robot_counts,
-            self.robot_area,
-            self.robot_centroid,
-            self.robot_heading,
-            self.n_updates,
-            self.n_frame_changes,
-            self.n_inconsistent,
+            *(getattr(self, name) for name in STATE_ARRAYS),
             frame,
             landmark,
             bad,
         )
+        threads = kernels.threads()
+        if n_rows >= PARALLEL_MIN_MAPS and threads > 1:
+            kernels.update_maps_parallel(min(n_rows, threads), *arguments)
+        else:
+            kernels.update_maps(*arguments)
         return BatchUpdateResult(frame == FRAME_CODE["ok"], frame, landmark, bad)
 
     def contains(self, points: ArrayLike, maps: ArrayLike | None = None) -> NDArray[np.bool_]:
@@ -267,7 +265,8 @@ class BatchedPolygonSLAM:
         self.__dict__.update(state)
 
 
-#: The per-map state, every array with the map axis first.
+#: The per-map state, every array with the map axis first, in the order the kernels of
+#: :mod:`bearing_env.slam.kernels` take them.
 STATE_ARRAYS = (
     "vertices",
     "counts",

@@ -24,7 +24,9 @@ one does.
 from __future__ import annotations
 
 import math
+import os
 
+import numba
 import numpy as np
 from numba import njit
 
@@ -68,6 +70,17 @@ LANDMARK_INCONSISTENT = 2
 LANDMARK_SKIPPED = 3
 
 _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
+
+# OpenMP's default busy-waiting made prange several times slower than serial code on a
+# 2-core machine; numba's own workqueue layer waits passively. A layer chosen by the user
+# (NUMBA_THREADING_LAYER) is left alone.
+if "NUMBA_THREADING_LAYER" not in os.environ:
+    numba.config.THREADING_LAYER = "workqueue"
+
+
+def threads() -> int:
+    """Threads the batched update may use: numba's current thread count."""
+    return int(numba.get_num_threads())
 _TWO_PI = 2.0 * math.pi
 
 
@@ -734,7 +747,9 @@ def transfer_region(
 
 
 @njit(**_JIT)
-def update_maps(
+def _update_rows(
+    first: int,
+    stop: int,
     bearings_start: np.ndarray,
     bearings_end: np.ndarray,
     rows: np.ndarray,
@@ -759,13 +774,7 @@ def update_maps(
     landmark_status: np.ndarray,
     inconsistent_now: np.ndarray,
 ) -> None:
-    """Fuse one movement into each map ``rows[i]`` (bearings row ``i``), in place.
-
-    A map's state is its regions (``vertices[map, j, :counts[map, j]]``; count 0 means
-    not initialised), their areas and centroids, and the robot's region and heading
-    (left as they were when ``with_robot`` is False). Each map is updated on its own, so
-    its result never depends on the other maps of the batch.
-    """
+    """:func:`update_maps` for bearings rows ``first`` to ``stop``, with scratch of its own."""
     n_landmarks = bearings_start.shape[1]
     fr = np.empty((n_landmarks, FR_VERTICES), dtype=np.complex128)
     fr_count = np.empty(n_landmarks, dtype=np.int64)
@@ -778,7 +787,7 @@ def update_maps(
     fused = np.empty(SCRATCH, dtype=np.complex128)
     work = np.empty(SCRATCH, dtype=np.complex128)
     robot_point = np.ones(1, dtype=np.complex128)
-    for i in range(rows.shape[0]):
+    for i in range(first, stop):
         row = rows[i]
         n_updates[row] += 1
         inconsistent_now[i] = 0
@@ -867,6 +876,131 @@ def update_maps(
             mean2 += a2[v]
         chord = mean2 / n2 - mean1 / n1
         robot_heading[row] = -math.atan2(chord.imag, chord.real)
+
+
+@njit(**_JIT)
+def update_maps(
+    bearings_start: np.ndarray,
+    bearings_end: np.ndarray,
+    rows: np.ndarray,
+    epsilon: float,
+    conservative: bool,
+    edge_samples: int,
+    keep_on_inconsistency: bool,
+    with_robot: bool,
+    vertices: np.ndarray,
+    counts: np.ndarray,
+    areas: np.ndarray,
+    centroids: np.ndarray,
+    robot_vertices: np.ndarray,
+    robot_counts: np.ndarray,
+    robot_area: np.ndarray,
+    robot_centroid: np.ndarray,
+    robot_heading: np.ndarray,
+    n_updates: np.ndarray,
+    n_frame_changes: np.ndarray,
+    n_inconsistent: np.ndarray,
+    frame_status: np.ndarray,
+    landmark_status: np.ndarray,
+    inconsistent_now: np.ndarray,
+) -> None:
+    """Fuse one movement into each map ``rows[i]`` (bearings row ``i``), in place.
+
+    A map's state is its regions (``vertices[map, j, :counts[map, j]]``; count 0 means
+    not initialised), their areas and centroids, and the robot's region and heading
+    (left as they were when ``with_robot`` is False). Each map is updated on its own, so
+    its result never depends on the other maps of the batch.
+    """
+    _update_rows(
+        0,
+        rows.shape[0],
+        bearings_start,
+        bearings_end,
+        rows,
+        epsilon,
+        conservative,
+        edge_samples,
+        keep_on_inconsistency,
+        with_robot,
+        vertices,
+        counts,
+        areas,
+        centroids,
+        robot_vertices,
+        robot_counts,
+        robot_area,
+        robot_centroid,
+        robot_heading,
+        n_updates,
+        n_frame_changes,
+        n_inconsistent,
+        frame_status,
+        landmark_status,
+        inconsistent_now,
+    )
+
+
+@njit(parallel=True, **_JIT)
+def update_maps_parallel(
+    blocks: int,
+    bearings_start: np.ndarray,
+    bearings_end: np.ndarray,
+    rows: np.ndarray,
+    epsilon: float,
+    conservative: bool,
+    edge_samples: int,
+    keep_on_inconsistency: bool,
+    with_robot: bool,
+    vertices: np.ndarray,
+    counts: np.ndarray,
+    areas: np.ndarray,
+    centroids: np.ndarray,
+    robot_vertices: np.ndarray,
+    robot_counts: np.ndarray,
+    robot_area: np.ndarray,
+    robot_centroid: np.ndarray,
+    robot_heading: np.ndarray,
+    n_updates: np.ndarray,
+    n_frame_changes: np.ndarray,
+    n_inconsistent: np.ndarray,
+    frame_status: np.ndarray,
+    landmark_status: np.ndarray,
+    inconsistent_now: np.ndarray,
+) -> None:
+    """:func:`update_maps` with the maps split into ``blocks`` blocks, one per thread.
+
+    Each map is computed by the same code as in the serial kernel, so the results are
+    the same bit for bit; only the order in which maps are done changes.
+    """
+    n_rows = rows.shape[0]
+    for block in numba.prange(blocks):
+        _update_rows(
+            block * n_rows // blocks,
+            (block + 1) * n_rows // blocks,
+            bearings_start,
+            bearings_end,
+            rows,
+            epsilon,
+            conservative,
+            edge_samples,
+            keep_on_inconsistency,
+            with_robot,
+            vertices,
+            counts,
+            areas,
+            centroids,
+            robot_vertices,
+            robot_counts,
+            robot_area,
+            robot_centroid,
+            robot_heading,
+            n_updates,
+            n_frame_changes,
+            n_inconsistent,
+            frame_status,
+            landmark_status,
+            inconsistent_now,
+        )
 
 
 @njit(**_JIT)
