@@ -163,7 +163,10 @@ def test_pickle_round_trip_continues_identically(env_id: str) -> None:
     clone = pickle.loads(pickle.dumps(env))
     actions = [env.action_space.sample() for _ in range(5)]
     for action in actions:
-        assert_same(env.step(action), clone.step(action))
+        result = env.step(action)
+        assert_same(result, clone.step(action))
+        if result[2] or result[3]:  # an ended episode must be reset before stepping on
+            assert_same(env.reset(), clone.reset())
     assert clone.render().shape == env.render().shape
 
 

@@ -234,8 +234,9 @@ def test_pickle_round_trip_continues_identically() -> None:
     for a in actions[4:]:
         assert_same(env.step(a), clone.step(a))
     # The clone's sub-envs still share one map batch of their own.
-    assert clone.envs[0].slam.batch is clone.envs[2].slam.batch
-    assert clone.envs[0].slam.batch is not env.envs[0].slam.batch
+    clone_maps, maps = clone.get_attr("slam"), env.get_attr("slam")
+    assert clone_maps[0].batch is clone_maps[2].batch
+    assert clone_maps[0].batch is not maps[0].batch
 
 
 def _step_in_subprocess(queue: Any) -> None:
