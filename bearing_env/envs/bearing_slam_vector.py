@@ -239,13 +239,9 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             infos = self._merge_rows(infos, group_infos, rows)
             if self.autoreset_mode == AutoresetMode.SAME_STEP:
                 ended = np.flatnonzero(terminations[rows] | truncations[rows])
-                for j in ended.tolist():
-                    final = {
-                        "final_obs": observations[rows[j]].copy(),
-                        "final_info": core.row_info(group_infos, j),
-                    }
-                    infos = self._add_info(infos, final, int(rows[j]))
-                finished.append(rows[ended])
+                if ended.size:
+                    infos = self._merge_final(infos, rows[ended], observations, group_infos, ended)
+                    finished.append(rows[ended])
         if finished:  # SAME_STEP: reset at once, the reset's observation and info returned
             infos = self._reset_rows(np.concatenate(finished), observations, infos)
         infos = self._reset_rows(np.flatnonzero(resetting), observations, infos)
@@ -466,6 +462,28 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             padded[key][..., : values.shape[-1]] = values
         return padded
 
+    def _merge_final(
+        self,
+        infos: dict[str, Any],
+        rows: IntArray,
+        observations: NDArray[np.float32],
+        group_infos: dict[str, Any],
+        group_rows: IntArray,
+    ) -> dict[str, Any]:
+        """What ``_add_info`` builds from ``{"final_obs": ..., "final_info": ...}`` of each
+        finished sub-env (``rows``; ``group_rows`` are their positions in ``group_infos``)."""
+        # Gymnasium keeps final observations in an object array, one array per sub-env.
+        final_obs = infos.get("final_obs")
+        if final_obs is None:
+            final_obs = np.full(self.num_envs, None, dtype=object)
+        for row in rows.tolist():
+            final_obs[row] = observations[row].copy()
+        mask = infos.get("_final_obs", np.zeros(self.num_envs, dtype=np.bool_))
+        mask[rows] = True
+        infos["final_obs"], infos["_final_obs"] = final_obs, mask
+        finals = _select_rows(group_infos, group_rows)
+        return self._merge_rows(infos, {"final_info": finals}, rows)
+
     def _merge_rows(
         self, infos: dict[str, Any], batched: dict[str, Any], rows: IntArray
     ) -> dict[str, Any]:
@@ -497,6 +515,14 @@ class BearingSLAMDiscreteVectorEnv(BearingSLAMVectorEnv):
 _ROW_ATTRIBUTES = frozenset(
     {"n_landmarks", "slam", "world", "observation_space", "action_space"}
 )
+
+
+def _select_rows(batched: dict[str, Any], rows: IntArray) -> dict[str, Any]:
+    """Batched infos restricted to some of their rows (nested dicts included)."""
+    return {
+        key: _select_rows(value, rows) if isinstance(value, dict) else value[rows]
+        for key, value in batched.items()
+    }
 
 
 def _is_int(value: Any) -> bool:
