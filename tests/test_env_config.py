@@ -217,3 +217,21 @@ def test_vector_set_attr_validates_every_value_before_applying_any() -> None:
         env.get_attr("no_such_attribute")
     env.set_attr("label", ["a", "b", "c"])  # not a setting: kept per sub-env
     assert env.get_attr("label") == ("a", "b", "c")
+
+
+def test_a_new_epsilon_gives_a_new_empty_map() -> None:
+    env = BearingSLAMEnv(scenario="khepera")
+    env.reset(seed=0)
+    for turn in (0.5, -0.6, 0.7, -0.4):
+        env.step(np.array([turn, 0.5], dtype=np.float32))
+    assert np.isfinite(env.slam.areas).any()  # the 2-degree map has regions
+    env.epsilon_deg = 3.0
+    assert env.slam.epsilon == pytest.approx(math.radians(3.0))
+    assert not np.isfinite(env.slam.areas).any()
+    env.step(np.array([0.5, 0.5], dtype=np.float32))
+    env.epsilon_deg = 2.0  # back: an empty map again, not the stale 2-degree one
+    assert not np.isfinite(env.slam.areas).any()
+    with pytest.raises(ValueError, match="max_landmarks"):
+        env.config = env.config.replace(max_landmarks=10)
+    with pytest.raises(TypeError, match="EnvConfig"):
+        env.config = {"scenario": "khepera"}  # type: ignore[assignment]

@@ -348,8 +348,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
                 f"unknown render_mode {render_mode!r}; expected None or one of "
                 f"{tuple(self.metadata['render_modes'])}"
             )
-        #: All the settings; assigning a setting attribute replaces it (validated).
-        self.config = config
+        self._config = config
         self.render_mode = render_mode
         self.action_space = self._make_action_space()
         self.observation_space = observation_space(config)
@@ -365,8 +364,20 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         return spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
 
     # ------------------------------------------------------------------------------------
-    # Read-only views
+    # Settings and read-only views
     # ------------------------------------------------------------------------------------
+
+    @property
+    def config(self) -> EnvConfig:
+        """All the settings; assigning a setting attribute replaces it (validated)."""
+        return self._config
+
+    @config.setter
+    def config(self, config: EnvConfig) -> None:
+        grid_fixed = isinstance(self.action_space, spaces.Discrete)
+        core.check_config_switch(self._config, config, action_grid_fixed=grid_fixed)
+        core.switch_maps(self._state, self._maps, 0, self._config, config)
+        self._config = config
 
     @property
     def epsilon(self) -> float:

@@ -312,6 +312,9 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             for extras, value in zip(self._extra_attributes, values, strict=True):
                 extras[name] = value
             return
+        grid_fixed = self.decode_actions is not core.decode_continuous
+        for row, config in enumerate(configs):
+            core.check_config_switch(self._row_config(row), config, grid_fixed)
         for row, config in enumerate(configs):
             self._set_row_config(row, config)
 
@@ -341,22 +344,10 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         return self._config_table[int(self._config_index[row])]
 
     def _set_row_config(self, row: int, config: EnvConfig) -> None:
-        old = self._row_config(row)
-        if config.max_landmarks != old.max_landmarks:
-            raise ValueError(
-                f"max_landmarks cannot change ({old.max_landmarks} -> {config.max_landmarks}): "
-                "it fixes the observation space"
-            )
-        if (config.n_turns, config.n_move_lengths) != (old.n_turns, old.n_move_lengths) and (
-            self.decode_actions is not core.decode_continuous
-        ):
-            raise ValueError("n_turns and n_move_lengths cannot change: they fix the action space")
+        core.switch_maps(self._state, self._maps, row, self._row_config(row), config)
         if config not in self._config_table:
             self._config_table.append(config)
         self._config_index[row] = self._config_table.index(config)
-        if (config.epsilon, config.transfer) != (old.epsilon, old.transfer):
-            # The map batch changes: the sub-env starts on an empty map there.
-            self._maps.batch(int(self._state.n_landmarks[row]), config).reset([row])
 
     def _rng(self, row: int) -> np.random.Generator:
         rng = self._rngs[row]

@@ -218,6 +218,36 @@ class MapBank:
         return self._views[key]
 
 
+def check_config_switch(old: EnvConfig, new: EnvConfig, action_grid_fixed: bool) -> None:
+    """Raise unless a live env may change its config from ``old`` to ``new``: the
+    observation space (``max_landmarks``) and, for discrete envs (``action_grid_fixed``),
+    the action grid cannot change."""
+    if not isinstance(new, EnvConfig):
+        raise TypeError(f"config must be an EnvConfig, got {new!r}")
+    if new.max_landmarks != old.max_landmarks:
+        raise ValueError(
+            f"max_landmarks cannot change ({old.max_landmarks} -> {new.max_landmarks}): "
+            "it fixes the observation space; make a new env"
+        )
+    if action_grid_fixed and (new.n_turns, new.n_move_lengths) != (
+        old.n_turns,
+        old.n_move_lengths,
+    ):
+        raise ValueError(
+            f"n_turns and n_move_lengths cannot change ({old.n_turns}, {old.n_move_lengths} "
+            f"-> {new.n_turns}, {new.n_move_lengths}): they fix the action space"
+        )
+
+
+def switch_maps(
+    state: BatchState, maps: MapBank, row: int, old: EnvConfig, new: EnvConfig
+) -> None:
+    """After a config change of row ``row``: an empty map if the map's settings (epsilon,
+    transfer) changed, since the row may have stale state in that other map batch."""
+    if (new.epsilon, new.transfer) != (old.epsilon, old.transfer):
+        maps.batch(int(state.n_landmarks[row]), new).reset([row])
+
+
 # ----------------------------------------------------------------------------------------
 # Ground truth, read-only
 # ----------------------------------------------------------------------------------------
