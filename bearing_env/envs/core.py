@@ -6,7 +6,7 @@ compute on a group of rows at once:
 
 - :func:`reset_rows` starts new episodes;
 - :func:`step` moves the robots, reads the sensors, updates the maps and computes the
-  rewards, terminations and truncations;
+  rewards (:func:`rewards`), terminations and truncations;
 - :func:`observations` and :func:`infos` build the observations and infos.
 
 ``BearingSLAMEnv`` is a batch of one; ``BearingSLAMVectorEnv`` steps the whole batch.
@@ -473,10 +473,9 @@ def step(
     state.frame_changed[rows] = frame_changed
 
     potential = potentials(batch.areas[rows], config)
-    uncertainty = state.potentials[rows] - potential
-    path_cost = -config.path_cost * travelled
-    move_cost = np.full(rows.size, -config.move_cost)
-    rewards = ((0.0 + uncertainty) + path_cost) + move_cost
+    reward, (uncertainty, path_cost, move_cost) = rewards(
+        state.potentials[rows], potential, travelled, config
+    )
     state.potentials[rows] = potential
 
     terminated = np.all(batch.initialised[rows], axis=-1) & np.all(
@@ -485,7 +484,7 @@ def step(
     truncated = ~terminated & (state.moves[rows] >= config.max_moves)
     state.done[rows] = terminated | truncated
     return StepOutcome(
-        rewards=rewards,
+        rewards=reward,
         terminated=terminated,
         truncated=truncated,
         frame_changed=frame_changed,
@@ -531,6 +530,18 @@ def potentials(areas: FloatArray, config: EnvConfig) -> FloatArray:
     if config.reward == "log_area":
         return _log_capped(areas, config.area_cap).sum(axis=-1)
     return _clipped(areas, AREA_FLOOR, config.area_cap).sum(axis=-1)
+
+
+def rewards(
+    previous_potential: FloatArray, potential: FloatArray, travelled: FloatArray, config: EnvConfig
+) -> tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray]]:
+    """The rewards of a group's step and their named parts (uncertainty, path cost, move
+    cost): the decrease of the potential, minus the costs of the path and of the move."""
+    uncertainty = previous_potential - potential
+    path_cost = -config.path_cost * travelled
+    move_cost = np.full(potential.shape, -config.move_cost)
+    # 0.0 + turns an uncertainty of -0.0 into 0.0; the order of the sum is fixed.
+    return ((0.0 + uncertainty) + path_cost) + move_cost, (uncertainty, path_cost, move_cost)
 
 
 def observations(
