@@ -14,8 +14,8 @@ from __future__ import annotations
 import gymnasium as gym
 
 from bearing_env.envs.bearing_slam import BearingSLAMEnv
+from bearing_env.envs.core import WorldView
 from bearing_env.slam import PolygonSLAM
-from bearing_env.world import World
 
 
 def bearing_env_of(env: gym.Env) -> BearingSLAMEnv:
@@ -34,8 +34,9 @@ def slam_of(env: gym.Env) -> PolygonSLAM:
     return bearing_env_of(env).slam
 
 
-def world_of(env: gym.Env) -> World:
-    """Ground truth: privileged policies only. RuntimeError before the first reset."""
+def world_of(env: gym.Env) -> WorldView:
+    """Ground truth (a read-only live view): privileged policies only. RuntimeError
+    before the first reset."""
     world = bearing_env_of(env).world
     if world is None:
         raise RuntimeError("the env has no world yet: call env.reset() first")

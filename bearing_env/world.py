@@ -409,7 +409,7 @@ class World:
 
 
 # --------------------------------------------------------------------------------------
-# Many worlds at once (the batched vector env; a single world is a batch of one)
+# Many worlds at once (the envs' core, bearing_env.envs.core; a World is a batch of one)
 # --------------------------------------------------------------------------------------
 
 
@@ -448,44 +448,3 @@ def straight_moves(
     new_x = np.minimum(np.maximum(x + travelled * dx, margin), arena.width - margin)
     new_y = np.minimum(np.maximum(y + travelled * dy, margin), arena.height - margin)
     return travelled, free < lengths, np.stack([new_x, new_y], axis=-1)
-
-
-@dataclass(frozen=True)
-class Moves:
-    """One movement of each of N worlds: turn, reading, straight move, reading."""
-
-    start_positions: FloatArray
-    start_bearings: FloatArray
-    end_bearings: FloatArray
-    requested: FloatArray
-    travelled: FloatArray
-    blocked: NDArray[np.bool_]
-
-
-def step_worlds(
-    worlds: Sequence[World],
-    turns: FloatArray,
-    lengths: FloatArray,
-    rngs: Sequence[np.random.Generator],
-) -> Moves:
-    """Move N worlds (same arena, noise model and landmark count) at once, in place.
-
-    World ``i`` turns by ``turns[i]``, reads its bearings, moves ``lengths[i]`` and reads
-    again, drawing its noise from ``rngs[i]``: exactly what :meth:`World.turn`,
-    :meth:`World.read_bearings` and :meth:`World.move` do one world at a time.
-    """
-    first = worlds[0]
-    headings = wrap_angle(np.array([world.heading for world in worlds]) + turns)
-    positions = np.stack([world.position for world in worlds])
-    landmarks = np.stack([world.landmarks for world in worlds])
-    noise, epsilon = first.noise, first.epsilon
-    start_truth = true_bearings(landmarks, positions, headings)
-    start_bearings = noise.corrupt_rows(rngs, start_truth, epsilon)
-    travelled, blocked, moved = straight_moves(
-        first.arena, positions, headings, lengths, first.min_baseline
-    )
-    end_bearings = noise.corrupt_rows(rngs, true_bearings(landmarks, moved, headings), epsilon)
-    for world, heading, position in zip(worlds, headings, moved, strict=True):
-        world.heading = float(heading)
-        world.position = position
-    return Moves(positions, start_bearings, end_bearings, lengths, travelled, blocked)

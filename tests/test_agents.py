@@ -255,7 +255,7 @@ def test_greedy_belief_tracks_the_true_pose_and_scale() -> None:
             action = policy.act(observation, info)
             # The pose the decision was based on (act() has just accounted for the last
             # move), against the truth at the same instant.
-            pose = policy.belief.pose(base._slam)
+            pose = policy.belief.pose(base.slam)
             world = base._world
             if pose is not None:
                 l1, l2 = world.landmarks[:2]

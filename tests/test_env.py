@@ -163,7 +163,10 @@ def test_pickle_round_trip_continues_identically(env_id: str) -> None:
     clone = pickle.loads(pickle.dumps(env))
     actions = [env.action_space.sample() for _ in range(5)]
     for action in actions:
-        assert_same(env.step(action), clone.step(action))
+        result = env.step(action)
+        assert_same(result, clone.step(action))
+        if result[2] or result[3]:  # an ended episode must be reset before stepping on
+            assert_same(env.reset(), clone.reset())
     assert clone.render().shape == env.render().shape
 
 
@@ -238,11 +241,14 @@ def test_sb3_subproc_vec_env_with_spawn() -> None:
 
 def test_info_keys_and_shapes() -> None:
     env = BearingSLAMEnv(n_landmarks=6)
+    env.action_space.seed(0)
     _, info = env.reset(seed=0)
     assert set(info) == INFO_KEYS
     assert np.all(np.isinf(info["landmark_area"])) and math.isinf(info["total_area"])
     for _ in range(8):
-        _, reward, _, _, info = env.step(env.action_space.sample())
+        _, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        if terminated or truncated:  # an ended episode must be reset before stepping on
+            env.reset()
         assert set(info) == INFO_KEYS
         assert info["landmark_area"].shape == (4,)
         assert info["landmark_error"].shape == (4,)
@@ -608,3 +614,91 @@ def test_the_map_and_the_ground_truth_are_public_and_apart() -> None:
     assert world.landmarks.shape == (4, 2) and slam.n_landmarks == 4
     env.step(np.array([0.5, 1.0], dtype=np.float32))
     assert env.unwrapped.slam is slam  # the same map, updated in place
+
+
+# --------------------------------------------------------------------------------------
+# Clear errors for malformed input
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "action",
+    [
+        ["0.5", "0.1"],
+        np.array(["0.5", "0.1"]),
+        [True, False],
+        np.array([True, True]),
+        [0.5 + 1j, 0.0],
+        np.array([0.1, 0.2], dtype=complex),
+        np.array([0.1, "x"], dtype=object),
+    ],
+    ids=["str-list", "str-array", "bool-list", "bool-array", "complex", "complex-array", "obj"],
+)
+def test_continuous_actions_that_are_not_real_numbers_raise(action: Any) -> None:
+    env = BearingSLAMEnv()
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="real numbers"):
+        env.step(action)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_stepping_an_ended_episode_without_reset_raises(env_id: str) -> None:
+    env = gym.make(env_id, max_moves=2).unwrapped
+    env.reset(seed=0)
+    action = env.action_space.sample()
+    env.step(action)
+    *_, terminated, truncated, _ = env.step(action)
+    assert terminated or truncated
+    with pytest.raises(RuntimeError, match=r"ended.*reset"):
+        env.step(action)
+    env.reset()
+    env.step(action)  # a reset starts a new episode
+
+
+def test_the_world_is_a_read_only_live_view() -> None:
+    env = BearingSLAMEnv(scenario="khepera")
+    env.reset(seed=0)
+    world = env.world
+    assert world is not None
+    start = world.position.copy()
+    with pytest.raises(ValueError, match="read-only"):
+        world.position[0] = 0.5
+    with pytest.raises(ValueError, match="read-only"):
+        world.landmarks[0, 0] = 0.5
+    with pytest.raises(AttributeError):
+        world.heading = 1.0  # type: ignore[misc]
+    env.step(np.array([0.0, 1.0], dtype=np.float32))
+    assert env.world is world and not np.array_equal(world.position, start)
+    snapshot = world.copy()  # a mutable, independent World
+    snapshot.position = np.array([0.3, 0.3])
+    assert not np.array_equal(world.position, snapshot.position)
+    np.testing.assert_array_equal(world.true_bearings(), world.copy().true_bearings())
+
+
+def _read_only_clone(env: Any) -> Any:
+    """A pickle round trip whose out-of-band buffers come back read-only."""
+    buffers: list[pickle.PickleBuffer] = []
+    data = pickle.dumps(env, protocol=5, buffer_callback=buffers.append)
+    assert buffers  # the arrays really travelled out of band
+    return pickle.loads(data, buffers=[memoryview(b.raw()).toreadonly() for b in buffers])
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_the_envs_own_arrays_are_writable_after_a_read_only_unpickle(env_id: str) -> None:
+    env = gym.make(env_id, scenario="khepera").unwrapped
+    env.reset(seed=0)
+    clone = _read_only_clone(env)
+    state = clone._state
+    for name, value in vars(state).items():
+        assert value.flags.writeable, name
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_an_env_from_a_read_only_unpickle_still_steps(env_id: str) -> None:
+    env = gym.make(env_id, scenario="khepera").unwrapped
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    actions = [env.action_space.sample() for _ in range(6)]
+    clone = _read_only_clone(env)
+    for action in actions:
+        assert_same(env.step(action), clone.step(action))

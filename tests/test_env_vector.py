@@ -234,8 +234,9 @@ def test_pickle_round_trip_continues_identically() -> None:
     for a in actions[4:]:
         assert_same(env.step(a), clone.step(a))
     # The clone's sub-envs still share one map batch of their own.
-    assert clone.envs[0].slam.batch is clone.envs[2].slam.batch
-    assert clone.envs[0].slam.batch is not env.envs[0].slam.batch
+    clone_maps, maps = clone.get_attr("slam"), env.get_attr("slam")
+    assert clone_maps[0].batch is clone_maps[2].batch
+    assert clone_maps[0].batch is not maps[0].batch
 
 
 def _step_in_subprocess(queue: Any) -> None:
@@ -389,3 +390,78 @@ def same_regions(a: PolygonSLAM, b: PolygonSLAM) -> bool:
         (p is None and q is None) or (p is not None and q is not None and np.array_equal(p, q))
         for p, q in pairs
     )
+
+
+# ----------------------------------------------------------------------------------------
+# Clear errors for malformed input
+# ----------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "actions",
+    [np.array([True, False]), np.array(["3", "5"]), ["3", "5"], np.array([1 + 0j, 2 + 0j])],
+    ids=["bools", "str-array", "str-list", "complex"],
+)
+def test_discrete_actions_that_are_not_numbers_raise_like_the_single_env(actions: Any) -> None:
+    env = BearingSLAMDiscreteVectorEnv(2, scenario="khepera")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="action"):
+        env.step(actions)
+    single = gym.make("BearingSLAMDiscrete-v0", scenario="khepera").unwrapped
+    single.reset(seed=0)
+    with pytest.raises(ValueError, match="action"):
+        single.step(np.asarray(actions)[0])
+
+
+@pytest.mark.parametrize(
+    "actions",
+    [
+        np.array([["0.5", "0.1"], ["0.2", "0.3"]]),
+        np.array([[True, False], [False, True]]),
+        np.array([[0.5 + 1j, 0.0], [0.1, 0.2]]),
+    ],
+    ids=["strings", "bools", "complex"],
+)
+def test_continuous_actions_that_are_not_real_numbers_raise(actions: Any) -> None:
+    env = BearingSLAMVectorEnv(2, scenario="khepera")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="real numbers"):
+        env.step(actions)
+
+
+@pytest.mark.parametrize(
+    ("seed", "shown"),
+    [(1.5, "1.5"), ("7", "'7'"), ([1, 2.5], "2.5"), ([True, 2], "True"), (np.float64(3), "3.0")],
+)
+def test_reset_with_a_seed_that_is_not_an_int_names_it(seed: Any, shown: str) -> None:
+    env = BearingSLAMVectorEnv(2)
+    with pytest.raises(TypeError, match="seed") as raised:
+        env.reset(seed=seed)
+    assert shown in str(raised.value)
+
+
+def _read_only_clone(env: Any) -> Any:
+    """A pickle round trip whose out-of-band buffers come back read-only."""
+    buffers: list[pickle.PickleBuffer] = []
+    data = pickle.dumps(env, protocol=5, buffer_callback=buffers.append)
+    assert buffers  # the arrays really travelled out of band
+    return pickle.loads(data, buffers=[memoryview(b.raw()).toreadonly() for b in buffers])
+
+
+def test_the_vector_envs_own_arrays_are_writable_after_a_read_only_unpickle() -> None:
+    env = BearingSLAMVectorEnv(3, scenario="khepera")
+    env.reset(seed=0)
+    clone = _read_only_clone(env)
+    for name, value in vars(clone._state).items():
+        assert value.flags.writeable, name
+    for name in ("_config_index", "_autoreset_envs", "_elapsed_steps"):
+        assert getattr(clone, name).flags.writeable, name
+
+
+def test_a_vector_env_from_a_read_only_unpickle_still_steps() -> None:
+    env = BearingSLAMVectorEnv(3, scenario="khepera")
+    env.reset(seed=0)
+    actions = np.random.default_rng(0).uniform(-1, 1, (6, 3, 2)).astype(np.float32)
+    clone = _read_only_clone(env)
+    for step_actions in actions:
+        assert_same(env.step(step_actions), clone.step(step_actions))

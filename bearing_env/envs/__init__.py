@@ -1,12 +1,22 @@
-"""The Gymnasium environments: one per module."""
+"""The Gymnasium environments (one per module), their shared config and functional core.
+
+- :mod:`~bearing_env.envs.config`: :class:`EnvConfig`, every setting, validated;
+- :mod:`~bearing_env.envs.core`: the world state and bookkeeping of a batch of envs as
+  arrays, and the pure functions that reset, step and observe it;
+- :mod:`~bearing_env.envs.bearing_slam`, :mod:`~bearing_env.envs.bearing_slam_discrete`:
+  the single envs (a batch of one);
+- :mod:`~bearing_env.envs.bearing_slam_vector`: the batched vector envs.
+"""
 
 from bearing_env.envs.bearing_slam import BearingSLAMEnv
 from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
 from bearing_env.envs.bearing_slam_vector import BearingSLAMDiscreteVectorEnv, BearingSLAMVectorEnv
+from bearing_env.envs.config import EnvConfig
 
 __all__ = [
     "BearingSLAMDiscreteEnv",
     "BearingSLAMDiscreteVectorEnv",
     "BearingSLAMEnv",
     "BearingSLAMVectorEnv",
+    "EnvConfig",
 ]

@@ -1,23 +1,27 @@
 """``BearingSLAM-v0`` as a natively batched vector environment.
 
 ``gym.make_vec("BearingSLAM-v0", num_envs=64, vectorization_mode="vector_entry_point")``
-returns :class:`BearingSLAMVectorEnv`.
+returns :class:`BearingSLAMVectorEnv`. It steps the functional core of
+:mod:`bearing_env.envs.core` on all its sub-envs at once; it holds no single-env objects.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
+from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 from numpy.typing import NDArray
 
-from bearing_env.envs.bearing_slam import BearingSLAMEnv, Movement, _row_info
+from bearing_env.envs import core
+from bearing_env.envs.bearing_slam import BearingSLAMEnv, Setting
 from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
-from bearing_env.slam import PolygonSLAM
-from bearing_env.slam.batch import BatchedPolygonSLAM
+from bearing_env.envs.config import MAX_N_LANDMARKS, EnvConfig
+from bearing_env.envs.core import BatchState, MapBank, WorldView
 
 AUTORESET_MODES = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)
 
@@ -28,37 +32,8 @@ LANDMARK_INFO_PADDING: dict[str, Any] = {
     "landmark_contains_truth": False,
 }
 
-
-class SharedMaps:
-    """One :class:`BatchedPolygonSLAM` per landmark count, with a row per sub-env.
-
-    Sub-envs with a range of landmark counts switch batches at reset; the rows of the
-    other batches are simply left idle.
-    """
-
-    def __init__(self, num_maps: int, epsilon: float, transfer: str) -> None:
-        self.num_maps = num_maps
-        self.epsilon = epsilon
-        self.transfer = transfer
-        self.batches: dict[int, BatchedPolygonSLAM] = {}
-
-    def batch_for(self, n_landmarks: int) -> BatchedPolygonSLAM:
-        if n_landmarks not in self.batches:
-            self.batches[n_landmarks] = BatchedPolygonSLAM(
-                self.num_maps, n_landmarks, self.epsilon, transfer=self.transfer
-            )
-        return self.batches[n_landmarks]
-
-
-class SharedMapRow:
-    """A sub-env's map factory: its own row of the shared batch (picklable)."""
-
-    def __init__(self, maps: SharedMaps, index: int) -> None:
-        self.maps = maps
-        self.index = index
-
-    def __call__(self, n_landmarks: int) -> PolygonSLAM:
-        return PolygonSLAM.view(self.maps.batch_for(n_landmarks), self.index)
+IntArray = NDArray[np.int64]
+Decoder = Callable[[EnvConfig, Any], tuple[NDArray[np.float64], NDArray[np.float64]]]
 
 
 class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[Any]]):
@@ -66,12 +41,14 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
     ## Description
 
     `num_envs` copies of :class:`~bearing_env.envs.bearing_slam.BearingSLAMEnv` stepped
-    together, each step in one batched numpy computation per group of sub-envs with the
-    same landmark count and settings: all robots move at once (`step_worlds`), all maps
-    fuse their movement in one :class:`BatchedPolygonSLAM` update (most of the work), and
-    observations, rewards and infos are built as arrays. Only the noise draws loop over
-    sub-envs, because each owns its random generator. These are the single env's own
-    functions, which it runs with a batch of one, so the two cannot drift apart.
+    together. The sub-envs are rows of one structure of arrays
+    (:class:`~bearing_env.envs.core.BatchState`), and each step is one batched numpy
+    computation per group of rows with the same settings (`EnvConfig`) and landmark
+    count: all robots move at once, all maps fuse their movement in one
+    :class:`BatchedPolygonSLAM` update (most of the work), and observations, rewards and
+    infos are built as arrays. Only the random draws loop over sub-envs, because each
+    owns its random generator. The functions are :mod:`bearing_env.envs.core`'s, which
+    the single env runs with a batch of one, so the two cannot drift apart.
 
     For the same per-env seeds and actions it reproduces
     `gym.make_vec(id, num_envs, vectorization_mode="sync")` exactly: observations,
@@ -105,8 +82,17 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
       `landmark_error`, `landmark_contains_truth`) are then padded to `max_landmarks - 2`
       entries (with inf, inf and False) so they batch; Gymnasium's own vector envs cannot
       batch them at all.
-    - every other keyword: as for the single environment (`scenario`, `n_landmarks`,
-      `epsilon_deg`, ...), validated by it.
+    - `config`: an `EnvConfig`, or every other keyword: as for the single environment
+      (`scenario`, `n_landmarks`, `epsilon_deg`, ...), validated by it.
+
+    ## Sub-env attributes
+
+    `get_attr(name)` gives one value per sub-env: any setting (`area_cap`,
+    `path_cost`, ...; `config` for the whole `EnvConfig`), `n_landmarks`, `slam` (the
+    sub-env's map, a `PolygonSLAM` view of the shared batch), `world` (its ground
+    truth, read-only) and `np_random`. `set_attr(name, values)` changes settings per
+    sub-env (validated); sub-envs whose settings differ are stepped in separate groups.
+    `call(name)` calls what `get_attr(name)` gives when it is callable.
 
     ## Version History
 
@@ -117,7 +103,10 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         "autoreset_mode": AutoresetMode.NEXT_STEP,
         "render_modes": ["rgb_array"],
     }
+    #: The single env this batches: it validates the settings and defines the spaces.
     single_env_class: type[BearingSLAMEnv] = BearingSLAMEnv
+    #: Actions (num_envs, ...) of one group to (turn angles, move lengths).
+    decode_actions: Decoder = staticmethod(core.decode_continuous)
 
     def __init__(
         self,
@@ -126,6 +115,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         max_episode_steps: int | None = None,
         render_mode: str | None = None,
+        config: EnvConfig | None = None,
         **env_kwargs: Any,
     ) -> None:
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)):
@@ -152,24 +142,29 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         # Instance-level metadata: the class's dict is shared and must not be mutated.
         self.metadata = {**type(self).metadata, "autoreset_mode": self.autoreset_mode}
 
-        self.envs = [
-            self.single_env_class(render_mode=render_mode, **env_kwargs)
-            for _ in range(self.num_envs)
-        ]
-        first = self.envs[0]
-        self._maps = SharedMaps(self.num_envs, first.epsilon, first.transfer)
-        for index, env in enumerate(self.envs):
-            env._make_slam = SharedMapRow(self._maps, index)  # type: ignore[method-assign]
-            env._slam = env._make_slam(env.n_landmarks)
-
-        self.single_observation_space = first.observation_space
-        self.single_action_space = first.action_space
+        # One single env, only to validate the settings exactly as it does and to give
+        # the spaces; the sub-envs themselves are rows of the batch state.
+        prototype = self.single_env_class(config=config, **env_kwargs)
+        first = prototype.config
+        self.single_observation_space = prototype.observation_space
+        self.single_action_space = prototype.action_space
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
 
-        lo, hi = first.landmark_counts
+        #: The distinct configs of the sub-envs, and which one each sub-env has.
+        self._config_table: list[EnvConfig] = [first]
+        self._config_index = np.zeros(self.num_envs, dtype=np.int64)
+        self._state = BatchState.empty(self.num_envs, first.max_landmarks)
+        self._state.n_landmarks[:] = first.landmark_counts[1]
+        self._maps = MapBank(self.num_envs)
+        self._rngs: list[np.random.Generator | None] = [None] * self.num_envs
+        #: Attributes set by ``set_attr`` that are not settings, per sub-env.
+        self._extra_attributes: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
+        self._worlds = [WorldView(self, row) for row in range(self.num_envs)]
+        self._renderers: list[Any] = [None] * self.num_envs
+
         #: Landmark slots of the per-landmark info arrays when counts vary per episode.
-        self._info_slots = first.max_landmarks - 2 if hi > lo else None
+        self._info_slots = first.max_landmarks - 2 if first.has_count_range else None
         self._autoreset_envs = np.zeros(self.num_envs, dtype=bool)
         self._elapsed_steps = np.zeros(self.num_envs, dtype=np.int64)
         self._has_reset = False
@@ -185,25 +180,17 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         options: dict[str, Any] | None = None,
     ) -> tuple[NDArray[np.float32], dict[str, Any]]:
         """Reset every sub-env; an int seed gives sub-env ``i`` the seed ``seed + i``."""
-        if seed is None:
-            seeds: list[int | None] = [None] * self.num_envs
-        elif isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
-            seeds = [int(seed) + i for i in range(self.num_envs)]
-        else:
-            seeds = list(seed)  # type: ignore[arg-type]
-            if len(seeds) != self.num_envs:
-                raise ValueError(
-                    f"seed must be None, an int or {self.num_envs} seeds, got {len(seeds)}"
-                )
-        observations, infos = [], {}
-        for index, (env, env_seed) in enumerate(zip(self.envs, seeds, strict=True)):
-            observation, info = env.reset(seed=env_seed, options=options)
-            observations.append(observation)
-            infos = self._add_info(infos, self._padded(info), index)
+        for row, row_seed in enumerate(self._seeds(seed)):
+            # As gym.Env.reset: a seed makes a new generator; without one, the
+            # generator carries on (or is made from fresh entropy the first time).
+            if row_seed is not None or self._rngs[row] is None:
+                self._rngs[row], _ = seeding.np_random(row_seed)
+        observations = np.zeros(self.observation_space.shape, dtype=np.float32)
+        infos = self._reset_rows(np.arange(self.num_envs), observations, {})
         self._autoreset_envs[:] = False
         self._elapsed_steps[:] = 0
         self._has_reset = True
-        return np.stack(observations), infos
+        return observations, infos
 
     def step(
         self, actions: NDArray[Any]
@@ -224,78 +211,78 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             )
         n = self.num_envs
         resetting = self._autoreset_envs & (self.autoreset_mode == AutoresetMode.NEXT_STEP)
-
-        # The world half of every stepping sub-env, then all SLAM updates at once.
-        groups = self._groups(np.flatnonzero(~resetting))
-        movements: list[Movement | None] = [None] * n
-        for group in groups:
-            first = self.envs[group[0]]
-            turns, lengths = first._decode_actions(actions[group])
-            moved = self.single_env_class._move_batch(
-                [self.envs[i] for i in group], turns, lengths
-            )
-            for index, movement in zip(group, moved, strict=True):
-                movements[index] = movement
-        frame_changed, inconsistent = self._update_maps(movements)
+        # Every group's actions are decoded (and checked) before anything moves.
+        groups = [
+            (config, rows, *self.decode_actions(config, actions[rows]))
+            for config, rows in self._groups(np.flatnonzero(~resetting))
+        ]
 
         observations = np.zeros(self.observation_space.shape, dtype=np.float32)
         rewards = np.zeros(n, dtype=np.float64)
         terminations = np.zeros(n, dtype=bool)
         truncations = np.zeros(n, dtype=bool)
         infos: dict[str, Any] = {}
-        for group in groups:
-            (
-                observations[group],
-                rewards[group],
-                terminations[group],
-                truncations[group],
-                group_infos,
-            ) = self.single_env_class._finish_steps(
-                [self.envs[i] for i in group],
-                [movements[i] for i in group],  # type: ignore[misc]
-                frame_changed[group],
-                inconsistent[group],
-            )
-            self._elapsed_steps[group] += 1
+        finished: list[IntArray] = []
+        for config, rows, turns, lengths in groups:
+            rngs = [self._rng(row) for row in rows.tolist()]
+            outcome = core.step(self._state, rows, config, turns, lengths, rngs, self._maps)
+            observations[rows] = core.observations(self._state, rows, config, self._maps)
+            rewards[rows] = outcome.rewards
+            terminations[rows] = outcome.terminated
+            truncations[rows] = outcome.truncated
+            self._elapsed_steps[rows] += 1
             if self.max_episode_steps is not None:
-                truncations[group] |= self._elapsed_steps[group] >= self.max_episode_steps
-            infos = self._merge_rows(infos, self._padded(group_infos), group)
+                truncations[rows] |= self._elapsed_steps[rows] >= self.max_episode_steps
+            group_infos = self._padded(
+                core.infos(self._state, rows, config, self._maps, outcome)
+            )
+            infos = self._merge_rows(infos, group_infos, rows)
             if self.autoreset_mode == AutoresetMode.SAME_STEP:
-                for j in np.flatnonzero(terminations[group] | truncations[group]):
-                    index = int(group[j])
-                    final_info = self._padded(_row_info(group_infos, int(j)))
-                    final = {"final_obs": observations[index].copy(), "final_info": final_info}
-                    infos = self._add_info(infos, final, index)
-                    observations[index], info = self.envs[index].reset()
-                    self._elapsed_steps[index] = 0
-                    infos = self._add_info(infos, self._padded(info), index)
-        for index in np.flatnonzero(resetting):
-            observations[index], info = self.envs[index].reset()
-            self._elapsed_steps[index] = 0
-            infos = self._add_info(infos, self._padded(info), index)
+                ended = np.flatnonzero(terminations[rows] | truncations[rows])
+                if ended.size:
+                    infos = self._merge_final(infos, rows[ended], observations, group_infos, ended)
+                    finished.append(rows[ended])
+        if finished:  # SAME_STEP: reset at once, the reset's observation and info returned
+            infos = self._reset_rows(np.concatenate(finished), observations, infos)
+        infos = self._reset_rows(np.flatnonzero(resetting), observations, infos)
         self._autoreset_envs = terminations | truncations
         return observations, rewards, terminations, truncations, infos
 
     def render(self) -> tuple[Any, ...] | None:
         if self.render_mode is None:
             return None
-        return tuple(env.render() for env in self.envs)
+        if not self._has_reset:
+            raise RuntimeError("call reset() before render()")
+        frames = []
+        for row in range(self.num_envs):
+            if self._renderers[row] is None:
+                from bearing_env.rendering import Renderer
+
+                self._renderers[row] = Renderer(
+                    self.render_mode,
+                    self._row_config(row).arena,
+                    fps=BearingSLAMEnv.metadata["render_fps"],
+                )
+            slam = self._slam(row)
+            frame = core.scene(self._state, row, self._row_config(row), slam)
+            frames.append(self._renderers[row].render(frame))
+        return tuple(frames)
 
     def close_extras(self, **kwargs: Any) -> None:
-        for env in self.envs:
-            env.close()
+        for renderer in self._renderers:
+            if renderer is not None:
+                renderer.close()
+        self._renderers = [None] * self.num_envs
 
     def call(self, name: str, *args: Any, **kwargs: Any) -> tuple[Any, ...]:
-        """Call method ``name`` of every sub-env (or read the attribute if not callable)."""
-        results = []
-        for env in self.envs:
-            attribute = getattr(env, name)
-            results.append(attribute(*args, **kwargs) if callable(attribute) else attribute)
-        return tuple(results)
+        """Call ``get_attr(name)``'s value of every sub-env (or return it if not callable)."""
+        return tuple(
+            value(*args, **kwargs) if callable(value) else value for value in self.get_attr(name)
+        )
 
     def get_attr(self, name: str) -> tuple[Any, ...]:
-        """Attribute ``name`` of every sub-env."""
-        return tuple(getattr(env, name) for env in self.envs)
+        """Attribute ``name`` of every sub-env (see the Sub-env attributes section)."""
+        return tuple(self._row_attribute(row, name) for row in range(self.num_envs))
 
     def set_attr(self, name: str, values: Any | Sequence[Any]) -> None:
         """Set attribute ``name`` of every sub-env (one value for all, or one per env)."""
@@ -303,17 +290,160 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             values = [values] * self.num_envs
         if len(values) != self.num_envs:
             raise ValueError(f"expected {self.num_envs} values for {name!r}, got {len(values)}")
-        for env, value in zip(self.envs, values, strict=True):
-            setattr(env, name, value)
+        attribute = getattr(self.single_env_class, name, None)
+        if name == "config":
+            configs = list(values)
+            if not all(isinstance(value, EnvConfig) for value in configs):
+                raise TypeError(f"config values must be EnvConfig objects, got {values!r}")
+        elif isinstance(attribute, Setting):
+            if attribute.read_only is not None:
+                raise AttributeError(f"{name} is read-only: {attribute.read_only}")
+            # All validated before any is applied, so a bad value changes nothing.
+            configs = [
+                self._row_config(row).replace(**{attribute.field: value})
+                for row, value in enumerate(values)
+            ]
+        elif name == "np_random":
+            self._rngs = list(values)
+            return
+        elif attribute is not None or name in _ROW_ATTRIBUTES:
+            raise AttributeError(f"the sub-envs' {name!r} cannot be set")
+        else:
+            for extras, value in zip(self._extra_attributes, values, strict=True):
+                extras[name] = value
+            return
+        grid_fixed = self.decode_actions is not core.decode_continuous
+        for row, config in enumerate(configs):
+            core.check_config_switch(self._row_config(row), config, grid_fixed)
+        for row, config in enumerate(configs):
+            self._set_row_config(row, config)
+
+    # ------------------------------------------------------------------------------------
+    # Pickling
+    # ------------------------------------------------------------------------------------
+
+    def __getstate__(self) -> dict[str, Any]:
+        # A pygame surface cannot be pickled; fresh ones are made on demand.
+        state = self.__dict__.copy()
+        state["_renderers"] = [None] * self.num_envs
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        # An out-of-band pickle may hand back read-only buffers: copy what is written.
+        self._state = self._state.writable()
+        self._config_index = np.require(self._config_index, requirements=["W"])
+        self._autoreset_envs = np.require(self._autoreset_envs, requirements=["W"])
+        self._elapsed_steps = np.require(self._elapsed_steps, requirements=["W"])
 
     # ------------------------------------------------------------------------------------
     # Internals
     # ------------------------------------------------------------------------------------
 
+    def _row_config(self, row: int) -> EnvConfig:
+        return self._config_table[int(self._config_index[row])]
+
+    def _set_row_config(self, row: int, config: EnvConfig) -> None:
+        core.switch_maps(self._state, self._maps, row, self._row_config(row), config)
+        if config not in self._config_table:
+            self._config_table.append(config)
+        self._config_index[row] = self._config_table.index(config)
+
+    def _rng(self, row: int) -> np.random.Generator:
+        rng = self._rngs[row]
+        if rng is None:
+            rng, _ = seeding.np_random()
+            self._rngs[row] = rng
+        return rng
+
+    def _slam(self, row: int) -> Any:
+        return self._maps.view(int(self._state.n_landmarks[row]), self._row_config(row), row)
+
+    def _row_attribute(self, row: int, name: str) -> Any:
+        if name == "config":
+            return self._row_config(row)
+        if name == "n_landmarks":
+            return int(self._state.n_landmarks[row])
+        if name == "slam":
+            return self._slam(row)
+        if name == "world":
+            return self._worlds[row] if self._has_reset else None
+        if name == "np_random":
+            return self._rng(row)
+        if name in ("observation_space", "action_space"):
+            return getattr(self, f"single_{name}")
+        if name in self._extra_attributes[row]:
+            return self._extra_attributes[row][name]
+        attribute = getattr(self.single_env_class, name, None)
+        if isinstance(attribute, (Setting, property)):
+            # Settings and the properties derived from the config alone (epsilon,
+            # turn_angles, ...), read as the single env reads them.
+            return attribute.__get__(SimpleNamespace(config=self._row_config(row)))
+        raise AttributeError(f"the sub-envs have no attribute {name!r}")
+
+    def _seeds(self, seed: Any) -> list[int | None]:
+        """One seed per sub-env from ``reset``'s ``seed`` (TypeError/ValueError naming it)."""
+        if seed is None:
+            return [None] * self.num_envs
+        if _is_int(seed):
+            return [int(seed) + i for i in range(self.num_envs)]
+        if isinstance(seed, (str, bytes)) or not isinstance(seed, (Sequence, np.ndarray)):
+            raise TypeError(
+                f"seed must be None, an int or a sequence of {self.num_envs} ints or None, "
+                f"got {seed!r}"
+            )
+        seeds = list(seed)
+        if len(seeds) != self.num_envs:
+            raise ValueError(
+                f"seed must be None, an int or {self.num_envs} seeds, got {len(seeds)}"
+            )
+        for value in seeds:
+            if value is not None and not _is_int(value):
+                raise TypeError(f"each seed must be an int or None, got {value!r} in {seed!r}")
+        return [None if value is None else int(value) for value in seeds]
+
+    def _reset_rows(
+        self, rows: IntArray, observations: NDArray[np.float32], infos: dict[str, Any]
+    ) -> dict[str, Any]:
+        """Start new episodes in ``rows``: their observations are written into
+        ``observations`` and their infos merged into ``infos``."""
+        if rows.size == 0:
+            return infos
+        for config, group in self._groups(rows, by_count=False):
+            rngs = [self._rng(row) for row in group.tolist()]
+            core.reset_rows(self._state, group, config, rngs, self._maps)
+        for config, group in self._groups(rows):
+            observations[group] = core.observations(self._state, group, config, self._maps)
+            reset_infos = core.infos(
+                self._state, group, config, self._maps, core.reset_outcome(group.size)
+            )
+            infos = self._merge_rows(infos, self._padded(reset_infos), group)
+        self._elapsed_steps[rows] = 0
+        return infos
+
+    def _groups(
+        self, rows: IntArray, by_count: bool = True
+    ) -> list[tuple[EnvConfig, IntArray]]:
+        """``rows`` split into groups that step as one batch: same config and (unless
+        ``by_count`` is False) same landmark count, so one map batch. Sub-envs share their
+        config unless ``set_attr`` changed some; each distinct config gets its own group."""
+        if rows.size == 0:
+            return []
+        keys = self._config_index[rows] * (MAX_N_LANDMARKS + 1)
+        if by_count:
+            keys = keys + self._state.n_landmarks[rows]
+        if np.all(keys == keys[0]):  # the common case: one group
+            return [(self._row_config(int(rows[0])), rows)]
+        groups = []
+        for key in np.unique(keys):
+            group = rows[keys == key]
+            groups.append((self._row_config(int(group[0])), group))
+        return groups
+
     def _padded(self, info: dict[str, Any]) -> dict[str, Any]:
         """With varying landmark counts, per-landmark arrays padded to a fixed length
         (Gymnasium batches an info key into one array, so every sub-env's must agree).
-        Works on one env's info and on batched infos (landmarks on the last axis)."""
+        Works on batched infos (landmarks on the last axis)."""
         if self._info_slots is None:
             return info
         padded = dict(info)
@@ -323,18 +453,30 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             padded[key][..., : values.shape[-1]] = values
         return padded
 
-    def _groups(self, indices: NDArray[np.int64]) -> list[NDArray[np.int64]]:
-        """Sub-envs that can be stepped as one batch: same landmark count (so one map
-        batch) and same settings. Sub-envs share their settings unless ``set_attr``
-        changed some; then each distinct setting gets its own batch, computed alike."""
-        groups: dict[tuple[Any, ...], list[int]] = {}
-        for index in indices.tolist():
-            env = self.envs[index]
-            groups.setdefault((env.n_landmarks, env._batch_settings()), []).append(index)
-        return [np.array(group) for group in groups.values()]
+    def _merge_final(
+        self,
+        infos: dict[str, Any],
+        rows: IntArray,
+        observations: NDArray[np.float32],
+        group_infos: dict[str, Any],
+        group_rows: IntArray,
+    ) -> dict[str, Any]:
+        """What ``_add_info`` builds from ``{"final_obs": ..., "final_info": ...}`` of each
+        finished sub-env (``rows``; ``group_rows`` are their positions in ``group_infos``)."""
+        # Gymnasium keeps final observations in an object array, one array per sub-env.
+        final_obs = infos.get("final_obs")
+        if final_obs is None:
+            final_obs = np.full(self.num_envs, None, dtype=object)
+        for row in rows.tolist():
+            final_obs[row] = observations[row].copy()
+        mask = infos.get("_final_obs", np.zeros(self.num_envs, dtype=np.bool_))
+        mask[rows] = True
+        infos["final_obs"], infos["_final_obs"] = final_obs, mask
+        finals = _select_rows(group_infos, group_rows)
+        return self._merge_rows(infos, {"final_info": finals}, rows)
 
     def _merge_rows(
-        self, infos: dict[str, Any], batched: dict[str, Any], rows: NDArray[np.int64]
+        self, infos: dict[str, Any], batched: dict[str, Any], rows: IntArray
     ) -> dict[str, Any]:
         """What ``_add_info`` would build from each row's info, for many rows at once."""
         for key, value in batched.items():
@@ -350,33 +492,32 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             infos[key], infos[f"_{key}"] = array, mask
         return infos
 
-    def _update_maps(
-        self, movements: list[Movement | None]
-    ) -> tuple[NDArray[np.bool_], NDArray[np.int64]]:
-        """One batched SLAM update per landmark count, over the sub-envs that moved."""
-        frame_changed = np.zeros(self.num_envs, dtype=bool)
-        inconsistent = np.zeros(self.num_envs, dtype=np.int64)
-        moved: dict[int, list[int]] = {}
-        for index, movement in enumerate(movements):
-            if movement is not None and movement.changes_map:
-                moved.setdefault(self.envs[index].n_landmarks, []).append(index)
-        for n_landmarks, rows in moved.items():
-            result = self._maps.batch_for(n_landmarks).update(
-                np.stack([movements[i].start_bearings for i in rows]),  # type: ignore[union-attr]
-                np.stack([movements[i].end_bearings for i in rows]),  # type: ignore[union-attr]
-                maps=np.array(rows),
-            )
-            frame_changed[rows] = result.frame_changed
-            inconsistent[rows] = result.n_inconsistent
-        return frame_changed, inconsistent
-
 
 class BearingSLAMDiscreteVectorEnv(BearingSLAMVectorEnv):
-    """``BearingSLAMDiscrete-v0`` batched: :class:`BearingSLAMVectorEnv` over
-    :class:`~bearing_env.envs.bearing_slam_discrete.BearingSLAMDiscreteEnv` (actions are
-    an array of ``num_envs`` discrete action indices)."""
+    """``BearingSLAMDiscrete-v0`` batched: :class:`BearingSLAMVectorEnv` with the
+    :class:`~bearing_env.envs.bearing_slam_discrete.BearingSLAMDiscreteEnv` action space
+    (actions are an array of ``num_envs`` discrete action indices)."""
 
     single_env_class = BearingSLAMDiscreteEnv
+    decode_actions: Decoder = staticmethod(core.decode_discrete)
+
+
+#: Sub-env attributes the vector env serves itself (see ``_row_attribute``).
+_ROW_ATTRIBUTES = frozenset(
+    {"n_landmarks", "slam", "world", "observation_space", "action_space"}
+)
+
+
+def _select_rows(batched: dict[str, Any], rows: IntArray) -> dict[str, Any]:
+    """Batched infos restricted to some of their rows (nested dicts included)."""
+    return {
+        key: _select_rows(value, rows) if isinstance(value, dict) else value[rows]
+        for key, value in batched.items()
+    }
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
 def _autoreset_mode(value: AutoresetMode | str) -> AutoresetMode:

@@ -1,0 +1,749 @@
+"""The envs' pure functional core: world state and bookkeeping of a batch, as arrays.
+
+In the spirit of Gymnasium's ``phys2d/cartpole.py``: one :class:`BatchState` holds the
+state of ``N`` envs as a structure of arrays (one row per env), and plain functions
+compute on a group of rows at once:
+
+- :func:`reset_rows` starts new episodes;
+- :func:`step` moves the robots, reads the sensors, updates the maps and computes the
+  rewards (:func:`rewards`), terminations and truncations;
+- :func:`observations` and :func:`infos` build the observations and infos.
+
+``BearingSLAMEnv`` is a batch of one; ``BearingSLAMVectorEnv`` steps the whole batch.
+Both call exactly these functions, so they agree bit for bit: every computation is
+row-wise (a row's result does not depend on the other rows of its batch), and every
+random draw comes from the row's own generator, in the same order as in a batch of one.
+
+A *group* is a set of rows that share one :class:`~bearing_env.envs.config.EnvConfig`
+and one landmark count ``n`` (so one map batch, and arrays ``[:, :n]`` without padding).
+The functions below take a group's row indices; rows with other settings are untouched.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from bearing_env.envs.config import AREA_FLOOR, EnvConfig
+from bearing_env.slam import PolygonSLAM
+from bearing_env.slam.batch import BatchedPolygonSLAM
+from bearing_env.world import (
+    REFERENCE_MIN_BASELINE,
+    Arena,
+    NoiseModel,
+    World,
+    random_layout,
+    random_start,
+    straight_moves,
+    true_bearings,
+    wrap_angle,
+)
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+ComplexArray = NDArray[np.complex128]
+
+#: FL coordinates in the observation are clipped to +-this (the frame is |L1 - L2| = 1, so
+#: this is 50 baselines away: far beyond any landmark of a sensible layout).
+FL_COORD_LIMIT = 50.0
+
+#: Observation layout: the robot block first, then one block per mapped landmark slot
+#: (landmarks L3, L4, ...), then one block per bearing slot (L1, L2, L3, ...).
+ROBOT_FEATURES: tuple[str, ...] = (
+    "robot_x",
+    "robot_y",
+    "robot_log_area",
+    "robot_unknown",
+    "heading_cos",
+    "heading_sin",
+    "progress",
+    "last_frame_changed",
+    "last_move_blocked",
+)
+LANDMARK_FEATURES: tuple[str, ...] = ("present", "uninitialised", "x", "y", "log_area")
+BEARING_FEATURES: tuple[str, ...] = ("present", "cos", "sin")
+
+#: Trajectory slots allocated per row at first; the array doubles when a row fills it.
+INITIAL_TRAJECTORY_SLOTS = 32
+
+
+def observation_size(max_landmarks: int) -> int:
+    """Length of the observation vector for ``max_landmarks`` landmark slots."""
+    return (
+        len(ROBOT_FEATURES)
+        + len(LANDMARK_FEATURES) * (max_landmarks - 2)
+        + len(BEARING_FEATURES) * max_landmarks
+    )
+
+
+def observation_slices(max_landmarks: int) -> dict[str, slice]:
+    """Where each block lives in the observation vector.
+
+    ``"robot"`` is the robot block; ``"landmarks"`` reshapes to ``(max_landmarks - 2,
+    len(LANDMARK_FEATURES))``; ``"bearings"`` to ``(max_landmarks, len(BEARING_FEATURES))``.
+    """
+    robot_end = len(ROBOT_FEATURES)
+    landmarks_end = robot_end + len(LANDMARK_FEATURES) * (max_landmarks - 2)
+    return {
+        "robot": slice(0, robot_end),
+        "landmarks": slice(robot_end, landmarks_end),
+        "bearings": slice(landmarks_end, observation_size(max_landmarks)),
+    }
+
+
+# ----------------------------------------------------------------------------------------
+# State
+# ----------------------------------------------------------------------------------------
+
+
+@dataclass
+class BatchState:
+    """World state and env bookkeeping of ``num_rows`` envs, one row each.
+
+    Per-landmark arrays have ``slots`` columns (the largest landmark count a row can
+    have); row ``i`` uses the first ``n_landmarks[i]`` (the rest are zeros).
+    """
+
+    #: Landmarks in each row's current episode.
+    n_landmarks: IntArray
+    #: True landmark positions (N, slots, 2), metres; L1 first.
+    landmarks: FloatArray
+    #: True robot positions (N, 2), metres, and headings (N,), radians CCW from +x.
+    positions: FloatArray
+    headings: FloatArray
+    #: FL frame per row: FL = (world - origin) / unit, as complex numbers (fixed per episode).
+    frame_origin: ComplexArray
+    frame_unit: ComplexArray
+    #: True FL positions (N, slots - 2) of landmarks L3.., for the info.
+    landmarks_fl: ComplexArray
+    #: Moves made this episode, and the potential Phi after the latest one.
+    moves: IntArray
+    potentials: FloatArray
+    #: The latest reading (N, slots), relative to the current heading.
+    latest_bearings: FloatArray
+    #: The last movement's first reading and start position (NaN before the first move).
+    start_bearings: FloatArray
+    start_positions: FloatArray
+    #: Flags of the last movement: it changed frames (updated the map); the wall stopped it.
+    frame_changed: BoolArray
+    blocked: BoolArray
+    #: Whether the episode has ended (terminated or truncated) and needs a reset.
+    done: BoolArray
+    #: Robot positions since the reset (N, capacity, 2), for rendering; the first
+    #: ``trajectory_length[i]`` entries of row ``i`` are used.
+    trajectory: FloatArray
+    trajectory_length: IntArray
+
+    @classmethod
+    def empty(cls, num_rows: int, slots: int) -> BatchState:
+        """A batch of rows that have not been reset yet."""
+        n = num_rows
+        return cls(
+            n_landmarks=np.zeros(n, dtype=np.int64),
+            landmarks=np.zeros((n, slots, 2)),
+            positions=np.zeros((n, 2)),
+            headings=np.zeros(n),
+            frame_origin=np.zeros(n, dtype=complex),
+            frame_unit=np.ones(n, dtype=complex),
+            landmarks_fl=np.zeros((n, slots - 2), dtype=complex),
+            moves=np.zeros(n, dtype=np.int64),
+            potentials=np.zeros(n),
+            latest_bearings=np.zeros((n, slots)),
+            start_bearings=np.full((n, slots), np.nan),
+            start_positions=np.full((n, 2), np.nan),
+            frame_changed=np.zeros(n, dtype=bool),
+            blocked=np.zeros(n, dtype=bool),
+            done=np.zeros(n, dtype=bool),
+            trajectory=np.zeros((n, INITIAL_TRAJECTORY_SLOTS, 2)),
+            trajectory_length=np.zeros(n, dtype=np.int64),
+        )
+
+    @property
+    def num_rows(self) -> int:
+        return int(self.n_landmarks.shape[0])
+
+    def writable(self) -> BatchState:
+        """This state with every array writable: read-only arrays (e.g. from an
+        out-of-band pickle with read-only buffers) are copied, the others kept."""
+        arrays = {
+            f.name: np.require(getattr(self, f.name), requirements=["W"]) for f in fields(self)
+        }
+        return BatchState(**arrays)
+
+    def append_positions(self, rows: IntArray) -> None:
+        """Record the rows' current positions in their trajectories."""
+        lengths = self.trajectory_length[rows]
+        capacity = self.trajectory.shape[1]
+        needed = int(lengths.max()) + 1
+        if needed > capacity:
+            grown = np.zeros((self.num_rows, max(needed, 2 * capacity), 2))
+            grown[:, :capacity] = self.trajectory
+            self.trajectory = grown
+        self.trajectory[rows, lengths] = self.positions[rows]
+        self.trajectory_length[rows] = lengths + 1
+
+
+class MapBank:
+    """The robots' maps: one :class:`BatchedPolygonSLAM` per (landmark count, epsilon,
+    transfer), each with a row per env (row ``i`` of every batch belongs to env ``i``).
+
+    Envs whose landmark count varies switch batches at reset; their rows in the other
+    batches are simply left idle.
+    """
+
+    def __init__(self, num_rows: int) -> None:
+        self.num_rows = num_rows
+        self.batches: dict[tuple[int, float, str], BatchedPolygonSLAM] = {}
+        self._views: dict[tuple[int, float, str, int], PolygonSLAM] = {}
+
+    def batch(self, n_landmarks: int, config: EnvConfig) -> BatchedPolygonSLAM:
+        key = (int(n_landmarks), config.epsilon, config.transfer)
+        if key not in self.batches:
+            self.batches[key] = BatchedPolygonSLAM(
+                self.num_rows, key[0], config.epsilon, transfer=config.transfer
+            )
+        return self.batches[key]
+
+    def view(self, n_landmarks: int, config: EnvConfig, row: int) -> PolygonSLAM:
+        """Row ``row``'s map as a :class:`PolygonSLAM` (the same object every time)."""
+        key = (int(n_landmarks), config.epsilon, config.transfer, int(row))
+        if key not in self._views:
+            self._views[key] = PolygonSLAM.view(self.batch(n_landmarks, config), row)
+        return self._views[key]
+
+
+def check_config_switch(old: EnvConfig, new: EnvConfig, action_grid_fixed: bool) -> None:
+    """Raise unless a live env may change its config from ``old`` to ``new``: the
+    observation space (``max_landmarks``) and, for discrete envs (``action_grid_fixed``),
+    the action grid cannot change."""
+    if not isinstance(new, EnvConfig):
+        raise TypeError(f"config must be an EnvConfig, got {new!r}")
+    if new.max_landmarks != old.max_landmarks:
+        raise ValueError(
+            f"max_landmarks cannot change ({old.max_landmarks} -> {new.max_landmarks}): "
+            "it fixes the observation space; make a new env"
+        )
+    if action_grid_fixed and (new.n_turns, new.n_move_lengths) != (
+        old.n_turns,
+        old.n_move_lengths,
+    ):
+        raise ValueError(
+            f"n_turns and n_move_lengths cannot change ({old.n_turns}, {old.n_move_lengths} "
+            f"-> {new.n_turns}, {new.n_move_lengths}): they fix the action space"
+        )
+
+
+def switch_maps(
+    state: BatchState, maps: MapBank, row: int, old: EnvConfig, new: EnvConfig
+) -> None:
+    """After a config change of row ``row``: an empty map if the map's settings (epsilon,
+    transfer) changed, since the row may have stale state in that other map batch."""
+    if (new.epsilon, new.transfer) != (old.epsilon, old.transfer):
+        maps.batch(int(state.n_landmarks[row]), new).reset([row])
+
+
+# ----------------------------------------------------------------------------------------
+# Ground truth, read-only
+# ----------------------------------------------------------------------------------------
+
+
+class WorldView:
+    """One row's ground truth (true landmarks, the robot's true pose), read-only and live.
+
+    It reads the batch's arrays, so it follows the episode; it offers what
+    :class:`~bearing_env.world.World` offers for reading. :meth:`copy` (and
+    ``copy.deepcopy``) give an independent, mutable :class:`World`.
+    """
+
+    def __init__(self, state_owner: Any, row: int) -> None:
+        # The owner (an env) is held rather than its state: the state object is
+        # replaced when the env is unpickled or its trajectory grows.
+        self._owner = state_owner
+        self._row = row
+
+    @property
+    def _state(self) -> BatchState:
+        return self._owner._state  # type: ignore[no-any-return]
+
+    @property
+    def _config(self) -> EnvConfig:
+        return self._owner._row_config(self._row)  # type: ignore[no-any-return]
+
+    @property
+    def arena(self) -> Arena:
+        return self._config.arena
+
+    @property
+    def noise(self) -> NoiseModel:
+        return self._config.noise
+
+    @property
+    def epsilon(self) -> float:
+        return self._config.epsilon
+
+    @property
+    def n_landmarks(self) -> int:
+        return int(self._state.n_landmarks[self._row])
+
+    @property
+    def landmarks(self) -> FloatArray:
+        """True landmark positions (n, 2), metres (a read-only view)."""
+        return _read_only(self._state.landmarks[self._row, : self.n_landmarks])
+
+    @property
+    def position(self) -> FloatArray:
+        """The robot's true position (2,), metres (a read-only view)."""
+        return _read_only(self._state.positions[self._row])
+
+    @property
+    def heading(self) -> float:
+        return float(self._state.headings[self._row])
+
+    @property
+    def min_baseline(self) -> float:
+        return REFERENCE_MIN_BASELINE * self.arena.scale
+
+    def true_bearings(self) -> FloatArray:
+        """Noise-free bearings (n,) of all landmarks, relative to the heading, [-pi, pi)."""
+        return true_bearings(
+            self.landmarks[None], self.position[None], np.array([self.heading])
+        )[0]
+
+    def copy(self) -> World:
+        """An independent, mutable snapshot of this ground truth."""
+        return World(
+            self.arena, self.landmarks, self.position, self.heading, self.noise, self.epsilon
+        )
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> World:
+        return self.copy()
+
+
+def _read_only(array: FloatArray) -> FloatArray:
+    view = array.view()
+    view.flags.writeable = False
+    return view
+
+
+# ----------------------------------------------------------------------------------------
+# Reset
+# ----------------------------------------------------------------------------------------
+
+
+def reset_rows(
+    state: BatchState,
+    rows: IntArray,
+    config: EnvConfig,
+    rngs: Sequence[np.random.Generator],
+    maps: MapBank,
+) -> None:
+    """Start new episodes in ``rows`` (all with ``config``); ``rngs[j]`` is row
+    ``rows[j]``'s generator.
+
+    Each row draws, from its own generator and in this order: its landmark count (for a
+    count range), its layout (``"random"``), its start pose, then its first reading.
+    Afterwards the rows may have different landmark counts (see :func:`group_rows`).
+    """
+    lo, hi = config.landmark_counts
+    fixed = config.fixed_landmarks
+    state.landmarks[rows] = 0.0
+    state.landmarks_fl[rows] = 0.0
+    for row, rng in zip(rows.tolist(), rngs, strict=True):
+        # Rejection sampling makes the draws per row: a layout's draw count varies.
+        count = int(rng.integers(lo, hi + 1)) if hi > lo else hi
+        landmarks = fixed if fixed is not None else random_layout(rng, config.arena, count)
+        position, heading = random_start(rng, config.arena, landmarks)
+        state.n_landmarks[row] = count
+        state.landmarks[row, :count] = landmarks
+        state.positions[row] = position
+        state.headings[row] = float(wrap_angle(heading))
+        # Landmarks do not move: their true FL positions (for info) are fixed per episode.
+        origin = complex(*landmarks[0])
+        unit = complex(*landmarks[1]) - origin
+        points = landmarks[2:, 0] + 1j * landmarks[2:, 1]
+        state.frame_origin[row] = origin
+        state.frame_unit[row] = unit
+        state.landmarks_fl[row, : count - 2] = (points - origin) / unit
+    state.moves[rows] = 0
+    state.frame_changed[rows] = False
+    state.blocked[rows] = False
+    state.done[rows] = False
+    state.start_bearings[rows] = np.nan
+    state.start_positions[rows] = np.nan
+    state.trajectory_length[rows] = 0
+    state.append_positions(rows)
+    rng_of = dict(zip(rows.tolist(), rngs, strict=True))
+    for n, group in group_rows(state, rows):
+        truth = true_bearings(
+            state.landmarks[group, :n], state.positions[group], state.headings[group]
+        )
+        group_rngs = [rng_of[i] for i in group.tolist()]
+        readings = config.noise.corrupt_rows(group_rngs, truth, config.epsilon)
+        state.latest_bearings[group] = 0.0
+        state.latest_bearings[group, :n] = readings
+        batch = maps.batch(n, config)
+        batch.reset(group)
+        state.potentials[group] = potentials(batch.areas[group], config)
+
+
+def group_rows(state: BatchState, rows: IntArray) -> list[tuple[int, IntArray]]:
+    """``rows`` split by landmark count: ``[(n, rows with n landmarks), ...]``."""
+    counts = state.n_landmarks[rows]
+    first = int(counts[0])
+    if np.all(counts == first):  # the common case: one count
+        return [(first, rows)]
+    return [(int(n), rows[counts == n]) for n in np.unique(counts)]
+
+
+# ----------------------------------------------------------------------------------------
+# Step
+# ----------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class StepOutcome:
+    """What one step of a group did, per row (arrays of the group's length)."""
+
+    rewards: FloatArray
+    terminated: BoolArray
+    truncated: BoolArray
+    frame_changed: BoolArray
+    inconsistent: IntArray
+    travelled: FloatArray
+    #: The named reward parts; the reward is their sum.
+    uncertainty: FloatArray
+    path_cost: FloatArray
+    move_cost: FloatArray
+
+
+def step(
+    state: BatchState,
+    rows: IntArray,
+    config: EnvConfig,
+    turns: FloatArray,
+    lengths: FloatArray,
+    rngs: Sequence[np.random.Generator],
+    maps: MapBank,
+) -> StepOutcome:
+    """One movement of every row of a group (same config, same landmark count ``n``):
+    turn, read, move straight (stopped at the wall), read, update the map.
+
+    ``turns`` and ``lengths`` are decoded actions (radians, metres); ``rngs[j]`` is row
+    ``rows[j]``'s generator.
+    """
+    n = int(state.n_landmarks[rows[0]])
+    arena, noise, epsilon = config.arena, config.noise, config.epsilon
+    min_baseline = REFERENCE_MIN_BASELINE * arena.scale
+    headings = wrap_angle(state.headings[rows] + turns)
+    positions = state.positions[rows]
+    landmarks = state.landmarks[rows, :n]
+    start_bearings = noise.corrupt_rows(
+        rngs, true_bearings(landmarks, positions, headings), epsilon
+    )
+    travelled, blocked, moved = straight_moves(arena, positions, headings, lengths, min_baseline)
+    end_bearings = noise.corrupt_rows(rngs, true_bearings(landmarks, moved, headings), epsilon)
+
+    state.headings[rows] = headings
+    state.positions[rows] = moved
+    state.start_positions[rows] = positions
+    state.start_bearings[rows, :n] = start_bearings
+    state.latest_bearings[rows, :n] = end_bearings
+    state.blocked[rows] = blocked
+    state.moves[rows] += 1
+    state.append_positions(rows)
+
+    # A move that could not start took both readings from the same place: there is no
+    # robot frame (R1 = R2), so the SLAM must not see it. The robot knows it did not move
+    # (it is stuck against the wall).
+    changes_map = travelled >= min_baseline
+    frame_changed = np.zeros(rows.size, dtype=bool)
+    inconsistent = np.zeros(rows.size, dtype=np.int64)
+    batch = maps.batch(n, config)
+    if np.any(changes_map):
+        moving = np.flatnonzero(changes_map)
+        result = batch.update(start_bearings[moving], end_bearings[moving], maps=rows[moving])
+        frame_changed[moving] = result.frame_changed
+        inconsistent[moving] = result.n_inconsistent
+    state.frame_changed[rows] = frame_changed
+
+    potential = potentials(batch.areas[rows], config)
+    reward, (uncertainty, path_cost, move_cost) = rewards(
+        state.potentials[rows], potential, travelled, config
+    )
+    state.potentials[rows] = potential
+
+    terminated = np.all(batch.initialised[rows], axis=-1) & np.all(
+        batch.areas[rows] <= config.target_area, axis=-1
+    )
+    truncated = ~terminated & (state.moves[rows] >= config.max_moves)
+    state.done[rows] = terminated | truncated
+    return StepOutcome(
+        rewards=reward,
+        terminated=terminated,
+        truncated=truncated,
+        frame_changed=frame_changed,
+        inconsistent=inconsistent,
+        travelled=travelled,
+        uncertainty=uncertainty,
+        path_cost=path_cost,
+        move_cost=move_cost,
+    )
+
+
+def reset_outcome(size: int) -> StepOutcome:
+    """The outcome fields a reset reports in its info: nothing moved, nothing earned."""
+    zeros = np.zeros(size)
+    no = np.zeros(size, dtype=bool)
+    return StepOutcome(zeros, no, no, no, np.zeros(size, np.int64), zeros, zeros, zeros, zeros)
+
+
+# ----------------------------------------------------------------------------------------
+# Potential, observation, info
+# ----------------------------------------------------------------------------------------
+
+
+def _clipped(values: FloatArray, low: float, high: float) -> FloatArray:
+    # np.clip's Python wrapper costs more than the arithmetic on these small arrays.
+    return np.minimum(np.maximum(values, low), high)
+
+
+def _log_capped(areas: FloatArray, area_cap: float) -> FloatArray:
+    # Uninitialised landmarks have area inf, so the cap also stands in for them.
+    return np.log(_clipped(areas, AREA_FLOOR, area_cap))
+
+
+def _xy(points: ComplexArray) -> FloatArray:
+    """Complex points as (..., 2) coordinates, without copying."""
+    points = np.ascontiguousarray(points)
+    return points.view(np.float64).reshape(*points.shape, 2)
+
+
+def potentials(areas: FloatArray, config: EnvConfig) -> FloatArray:
+    """The uncertainty potential Phi of each row of landmark areas (see the env's
+    Rewards section)."""
+    if config.reward == "log_area":
+        return _log_capped(areas, config.area_cap).sum(axis=-1)
+    return _clipped(areas, AREA_FLOOR, config.area_cap).sum(axis=-1)
+
+
+def rewards(
+    previous_potential: FloatArray, potential: FloatArray, travelled: FloatArray, config: EnvConfig
+) -> tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray]]:
+    """The rewards of a group's step and their named parts (uncertainty, path cost, move
+    cost): the decrease of the potential, minus the costs of the path and of the move."""
+    uncertainty = previous_potential - potential
+    path_cost = -config.path_cost * travelled
+    move_cost = np.full(potential.shape, -config.move_cost)
+    # 0.0 + turns an uncertainty of -0.0 into 0.0; the order of the sum is fixed.
+    return ((0.0 + uncertainty) + path_cost) + move_cost, (uncertainty, path_cost, move_cost)
+
+
+def observations(
+    state: BatchState, rows: IntArray, config: EnvConfig, maps: MapBank
+) -> NDArray[np.float32]:
+    """Observations (len(rows), observation_size) of a group (see the env's Observation
+    Space section)."""
+    n = int(state.n_landmarks[rows[0]])
+    batch = maps.batch(n, config)
+    n_rows, n_slots = rows.size, config.max_landmarks
+    observation = np.zeros((n_rows, observation_size(n_slots)))
+    blocks = observation_slices(n_slots)
+    robot = observation[:, blocks["robot"]]
+    mapped = observation[:, blocks["landmarks"]].reshape(n_rows, n_slots - 2, -1)
+    bearing = observation[:, blocks["bearings"]].reshape(n_rows, n_slots, -1)
+
+    centroid = batch.robot_centroid[rows]
+    known = batch.has_robot[rows] & np.isfinite(centroid)
+    robot[:, 0:2] = _clipped(
+        _xy(np.where(known, centroid, 0.0)), -FL_COORD_LIMIT, FL_COORD_LIMIT
+    )
+    robot[:, 2] = np.where(
+        known, _log_capped(batch.robot_area[rows], config.area_cap), math.log(config.area_cap)
+    )
+    robot[:, 3] = ~known
+    heading = batch.robot_heading[rows]
+    has_heading = np.isfinite(heading)
+    safe_heading = np.where(has_heading, heading, 0.0)
+    robot[:, 4] = np.where(has_heading, np.cos(safe_heading), 0.0)
+    robot[:, 5] = np.where(has_heading, np.sin(safe_heading), 0.0)
+    robot[:, 6] = np.minimum(state.moves[rows] / config.max_moves, 1.0)
+    robot[:, 7] = state.frame_changed[rows]
+    robot[:, 8] = state.blocked[rows]
+
+    n_mapped = n - 2
+    initialised = batch.initialised[rows]
+    mapped[:, :n_mapped, 0] = 1.0
+    mapped[:, :n_mapped, 1] = ~initialised
+    mapped[:, :n_mapped, 2:4] = _clipped(
+        _xy(np.where(initialised, batch.centroids[rows], 0.0)), -FL_COORD_LIMIT, FL_COORD_LIMIT
+    )
+    mapped[:, :n_mapped, 4] = _log_capped(batch.areas[rows], config.area_cap)
+
+    latest = state.latest_bearings[rows, :n]
+    bearing[:, :n, 0] = 1.0
+    bearing[:, :n, 1] = np.cos(latest)
+    bearing[:, :n, 2] = np.sin(latest)
+    return observation.astype(np.float32)
+
+
+def infos(
+    state: BatchState,
+    rows: IntArray,
+    config: EnvConfig,
+    maps: MapBank,
+    outcome: StepOutcome,
+) -> dict[str, Any]:
+    """The group's infos, batched along a first axis (see the env's Info section)."""
+    n = int(state.n_landmarks[rows[0]])
+    batch = maps.batch(n, config)
+    initialised = batch.initialised[rows]
+    areas = batch.areas[rows]
+    truth = state.landmarks_fl[rows, : n - 2]
+    errors = np.where(
+        initialised, np.abs(np.where(initialised, batch.centroids[rows] - truth, 0.0)), np.inf
+    )
+    contains = batch.contains(truth, maps=rows)
+    position = np.ascontiguousarray(state.positions[rows]).view(np.complex128)[:, 0]
+    robot_truth = (position - state.frame_origin[rows]) / state.frame_unit[rows]
+    robot_centroid = batch.robot_centroid[rows]
+    robot_known = np.isfinite(robot_centroid)
+    robot_error = np.where(
+        robot_known, np.abs(np.where(robot_known, robot_centroid - robot_truth, 0.0)), np.inf
+    )
+    return {
+        "landmark_area": areas,
+        "landmark_error": errors,
+        "landmark_contains_truth": contains,
+        "total_area": areas.sum(axis=-1),
+        "robot_error": robot_error,
+        "frame_changed": outcome.frame_changed,
+        "inconsistent": outcome.inconsistent,
+        "path_length": outcome.travelled,
+        "rewards": {
+            "uncertainty": outcome.uncertainty,
+            "path_cost": outcome.path_cost,
+            "move_cost": outcome.move_cost,
+        },
+    }
+
+
+def row_info(batched: dict[str, Any], row: int) -> dict[str, Any]:
+    """One env's info dict (Python scalars, per-landmark arrays) from batched infos."""
+    info: dict[str, Any] = {}
+    for key, value in batched.items():
+        if isinstance(value, dict):
+            info[key] = row_info(value, row)
+        elif value.ndim > 1:
+            info[key] = value[row].copy()
+        else:
+            info[key] = value[row].item()
+    return info
+
+
+# ----------------------------------------------------------------------------------------
+# Actions
+# ----------------------------------------------------------------------------------------
+
+
+def _real_values(actions: Any, what: str) -> NDArray[Any]:
+    """``actions`` as a numeric array; strings, bools, complex numbers and other objects
+    are refused (numpy would quietly turn ``"0.5"`` or ``True`` into a float)."""
+    values = np.asarray(actions)
+    if values.dtype == object:
+        flat = values.ravel().tolist()
+        if not all(_is_real(value) for value in flat):
+            raise ValueError(f"{what} must be real numbers, got {actions!r}")
+        values = np.array(flat, dtype=np.float64).reshape(values.shape)
+    elif values.dtype.kind not in "iuf":
+        raise ValueError(f"{what} must be real numbers, got {actions!r} (dtype {values.dtype})")
+    return values
+
+
+def _is_real(value: Any) -> bool:
+    return not isinstance(value, (bool, np.bool_)) and isinstance(
+        value, (int, float, np.integer, np.floating)
+    )
+
+
+def decode_continuous(config: EnvConfig, actions: Any) -> tuple[FloatArray, FloatArray]:
+    """(turn angles, move lengths) from continuous actions (N, 2) in [-1, 1]^2."""
+    values = _real_values(actions, "actions").astype(np.float64)
+    if not np.all(np.isfinite(values)):
+        raise ValueError(f"actions must be finite, got {actions!r}")
+    # float32 rounding of +-1 must not be rejected; anything else outside is a bug.
+    if np.any(np.abs(values) > 1.0 + 1e-6):
+        raise ValueError(f"actions {actions!r} are outside the action space [-1, 1]^2")
+    values = np.minimum(np.maximum(values, -1.0), 1.0)
+    lo, hi = config.move_length
+    return math.pi * values[:, 0], lo + 0.5 * (values[:, 1] + 1.0) * (hi - lo)
+
+
+def discrete_tables(config: EnvConfig) -> tuple[FloatArray, FloatArray]:
+    """The discrete action grid: (turn angles (n_turns,), move lengths (n_move_lengths,))."""
+    lo, hi = config.move_length
+    turns = wrap_angle(2.0 * math.pi * np.arange(config.n_turns) / config.n_turns)
+    return turns, np.linspace(lo, hi, config.n_move_lengths)
+
+
+def decode_discrete(config: EnvConfig, actions: Any) -> tuple[FloatArray, FloatArray]:
+    """(turn angles, move lengths) from discrete action indices (N,)."""
+    n_actions = config.n_turns * config.n_move_lengths
+    values = _real_values(actions, f"actions (integers in [0, {n_actions}))")
+    if values.dtype.kind == "f":
+        if not np.all(np.isfinite(values)) or np.any(values != np.round(values)):
+            raise ValueError(f"actions must be integers in [0, {n_actions}), got {actions!r}")
+    index = values.astype(np.int64)
+    if np.any((index < 0) | (index >= n_actions)):
+        raise ValueError(
+            f"actions {actions!r} are outside the action space Discrete({n_actions})"
+        )
+    turns, lengths = discrete_tables(config)
+    turn_index, length_index = np.divmod(index, config.n_move_lengths)
+    return turns[turn_index], lengths[length_index]
+
+
+# ----------------------------------------------------------------------------------------
+# Rendering
+# ----------------------------------------------------------------------------------------
+
+
+def scene(state: BatchState, row: int, config: EnvConfig, slam: PolygonSLAM) -> Any:
+    """What the renderer draws for one row (pygame is only imported here)."""
+    from bearing_env.rendering import Scene
+    from bearing_env.slam import fl_to_world
+
+    n = int(state.n_landmarks[row])
+    landmarks = state.landmarks[row, :n].copy()
+    l1, l2 = landmarks[0], landmarks[1]
+
+    def to_world(points: FloatArray | None) -> FloatArray | None:
+        return None if points is None else fl_to_world(points, l1, l2)
+
+    has_moved = bool(np.all(np.isfinite(state.start_positions[row])))
+    areas = slam.areas
+    return Scene(
+        arena=config.arena,
+        landmarks=landmarks,
+        estimates=fl_to_world(slam.estimates, l1, l2),
+        regions=[to_world(polygon) for polygon in slam.polygons],
+        robot_region=to_world(slam.robot_polygon),
+        robot_position=state.positions[row].copy(),
+        robot_heading=float(state.headings[row]),
+        trajectory=state.trajectory[row, : state.trajectory_length[row]].copy(),
+        start_position=state.start_positions[row].copy() if has_moved else None,
+        start_bearings=state.start_bearings[row, :n].copy() if has_moved else None,
+        end_bearings=state.latest_bearings[row, :n].copy(),
+        epsilon=config.epsilon,
+        moves=int(state.moves[row]),
+        max_moves=config.max_moves,
+        total_area=float(np.sum(areas)),
+        n_initialised=int(np.sum(slam.initialised)),
+        frame_changed=bool(state.frame_changed[row]),
+        robot_radius=config.arena.wall_margin,
+    )

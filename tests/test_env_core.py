@@ -1,0 +1,73 @@
+"""The functional core: a batch of rows computes as rows computed one at a time."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bearing_env.envs import core
+from bearing_env.envs.config import EnvConfig
+from bearing_env.envs.core import BatchState, MapBank
+
+
+def started_batch(
+    config: EnvConfig, num_rows: int, seed: int
+) -> tuple[BatchState, MapBank, list[np.random.Generator]]:
+    state = BatchState.empty(num_rows, config.max_landmarks)
+    maps = MapBank(num_rows)
+    rngs = [np.random.default_rng(seed + row) for row in range(num_rows)]
+    core.reset_rows(state, np.arange(num_rows), config, rngs, maps)
+    return state, maps, rngs
+
+
+def test_a_batch_steps_as_its_rows_one_at_a_time() -> None:
+    config = EnvConfig.create(n_landmarks=6, noise={"kind": "gaussian", "outlier_rate": 0.1})
+    n = 5
+    batch, batch_maps, batch_rngs = started_batch(config, n, seed=10)
+    singles = [started_batch(config, 1, seed=10 + row) for row in range(n)]
+    actions = np.random.default_rng(0).uniform(-1, 1, (6, n, 2))
+    all_rows, one = np.arange(n), np.array([0])
+    for step_actions in actions:
+        turns, lengths = core.decode_continuous(config, step_actions)
+        outcome = core.step(batch, all_rows, config, turns, lengths, batch_rngs, batch_maps)
+        observations = core.observations(batch, all_rows, config, batch_maps)
+        for row, (state, maps, rngs) in enumerate(singles):
+            single = core.step(
+                state, one, config, turns[row : row + 1], lengths[row : row + 1], rngs, maps
+            )
+            assert single.rewards[0] == outcome.rewards[row]
+            assert single.frame_changed[0] == outcome.frame_changed[row]
+            assert np.array_equal(core.observations(state, one, config, maps)[0], observations[row])
+            assert np.array_equal(state.positions[0], batch.positions[row])
+    assert np.any(batch.frame_changed)  # the maps really fused movements
+
+
+def test_a_group_step_leaves_the_other_rows_untouched() -> None:
+    config = EnvConfig.create(scenario="khepera")
+    state, maps, rngs = started_batch(config, 4, seed=3)
+    before = {name: np.copy(value) for name, value in vars(state).items()}
+    areas_before = maps.batch(4, config).areas.copy()
+    group = np.array([1, 3])
+    turns, lengths = core.decode_continuous(config, np.array([[0.3, 1.0], [-0.2, 1.0]]))
+    core.step(state, group, config, turns, lengths, [rngs[1], rngs[3]], maps)
+    others = np.array([0, 2])
+    for name, value in vars(state).items():
+        if name == "trajectory":
+            continue  # may have grown; the used entries are compared below
+        assert np.array_equal(value[others], before[name][others], equal_nan=True), name
+    assert np.array_equal(maps.batch(4, config).areas[others], areas_before[others])
+    assert np.all(state.moves[group] == 1) and np.all(state.trajectory_length[group] == 2)
+    assert np.array_equal(state.trajectory[others, :1], before["trajectory"][others, :1])
+
+
+def test_the_trajectory_grows_past_its_first_capacity() -> None:
+    config = EnvConfig.create(scenario="khepera", max_moves=200, target_area=1e-12)
+    state, maps, rngs = started_batch(config, 2, seed=0)
+    rows = np.arange(2)
+    visited = [state.positions.copy()]
+    steps = 2 * core.INITIAL_TRAJECTORY_SLOTS + 3
+    for action in np.random.default_rng(1).uniform(-1, 1, (steps, 2, 2)):
+        turns, lengths = core.decode_continuous(config, action)
+        core.step(state, rows, config, turns, lengths, rngs, maps)
+        visited.append(state.positions.copy())
+    assert np.all(state.trajectory_length == steps + 1)
+    assert np.array_equal(state.trajectory[:, : steps + 1], np.stack(visited, axis=1))
