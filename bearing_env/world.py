@@ -1,6 +1,7 @@
 """The simulated world: arena, true landmarks, robot pose, motion and the bearing sensor.
 
-Pure numpy (no gymnasium, no pygame), so it can be reused by planners and benchmarks.
+numpy, with the motion and the noise-free bearings compiled by numba (no gymnasium, no
+pygame), so it can be reused by planners and benchmarks.
 
 Units: lengths are in **metres**, angles in **radians** (the public constructor arguments
 that are in degrees say so in their names, e.g. ``bound_deg``). The paper's Khepera field
@@ -19,9 +20,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.slam.geometry import wrap_angle
+from bearing_env.slam.kernels import wrap
 
 FloatArray = NDArray[np.float64]
 
@@ -197,26 +200,77 @@ class NoiseModel:
     ) -> FloatArray:
         """:meth:`corrupt` for many robots at once: row ``i`` of ``true_bearings`` (N, n)
         draws from ``rngs[i]`` (one generator per row), in the order :meth:`corrupt` would."""
-        size = true_bearings.shape[1]
-        if self.kind == "uniform":
-            bound = epsilon if self.bound_deg is None else math.radians(self.bound_deg)
-            noise = [rng.uniform(-bound, bound, size) for rng in rngs]
-        elif self.kind == "gaussian":
-            sigma = 0.5 * epsilon if self.sigma_deg is None else math.radians(self.sigma_deg)
-            noise = [rng.normal(0.0, sigma, size) for rng in rngs]
-        else:
-            noise = [np.zeros(size) for _ in rngs]
-        if self.outlier_rate == 0.0:
-            return wrap_angle(true_bearings + np.stack(noise))
-        # Each robot draws its noise, then both outlier arrays in full, so the stream of
-        # draws does not depend on which landmarks turn out to be outliers.
-        is_outlier = np.empty(true_bearings.shape, dtype=bool)
-        random_bearing = np.empty(true_bearings.shape)
+        draws = self.draw_rows(rngs, true_bearings.shape[1], epsilon)
+        out = np.empty(true_bearings.shape)
+        apply_noise(np.ascontiguousarray(true_bearings, dtype=np.float64), draws, out)
+        return out
+
+    def draw_rows(
+        self, rngs: Sequence[np.random.Generator], size: int, epsilon: float
+    ) -> NoiseDraws:
+        """The random draws of one reading of ``size`` bearings per robot (row ``i`` from
+        ``rngs[i]``); :func:`apply_noise` turns true bearings into the reading.
+
+        Each robot draws its noise, then (with outliers) both outlier arrays in full, so
+        the stream of draws does not depend on which landmarks turn out to be outliers.
+        """
+        rows = len(rngs)
+        offsets = np.zeros((rows, size))
+        outliers = self.outlier_rate > 0.0
+        is_outlier = np.zeros((rows, size), dtype=bool) if outliers else None
+        replacement = np.zeros((rows, size)) if outliers else None
+        bound = epsilon if self.bound_deg is None else math.radians(self.bound_deg)
+        sigma = 0.5 * epsilon if self.sigma_deg is None else math.radians(self.sigma_deg)
         for row, rng in enumerate(rngs):
-            is_outlier[row] = rng.random(size) < self.outlier_rate
-            random_bearing[row] = rng.uniform(-np.pi, np.pi, size)
-        noisy = true_bearings + np.stack(noise)
-        return wrap_angle(np.where(is_outlier, random_bearing, noisy))
+            if self.kind == "uniform":
+                offsets[row] = rng.uniform(-bound, bound, size)
+            elif self.kind == "gaussian":
+                offsets[row] = rng.normal(0.0, sigma, size)
+            if is_outlier is not None and replacement is not None:
+                is_outlier[row] = rng.random(size) < self.outlier_rate
+                replacement[row] = rng.uniform(-np.pi, np.pi, size)
+        return NoiseDraws(offsets, is_outlier, replacement)
+
+
+@dataclass(frozen=True)
+class NoiseDraws:
+    """One reading's random draws per robot (rows): an offset per bearing and, with
+    outliers, which bearings are outliers and the random bearings that replace them."""
+
+    offsets: FloatArray
+    is_outlier: NDArray[np.bool_] | None
+    replacement: FloatArray | None
+
+
+def apply_noise(true_bearings: FloatArray, draws: NoiseDraws, out: FloatArray) -> None:
+    """The noisy reading (wrapped to [-pi, pi)) of true bearings (N, n), into ``out``."""
+    if draws.is_outlier is None or draws.replacement is None:
+        _add_wrapped(true_bearings, draws.offsets, out)
+    else:
+        _add_wrapped_with_outliers(
+            true_bearings, draws.offsets, draws.is_outlier, draws.replacement, out
+        )
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _add_wrapped(true_bearings: FloatArray, offsets: FloatArray, out: FloatArray) -> None:
+    for i in range(true_bearings.shape[0]):
+        for j in range(true_bearings.shape[1]):
+            out[i, j] = wrap(true_bearings[i, j] + offsets[i, j])
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _add_wrapped_with_outliers(
+    true_bearings: FloatArray,
+    offsets: FloatArray,
+    is_outlier: NDArray[np.bool_],
+    replacement: FloatArray,
+    out: FloatArray,
+) -> None:
+    for i in range(true_bearings.shape[0]):
+        for j in range(true_bearings.shape[1]):
+            value = replacement[i, j] if is_outlier[i, j] else true_bearings[i, j] + offsets[i, j]
+            out[i, j] = wrap(value)
 
 
 # --------------------------------------------------------------------------------------
@@ -413,10 +467,65 @@ class World:
 # --------------------------------------------------------------------------------------
 
 
+@njit(cache=True, nogil=True, error_model="numpy")
+def bearing(landmark_x: float, landmark_y: float, x: float, y: float, heading: float) -> float:
+    """The noise-free bearing of a landmark from a pose, radians CCW from the heading."""
+    return wrap(math.atan2(landmark_y - y, landmark_x - x) - heading)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def straight_move(
+    x: float,
+    y: float,
+    heading: float,
+    length: float,
+    width: float,
+    height: float,
+    margin: float,
+    min_baseline: float,
+) -> tuple[float, float, float, bool]:
+    """One straight move stopped at the wall margin: ``(new x, new y, travelled, blocked)``.
+
+    A robot that could not move at least ``min_baseline`` (against the wall, up to
+    rounding) does not move at all.
+    """
+    dx, dy = math.cos(heading), math.sin(heading)
+    # Per axis, the wall the heading points at is the only one that can stop it.
+    room_x = (width - margin - x) / dx if dx > 0.0 else (margin - x) / dx if dx < 0.0 else np.inf
+    room_y = (height - margin - y) / dy if dy > 0.0 else (margin - y) / dy if dy < 0.0 else np.inf
+    free = max(0.0, min(room_x, room_y))
+    if free < min_baseline:
+        free = 0.0
+    travelled = min(length, free)
+    # Rounding can leave the robot a hair outside the margin; clamp so the invariant
+    # "always inside the margin" holds exactly.
+    new_x = min(max(x + travelled * dx, margin), width - margin)
+    new_y = min(max(y + travelled * dy, margin), height - margin)
+    return new_x, new_y, travelled, free < length
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _true_bearings_into(
+    landmarks: FloatArray, positions: FloatArray, headings: FloatArray, out: FloatArray
+) -> None:
+    for i in range(landmarks.shape[0]):
+        for j in range(landmarks.shape[1]):
+            out[i, j] = bearing(
+                landmarks[i, j, 0], landmarks[i, j, 1], positions[i, 0], positions[i, 1],
+                headings[i],
+            )
+
+
 def true_bearings(landmarks: FloatArray, positions: FloatArray, headings: FloatArray) -> FloatArray:
     """Noise-free bearings (N, n) of landmarks (N, n, 2) from poses (N, 2), (N,)."""
-    delta = landmarks - positions[:, None, :]
-    return wrap_angle(np.arctan2(delta[..., 1], delta[..., 0]) - headings[:, None])
+    out = np.empty(landmarks.shape[:2])
+    _true_bearings_into(
+        np.ascontiguousarray(landmarks, dtype=np.float64),
+        np.ascontiguousarray(positions, dtype=np.float64),
+        np.ascontiguousarray(headings, dtype=np.float64),
+        out,
+    )
+    return out
 
 
 def straight_moves(
@@ -426,25 +535,13 @@ def straight_moves(
     lengths: FloatArray,
     min_baseline: float,
 ) -> tuple[FloatArray, NDArray[np.bool_], FloatArray]:
-    """Straight moves stopped at the wall margin: ``(travelled, blocked, new positions)``.
-
-    A robot that could not move at least ``min_baseline`` (against the wall, up to
-    rounding) does not move at all.
-    """
-    margin = arena.wall_margin
-    dx, dy = np.cos(headings), np.sin(headings)
-    x, y = positions[:, 0], positions[:, 1]
-    # Per axis: the wall the heading points at is the only one that can stop it.
-    room_x = np.where(dx > 0.0, arena.width - margin - x, np.where(dx < 0.0, margin - x, np.inf))
-    room_y = np.where(dy > 0.0, arena.height - margin - y, np.where(dy < 0.0, margin - y, np.inf))
-    free = np.maximum(
-        0.0,
-        np.minimum(room_x / np.where(dx == 0.0, 1.0, dx), room_y / np.where(dy == 0.0, 1.0, dy)),
-    )
-    free = np.where(free < min_baseline, 0.0, free)
-    travelled = np.minimum(lengths, free)
-    # Rounding can leave the robot a hair outside the margin; clamp so the invariant
-    # "always inside the margin" holds exactly.
-    new_x = np.minimum(np.maximum(x + travelled * dx, margin), arena.width - margin)
-    new_y = np.minimum(np.maximum(y + travelled * dy, margin), arena.height - margin)
-    return travelled, free < lengths, np.stack([new_x, new_y], axis=-1)
+    """:func:`straight_move` for many robots: ``(travelled, blocked, new positions)``."""
+    travelled = np.empty(len(positions))
+    blocked = np.empty(len(positions), dtype=bool)
+    moved = np.empty((len(positions), 2))
+    for i, ((x, y), heading, length) in enumerate(zip(positions, headings, lengths, strict=True)):
+        moved[i, 0], moved[i, 1], travelled[i], blocked[i] = straight_move(
+            float(x), float(y), float(heading), float(length), arena.width, arena.height,
+            arena.wall_margin, min_baseline,
+        )
+    return travelled, blocked, moved

@@ -29,17 +29,18 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from bearing_env.envs import kernels
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig
 from bearing_env.slam import PolygonSLAM
-from bearing_env.slam.batch import BatchedPolygonSLAM
+from bearing_env.slam.batch import CONTAINMENT_TOLERANCE, BatchedPolygonSLAM
 from bearing_env.world import (
     REFERENCE_MIN_BASELINE,
     Arena,
+    NoiseDraws,
     NoiseModel,
     World,
     random_layout,
     random_start,
-    straight_moves,
     true_bearings,
     wrap_angle,
 )
@@ -389,7 +390,7 @@ def reset_rows(
         state.latest_bearings[group, :n] = readings
         batch = maps.batch(n, config)
         batch.reset(group)
-        state.potentials[group] = potentials(batch.areas[group], config)
+        state.potentials[group] = potentials(group, batch, config)
 
 
 def group_rows(state: BatchState, rows: IntArray) -> list[tuple[int, IntArray]]:
@@ -440,49 +441,81 @@ def step(
     n = int(state.n_landmarks[rows[0]])
     arena, noise, epsilon = config.arena, config.noise, config.epsilon
     min_baseline = REFERENCE_MIN_BASELINE * arena.scale
-    headings = wrap_angle(state.headings[rows] + turns)
-    positions = state.positions[rows]
-    landmarks = state.landmarks[rows, :n]
-    start_bearings = noise.corrupt_rows(
-        rngs, true_bearings(landmarks, positions, headings), epsilon
+    size = rows.size
+    # Each row draws its first reading's noise, then its second's, from its generator.
+    first = _draws_as_arrays(noise.draw_rows(rngs, n, epsilon))
+    second = _draws_as_arrays(noise.draw_rows(rngs, n, epsilon))
+    travelled = np.empty(size)
+    start_bearings = np.empty((size, n))
+    end_bearings = np.empty((size, n))
+    kernels.move_and_read(
+        rows,
+        np.ascontiguousarray(turns, dtype=np.float64),
+        np.ascontiguousarray(lengths, dtype=np.float64),
+        n,
+        arena.width,
+        arena.height,
+        arena.wall_margin,
+        min_baseline,
+        *first,
+        *second,
+        state.positions,
+        state.headings,
+        state.landmarks,
+        state.start_positions,
+        state.start_bearings,
+        state.latest_bearings,
+        state.moves,
+        state.blocked,
+        travelled,
+        start_bearings,
+        end_bearings,
     )
-    travelled, blocked, moved = straight_moves(arena, positions, headings, lengths, min_baseline)
-    end_bearings = noise.corrupt_rows(rngs, true_bearings(landmarks, moved, headings), epsilon)
-
-    state.headings[rows] = headings
-    state.positions[rows] = moved
-    state.start_positions[rows] = positions
-    state.start_bearings[rows, :n] = start_bearings
-    state.latest_bearings[rows, :n] = end_bearings
-    state.blocked[rows] = blocked
-    state.moves[rows] += 1
     state.append_positions(rows)
 
     # A move that could not start took both readings from the same place: there is no
     # robot frame (R1 = R2), so the SLAM must not see it. The robot knows it did not move
     # (it is stuck against the wall).
     changes_map = travelled >= min_baseline
-    frame_changed = np.zeros(rows.size, dtype=bool)
-    inconsistent = np.zeros(rows.size, dtype=np.int64)
+    frame_changed = np.zeros(size, dtype=bool)
+    inconsistent = np.zeros(size, dtype=np.int64)
     batch = maps.batch(n, config)
-    if np.any(changes_map):
+    if changes_map.all():
+        result = batch.update(start_bearings, end_bearings, maps=rows)
+        frame_changed, inconsistent = result.frame_changed, result.n_inconsistent
+    elif changes_map.any():
         moving = np.flatnonzero(changes_map)
         result = batch.update(start_bearings[moving], end_bearings[moving], maps=rows[moving])
         frame_changed[moving] = result.frame_changed
         inconsistent[moving] = result.n_inconsistent
     state.frame_changed[rows] = frame_changed
 
-    potential = potentials(batch.areas[rows], config)
-    reward, (uncertainty, path_cost, move_cost) = rewards(
-        state.potentials[rows], potential, travelled, config
+    reward, uncertainty, path_cost, move_cost = (np.empty(size) for _ in range(4))
+    terminated = np.empty(size, dtype=bool)
+    truncated = np.empty(size, dtype=bool)
+    kernels.finish_steps(
+        rows,
+        n - 2,
+        config.reward == "log_area",
+        AREA_FLOOR,
+        config.area_cap,
+        config.target_area,
+        config.max_moves,
+        config.path_cost,
+        config.move_cost,
+        travelled,
+        batch.areas,
+        batch.counts,
+        state.potentials,
+        state.moves,
+        state.done,
+        reward,
+        uncertainty,
+        path_cost,
+        move_cost,
+        terminated,
+        truncated,
     )
-    state.potentials[rows] = potential
-
-    terminated = np.all(batch.initialised[rows], axis=-1) & np.all(
-        batch.areas[rows] <= config.target_area, axis=-1
-    )
-    truncated = ~terminated & (state.moves[rows] >= config.max_moves)
-    state.done[rows] = terminated | truncated
     return StepOutcome(
         rewards=reward,
         terminated=terminated,
@@ -494,6 +527,13 @@ def step(
         path_cost=path_cost,
         move_cost=move_cost,
     )
+
+
+def _draws_as_arrays(draws: NoiseDraws) -> tuple[FloatArray, BoolArray, FloatArray]:
+    """(offsets, outlier mask, replacements) for the kernel; no outliers: all False."""
+    if draws.is_outlier is None or draws.replacement is None:
+        return draws.offsets, np.zeros(draws.offsets.shape, dtype=bool), draws.offsets
+    return draws.offsets, draws.is_outlier, draws.replacement
 
 
 def reset_outcome(size: int) -> StepOutcome:
@@ -508,40 +548,19 @@ def reset_outcome(size: int) -> StepOutcome:
 # ----------------------------------------------------------------------------------------
 
 
-def _clipped(values: FloatArray, low: float, high: float) -> FloatArray:
-    # np.clip's Python wrapper costs more than the arithmetic on these small arrays.
-    return np.minimum(np.maximum(values, low), high)
-
-
-def _log_capped(areas: FloatArray, area_cap: float) -> FloatArray:
-    # Uninitialised landmarks have area inf, so the cap also stands in for them.
-    return np.log(_clipped(areas, AREA_FLOOR, area_cap))
-
-
-def _xy(points: ComplexArray) -> FloatArray:
-    """Complex points as (..., 2) coordinates, without copying."""
-    points = np.ascontiguousarray(points)
-    return points.view(np.float64).reshape(*points.shape, 2)
-
-
-def potentials(areas: FloatArray, config: EnvConfig) -> FloatArray:
-    """The uncertainty potential Phi of each row of landmark areas (see the env's
-    Rewards section)."""
-    if config.reward == "log_area":
-        return _log_capped(areas, config.area_cap).sum(axis=-1)
-    return _clipped(areas, AREA_FLOOR, config.area_cap).sum(axis=-1)
-
-
-def rewards(
-    previous_potential: FloatArray, potential: FloatArray, travelled: FloatArray, config: EnvConfig
-) -> tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray]]:
-    """The rewards of a group's step and their named parts (uncertainty, path cost, move
-    cost): the decrease of the potential, minus the costs of the path and of the move."""
-    uncertainty = previous_potential - potential
-    path_cost = -config.path_cost * travelled
-    move_cost = np.full(potential.shape, -config.move_cost)
-    # 0.0 + turns an uncertainty of -0.0 into 0.0; the order of the sum is fixed.
-    return ((0.0 + uncertainty) + path_cost) + move_cost, (uncertainty, path_cost, move_cost)
+def potentials(state_rows: IntArray, batch: BatchedPolygonSLAM, config: EnvConfig) -> FloatArray:
+    """The uncertainty potential Phi of the rows' maps (see the env's Rewards section)."""
+    out = np.empty(state_rows.size)
+    kernels.potentials(
+        state_rows,
+        batch.areas,
+        batch.n_landmarks - 2,
+        config.reward == "log_area",
+        AREA_FLOOR,
+        config.area_cap,
+        out,
+    )
+    return out
 
 
 def observations(
@@ -551,45 +570,29 @@ def observations(
     Space section)."""
     n = int(state.n_landmarks[rows[0]])
     batch = maps.batch(n, config)
-    n_rows, n_slots = rows.size, config.max_landmarks
-    observation = np.zeros((n_rows, observation_size(n_slots)))
-    blocks = observation_slices(n_slots)
-    robot = observation[:, blocks["robot"]]
-    mapped = observation[:, blocks["landmarks"]].reshape(n_rows, n_slots - 2, -1)
-    bearing = observation[:, blocks["bearings"]].reshape(n_rows, n_slots, -1)
-
-    centroid = batch.robot_centroid[rows]
-    known = batch.has_robot[rows] & np.isfinite(centroid)
-    robot[:, 0:2] = _clipped(
-        _xy(np.where(known, centroid, 0.0)), -FL_COORD_LIMIT, FL_COORD_LIMIT
+    out = np.zeros((rows.size, observation_size(config.max_landmarks)), dtype=np.float32)
+    kernels.write_observations(
+        rows,
+        n,
+        config.max_landmarks,
+        AREA_FLOOR,
+        config.area_cap,
+        config.max_moves,
+        FL_COORD_LIMIT,
+        batch.robot_centroid,
+        batch.robot_counts,
+        batch.robot_area,
+        batch.robot_heading,
+        batch.counts,
+        batch.centroids,
+        batch.areas,
+        state.moves,
+        state.frame_changed,
+        state.blocked,
+        state.latest_bearings,
+        out,
     )
-    robot[:, 2] = np.where(
-        known, _log_capped(batch.robot_area[rows], config.area_cap), math.log(config.area_cap)
-    )
-    robot[:, 3] = ~known
-    heading = batch.robot_heading[rows]
-    has_heading = np.isfinite(heading)
-    safe_heading = np.where(has_heading, heading, 0.0)
-    robot[:, 4] = np.where(has_heading, np.cos(safe_heading), 0.0)
-    robot[:, 5] = np.where(has_heading, np.sin(safe_heading), 0.0)
-    robot[:, 6] = np.minimum(state.moves[rows] / config.max_moves, 1.0)
-    robot[:, 7] = state.frame_changed[rows]
-    robot[:, 8] = state.blocked[rows]
-
-    n_mapped = n - 2
-    initialised = batch.initialised[rows]
-    mapped[:, :n_mapped, 0] = 1.0
-    mapped[:, :n_mapped, 1] = ~initialised
-    mapped[:, :n_mapped, 2:4] = _clipped(
-        _xy(np.where(initialised, batch.centroids[rows], 0.0)), -FL_COORD_LIMIT, FL_COORD_LIMIT
-    )
-    mapped[:, :n_mapped, 4] = _log_capped(batch.areas[rows], config.area_cap)
-
-    latest = state.latest_bearings[rows, :n]
-    bearing[:, :n, 0] = 1.0
-    bearing[:, :n, 1] = np.cos(latest)
-    bearing[:, :n, 2] = np.sin(latest)
-    return observation.astype(np.float32)
+    return out
 
 
 def infos(
@@ -602,25 +605,36 @@ def infos(
     """The group's infos, batched along a first axis (see the env's Info section)."""
     n = int(state.n_landmarks[rows[0]])
     batch = maps.batch(n, config)
-    initialised = batch.initialised[rows]
-    areas = batch.areas[rows]
-    truth = state.landmarks_fl[rows, : n - 2]
-    errors = np.where(
-        initialised, np.abs(np.where(initialised, batch.centroids[rows] - truth, 0.0)), np.inf
-    )
-    contains = batch.contains(truth, maps=rows)
-    position = np.ascontiguousarray(state.positions[rows]).view(np.complex128)[:, 0]
-    robot_truth = (position - state.frame_origin[rows]) / state.frame_unit[rows]
-    robot_centroid = batch.robot_centroid[rows]
-    robot_known = np.isfinite(robot_centroid)
-    robot_error = np.where(
-        robot_known, np.abs(np.where(robot_known, robot_centroid - robot_truth, 0.0)), np.inf
+    size, n_mapped = rows.size, n - 2
+    areas = np.empty((size, n_mapped))
+    errors = np.empty((size, n_mapped))
+    contains = np.empty((size, n_mapped), dtype=bool)
+    total_area = np.empty(size)
+    robot_error = np.empty(size)
+    kernels.write_infos(
+        rows,
+        n_mapped,
+        CONTAINMENT_TOLERANCE,
+        batch.areas,
+        batch.counts,
+        batch.centroids,
+        batch.vertices,
+        state.landmarks_fl,
+        state.positions,
+        state.frame_origin,
+        state.frame_unit,
+        batch.robot_centroid,
+        areas,
+        errors,
+        contains,
+        total_area,
+        robot_error,
     )
     return {
         "landmark_area": areas,
         "landmark_error": errors,
         "landmark_contains_truth": contains,
-        "total_area": areas.sum(axis=-1),
+        "total_area": total_area,
         "robot_error": robot_error,
         "frame_changed": outcome.frame_changed,
         "inconsistent": outcome.inconsistent,

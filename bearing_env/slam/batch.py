@@ -201,8 +201,8 @@ class BatchedPolygonSLAM:
             landmark,
             bad,
         )
-        threads = kernels.threads()
-        if n_rows >= PARALLEL_MIN_MAPS and threads > 1:
+        threads = kernels.threads() if n_rows >= PARALLEL_MIN_MAPS else 1
+        if threads > 1:
             kernels.update_maps_parallel(min(n_rows, threads), *arguments)
         else:
             kernels.update_maps(*arguments)
@@ -249,7 +249,7 @@ class BatchedPolygonSLAM:
             raise ValueError(
                 f"maps must be indices in [0, {self.num_maps}), got {rows.tolist()}"
             )
-        if distinct and np.unique(rows).size != rows.size:
+        if distinct and rows.size > 1 and np.unique(rows).size != rows.size:
             raise ValueError(f"maps must not repeat a map, got {rows.tolist()}")
         return rows
 
