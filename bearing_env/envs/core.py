@@ -687,15 +687,17 @@ def _is_real(value: Any) -> bool:
 
 def decode_continuous(config: EnvConfig, actions: Any) -> tuple[FloatArray, FloatArray]:
     """(turn angles, move lengths) from continuous actions (N, 2) in [-1, 1]^2."""
-    values = _real_values(actions, "actions").astype(np.float64)
-    if not np.all(np.isfinite(values)):
-        raise ValueError(f"actions must be finite, got {actions!r}")
-    # float32 rounding of +-1 must not be rejected; anything else outside is a bug.
-    if np.any(np.abs(values) > 1.0 + 1e-6):
-        raise ValueError(f"actions {actions!r} are outside the action space [-1, 1]^2")
-    values = np.minimum(np.maximum(values, -1.0), 1.0)
+    values = _real_values(actions, "actions")
+    if values.ndim != 2 or values.shape[1] != 2:
+        raise ValueError(f"actions must have shape (N, 2), got shape {values.shape}")
+    turns, lengths = np.empty(values.shape[0]), np.empty(values.shape[0])
     lo, hi = config.move_length
-    return math.pi * values[:, 0], lo + 0.5 * (values[:, 1] + 1.0) * (hi - lo)
+    outcome = kernels.decode_continuous(values, lo, hi, turns, lengths)
+    if outcome == kernels.ACTIONS_NOT_FINITE:
+        raise ValueError(f"actions must be finite, got {actions!r}")
+    if outcome == kernels.ACTIONS_OUTSIDE:
+        raise ValueError(f"actions {actions!r} are outside the action space [-1, 1]^2")
+    return turns, lengths
 
 
 def discrete_tables(config: EnvConfig) -> tuple[FloatArray, FloatArray]:

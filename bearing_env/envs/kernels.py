@@ -276,3 +276,30 @@ def write_infos(
             robot_error[i] = abs(centroid - truth)
         else:
             robot_error[i] = np.inf
+
+
+#: Outcomes of :func:`decode_continuous`.
+ACTIONS_OK = 0
+ACTIONS_NOT_FINITE = 1
+ACTIONS_OUTSIDE = 2
+
+
+@njit(**_JIT)
+def decode_continuous(
+    actions: np.ndarray, lo: float, hi: float, turns: np.ndarray, lengths: np.ndarray
+) -> int:
+    """Turn angles and move lengths of continuous actions (N, 2) in [-1, 1]^2.
+
+    Returns :data:`ACTIONS_OK`, or why not (then the outputs are incomplete). float32
+    rounding of +-1 is accepted: values within 1e-6 outside are clipped.
+    """
+    for i in range(actions.shape[0]):
+        a, b = float(actions[i, 0]), float(actions[i, 1])
+        if not (np.isfinite(a) and np.isfinite(b)):
+            return ACTIONS_NOT_FINITE
+        if abs(a) > 1.0 + 1e-6 or abs(b) > 1.0 + 1e-6:
+            return ACTIONS_OUTSIDE
+        a, b = min(max(a, -1.0), 1.0), min(max(b, -1.0), 1.0)
+        turns[i] = math.pi * a
+        lengths[i] = lo + 0.5 * (b + 1.0) * (hi - lo)
+    return ACTIONS_OK

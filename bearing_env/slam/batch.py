@@ -196,7 +196,7 @@ class BatchedPolygonSLAM:
             self.edge_samples,
             self.on_inconsistency == "keep",
             bool(robot),
-            *(getattr(self, name) for name in STATE_ARRAYS),
+            *self._state_arrays(),
             frame,
             landmark,
             bad,
@@ -237,6 +237,11 @@ class BatchedPolygonSLAM:
     def robot_polygon(self, map_index: int) -> NDArray[np.complex128]:
         """The vertices (CCW) of a map's robot region; empty before any frame change."""
         return self.robot_vertices[map_index, : self.robot_counts[map_index]].copy()
+
+    def _state_arrays(self) -> tuple[NDArray[Any], ...]:
+        """The state in the kernels' argument order (see :data:`STATE_ARRAYS`)."""
+        d = self.__dict__
+        return tuple(d[name] for name in STATE_ARRAYS)
 
     def _check_maps(self, maps: ArrayLike | None, distinct: bool = True) -> IntArray:
         if maps is None:
