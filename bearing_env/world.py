@@ -232,6 +232,20 @@ class NoiseModel:
         return NoiseDraws(offsets, is_outlier, replacement)
 
 
+    def draw_movement_rows(
+        self, rngs: Sequence[np.random.Generator], size: int, epsilon: float
+    ) -> tuple[NoiseDraws, NoiseDraws]:
+        """The draws of a movement's two readings: :meth:`draw_rows` twice, in that order.
+
+        Without outliers a robot's two readings take one call of its generator (the
+        stream is the same as two calls: both distributions draw element by element).
+        """
+        if self.outlier_rate > 0.0 or self.kind == "none":
+            return self.draw_rows(rngs, size, epsilon), self.draw_rows(rngs, size, epsilon)
+        both = self.draw_rows(rngs, 2 * size, epsilon).offsets
+        return NoiseDraws(both[:, :size], None, None), NoiseDraws(both[:, size:], None, None)
+
+
 @dataclass(frozen=True)
 class NoiseDraws:
     """One reading's random draws per robot (rows): an offset per bearing and, with

@@ -237,3 +237,28 @@ def test_default_lengths_scale_with_the_arena() -> None:
     big = Arena(2.1, 2.1)
     assert big.default_move_length == pytest.approx((0.10, 0.60))
     assert big.wall_margin == pytest.approx(2 * KHEPERA.wall_margin)
+
+
+@pytest.mark.parametrize(
+    "noise",
+    [
+        {"kind": "uniform"},
+        {"kind": "gaussian", "sigma_deg": 1.0},
+        {"kind": "uniform", "outlier_rate": 0.3},
+        {"kind": "none"},
+    ],
+)
+def test_a_movements_draws_are_two_readings_draws_in_order(noise):
+    model = NoiseModel.parse(noise)
+    rngs = [np.random.default_rng(seed) for seed in (1, 2, 3)]
+    again = [np.random.default_rng(seed) for seed in (1, 2, 3)]
+    first, second = model.draw_movement_rows(rngs, 5, 0.03)
+    expected = (model.draw_rows(again, 5, 0.03), model.draw_rows(again, 5, 0.03))
+    for got, want in zip((first, second), expected, strict=True):
+        np.testing.assert_array_equal(got.offsets, want.offsets)
+        assert (got.is_outlier is None) == (want.is_outlier is None)
+        if want.is_outlier is not None:
+            np.testing.assert_array_equal(got.is_outlier, want.is_outlier)
+            np.testing.assert_array_equal(got.replacement, want.replacement)
+    # And the generators end in the same state.
+    assert [r.random() for r in rngs] == [r.random() for r in again]

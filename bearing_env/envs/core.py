@@ -443,8 +443,8 @@ def step(
     min_baseline = REFERENCE_MIN_BASELINE * arena.scale
     size = rows.size
     # Each row draws its first reading's noise, then its second's, from its generator.
-    first = _draws_as_arrays(noise.draw_rows(rngs, n, epsilon))
-    second = _draws_as_arrays(noise.draw_rows(rngs, n, epsilon))
+    first_draws, second_draws = noise.draw_movement_rows(rngs, n, epsilon)
+    first, second = _draws_as_arrays(first_draws), _draws_as_arrays(second_draws)
     travelled = np.empty(size)
     start_bearings = np.empty((size, n))
     end_bearings = np.empty((size, n))
