@@ -249,12 +249,13 @@ class BatchedPolygonSLAM:
         raw = np.asarray(maps)
         if raw.dtype.kind not in "iu" or raw.ndim != 1:
             raise TypeError(f"maps must be a 1-D array of int map indices, got {maps!r}")
-        rows = raw.astype(np.int64)
-        if rows.size and (rows.min() < 0 or rows.max() >= self.num_maps):
+        rows = np.ascontiguousarray(raw, dtype=np.int64)
+        problem = kernels.check_indices(rows, self.num_maps, distinct)
+        if problem == kernels.INDEX_OUT_OF_RANGE:
             raise ValueError(
                 f"maps must be indices in [0, {self.num_maps}), got {rows.tolist()}"
             )
-        if distinct and rows.size > 1 and np.unique(rows).size != rows.size:
+        if problem == kernels.INDEX_REPEATED:
             raise ValueError(f"maps must not repeat a map, got {rows.tolist()}")
         return rows
 

@@ -1003,6 +1003,26 @@ def update_maps_parallel(
         )
 
 
+#: Outcomes of :func:`check_indices`.
+INDEX_OK = 0
+INDEX_OUT_OF_RANGE = 1
+INDEX_REPEATED = 2
+
+
+@njit(**_JIT)
+def check_indices(indices: np.ndarray, size: int, distinct: bool) -> int:
+    """Whether ``indices`` are in ``[0, size)`` (and, if ``distinct``, none repeats)."""
+    seen = np.zeros(size if distinct else 0, dtype=np.bool_)
+    for index in indices:
+        if index < 0 or index >= size:
+            return INDEX_OUT_OF_RANGE
+        if distinct:
+            if seen[index]:
+                return INDEX_REPEATED
+            seen[index] = True
+    return INDEX_OK
+
+
 @njit(**_JIT)
 def all_finite(values: np.ndarray) -> bool:
     """Whether every element of a float array is finite (one pass, no temporaries)."""
