@@ -179,15 +179,15 @@ class BatchState:
 
     def append_positions(self, rows: IntArray) -> None:
         """Record the rows' current positions in their trajectories."""
-        lengths = self.trajectory_length[rows]
-        capacity = self.trajectory.shape[1]
-        needed = int(lengths.max()) + 1
-        if needed > capacity:
-            grown = np.zeros((self.num_rows, max(needed, 2 * capacity), 2))
+        if not kernels.append_positions(
+            rows, self.positions, self.trajectory, self.trajectory_length
+        ):
+            # Some row is full: double the capacity (for every row) and record again.
+            capacity = self.trajectory.shape[1]
+            grown = np.zeros((self.num_rows, 2 * capacity, 2))
             grown[:, :capacity] = self.trajectory
             self.trajectory = grown
-        self.trajectory[rows, lengths] = self.positions[rows]
-        self.trajectory_length[rows] = lengths + 1
+            kernels.append_positions(rows, self.positions, self.trajectory, self.trajectory_length)
 
 
 class MapBank:

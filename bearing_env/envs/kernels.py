@@ -94,6 +94,23 @@ def move_and_read(
 
 
 @njit(**_JIT)
+def append_positions(
+    rows: np.ndarray, positions: np.ndarray, trajectory: np.ndarray, lengths: np.ndarray
+) -> bool:
+    """Append each row's position to its trajectory; False (and nothing written) when
+    some row's trajectory is full."""
+    capacity = trajectory.shape[1]
+    for row in rows:
+        if lengths[row] >= capacity:
+            return False
+    for row in rows:
+        trajectory[row, lengths[row], 0] = positions[row, 0]
+        trajectory[row, lengths[row], 1] = positions[row, 1]
+        lengths[row] += 1
+    return True
+
+
+@njit(**_JIT)
 def capped(area: float, floor: float, cap: float) -> float:
     return min(max(area, floor), cap)
 
