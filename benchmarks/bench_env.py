@@ -30,7 +30,10 @@ Sections:
   numba cache (a new ``NUMBA_CACHE_DIR``), then, with that cache warm, the time from the
   interpreter's start to the end of the first ``env.step`` (imports included), the
   median of three processes. These are seconds, not ratios.
-- ``ppo``: SB3 ``PPO`` with ``train/hyperparams/ppo.yml``'s settings for BearingSLAM-v0
+- ``planning``: ``agents.GreedyOneStep``'s planning time per move (its ``act()``, which
+  scores 16 candidate moves on copies of the map), Khepera scenario, the median over the
+  moves of several episodes. Seconds, not a ratio.
+- ``ppo``: SB3 ``PPO with ``train/hyperparams/ppo.yml``'s settings for BearingSLAM-v0
   (VecNormalize included) on ``--ppo-envs`` envs built by ``train.train.make_training_env``
   for each vec env kind (batched, subproc with spawn, dummy). The rate is env steps per
   second of wall time of ``model.learn()``, measured after a warm-up ``learn()`` of one
@@ -53,7 +56,8 @@ b. batched env, 64 sub-envs (Khepera, 4 landmarks): total env steps/s >= 30% of
 c. 64 landmarks at >= 1/16 of the 4-landmark single-env rate;
 d. PPO on the batched env >= 2x the env steps/s of PPO on SubprocVecEnv, same n_envs;
 e. ``PolygonSLAM.update``, 4 landmarks, conservative: >= 20% of CartPole-v1's step rate;
-f. first env step in a fresh process with a warm numba cache: <= 1.5 s.
+f. first env step in a fresh process with a warm numba cache: <= 1.5 s;
+g. ``GreedyOneStep`` plans a move in <= 0.2 ms (median).
 """
 
 from __future__ import annotations
@@ -85,7 +89,7 @@ import bearing_env
 from benchmarks.bench_slam import cartpole_steps_per_second
 
 ENV_ID = "BearingSLAM-v0"
-SECTIONS: tuple[str, ...] = ("single", "vector", "slam", "startup", "ppo")
+SECTIONS: tuple[str, ...] = ("single", "vector", "slam", "startup", "planning", "ppo")
 PPO_KINDS: tuple[str, ...] = ("batched", "subproc", "dummy")
 DEFAULT_NUM_ENVS: tuple[int, ...] = (1, 4, 16, 64, 256)
 DEFAULT_SINGLE_LANDMARKS: tuple[int, ...] = (4, 16, 64)
@@ -108,6 +112,7 @@ TARGETS: dict[str, str] = {
     "d": "PPO on the batched env >= 2x PPO on SubprocVecEnv (same n_envs)",
     "e": "PolygonSLAM.update, 4 landmarks: >= 20% of CartPole-v1",
     "f": "first env step, fresh process, warm cache: <= 1.5 s",
+    "g": "GreedyOneStep planning per move (median): <= 0.2 ms",
 }
 TARGET_THRESHOLDS: dict[str, float] = {
     "a": 0.10,
@@ -116,9 +121,12 @@ TARGET_THRESHOLDS: dict[str, float] = {
     "d": 2.0,
     "e": 0.20,
     "f": 1.5,
+    "g": 0.2e-3,
 }
 #: Targets that are upper bounds (seconds); the others are lower bounds (ratios).
-UPPER_BOUND_TARGETS = frozenset({"f"})
+UPPER_BOUND_TARGETS = frozenset({"f", "g"})
+#: Episodes of the planning section (Khepera, 20 moves each; --quick: 2).
+PLANNING_EPISODES = 20
 #: Fresh processes timed with a warm cache (the median counts).
 STARTUP_WARM_RUNS = 3
 
@@ -326,6 +334,35 @@ def bench_startup() -> dict[str, Any]:
         "cold_first_step_s": cold,
         "warm_first_step_s": float(np.median(warm)),
         "warm_runs_s": warm,
+    }
+
+
+def bench_planning(episodes: int) -> dict[str, Any]:
+    """GreedyOneStep's act() time per move, Khepera, seeded episodes."""
+    from agents import GreedyOneStep
+
+    env = gym.make(ENV_ID, scenario="khepera")
+    policy = GreedyOneStep(env)
+    times: list[float] = []
+    for episode in range(episodes + 1):  # the first episode warms up, untimed
+        observation, info = env.reset(seed=episode)
+        policy.reset(seed=episode)
+        done = False
+        while not done:
+            start = time.perf_counter()
+            action = policy.act(observation, info)
+            if episode:
+                times.append(time.perf_counter() - start)
+            observation, _, terminated, truncated, info = env.step(action)
+            done = terminated or truncated
+    env.close()
+    median = float(np.median(times))
+    log(f"  GreedyOneStep: {median * 1e3:.3f} ms per move (median of {len(times)})")
+    return {
+        "moves": len(times),
+        "median_s": median,
+        "mean_s": float(np.mean(times)),
+        "p90_s": float(np.percentile(times, 90)),
     }
 
 
@@ -709,6 +746,12 @@ def evaluate_targets(results: dict[str, Any]) -> list[dict[str, Any]]:
     else:
         targets.append(_target("f", startup["warm_first_step_s"]))
 
+    planning = results.get("planning")
+    if planning is None:
+        targets.append(_target("g", None, "needs the planning section"))
+    else:
+        targets.append(_target("g", planning["median_s"]))
+
     batched, subproc = ppo.get("batched"), ppo.get("subproc")
     if batched is None or subproc is None:
         targets.append(_target("d", None, "needs the batched and subproc PPO rows"))
@@ -887,6 +930,14 @@ def table_notes(results: dict[str, Any]) -> list[str]:
             f"compiling from an empty numba cache; {startup['warm_first_step_s']:.2f} s with "
             f"the cache warm (median of {warm} s).",
         ]
+    planning = results.get("planning")
+    if planning is not None:
+        lines += [
+            "",
+            f"Planning: GreedyOneStep.act {planning['median_s'] * 1e3:.3f} ms per move "
+            f"(median of {planning['moves']} moves; mean {planning['mean_s'] * 1e3:.3f} ms, "
+            f"p90 {planning['p90_s'] * 1e3:.3f} ms).",
+        ]
     lines += ["", "Targets:"]
     lines.extend("  " + format_target(target) for target in results["targets"])
     lines.append("")
@@ -938,6 +989,8 @@ def format_target(target: dict[str, Any]) -> str:
         shown = f"{value:.3f} (need {target['threshold']:.4f})"
     elif target["id"] == "f":
         shown = f"{value:.2f} s (need <= {target['threshold']:g} s)"
+    elif target["id"] == "g":
+        shown = f"{value * 1e3:.3f} ms (need <= {target['threshold'] * 1e3:g} ms)"
     else:
         shown = f"{value:.2f}x (need {target['threshold']:.0f}x)"
     note = f"  [{target['note']}]" if target["note"] else ""
@@ -1201,6 +1254,10 @@ def run(settings: Settings) -> dict[str, Any]:
     if "startup" in settings.sections:
         log("[startup] fresh processes: compile, then first step with a warm cache")
         results["startup"] = bench_startup()
+    if "planning" in settings.sections:
+        log("[planning] GreedyOneStep.act on Khepera")
+        episodes = 2 if settings.quick else PLANNING_EPISODES
+        results["planning"] = bench_planning(episodes)
     if "ppo" in settings.sections:
         log(
             f"[ppo] SB3 PPO on {settings.ppo_envs} envs, {settings.ppo_rounds} interleaved "

@@ -42,12 +42,12 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
     `num_envs` copies of :class:`~bearing_env.envs.bearing_slam.BearingSLAMEnv` stepped
     together. The sub-envs are rows of one structure of arrays
-    (:class:`~bearing_env.envs.core.BatchState`), and each step is one batched numpy
-    computation per group of rows with the same settings (`EnvConfig`) and landmark
-    count: all robots move at once, all maps fuse their movement in one
+    (:class:`~bearing_env.envs.core.BatchState`), and each step is a few compiled kernel
+    calls per group of rows with the same settings (`EnvConfig`) and landmark count: all
+    robots move at once, all maps fuse their movement in one
     :class:`BatchedPolygonSLAM` update (most of the work), and observations, rewards and
-    infos are built as arrays. Only the random draws loop over sub-envs, because each
-    owns its random generator. The functions are :mod:`bearing_env.envs.core`'s, which
+    infos are built for the whole group. Only the random draws loop over sub-envs in
+    Python, because each owns its random generator. The functions are :mod:`bearing_env.envs.core`'s, which
     the single env runs with a batch of one, so the two cannot drift apart.
 
     For the same per-env seeds and actions it reproduces
