@@ -267,3 +267,15 @@ def test_quick_slam_and_startup(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert targets["f"]["met"] == (startup["warm_first_step_s"] <= 1.5)
     out = capsys.readouterr().out
     assert "update(), conservative, 4 landmarks" in out and "Start-up" in out
+
+
+def test_quick_planning(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    results, _ = run_quick(tmp_path, "--sections", "planning")
+    check_common(results, {"planning"})
+    planning = results["planning"]
+    assert planning["moves"] == 2 * 20  # two timed Khepera episodes of 20 moves
+    assert 0 < planning["median_s"] <= planning["p90_s"]
+    target = {t["id"]: t for t in results["targets"]}["g"]
+    assert target["value"] == planning["median_s"]
+    assert target["met"] == (planning["median_s"] <= 0.2e-3)
+    assert "GreedyOneStep.act" in capsys.readouterr().out
