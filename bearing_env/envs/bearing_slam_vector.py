@@ -47,8 +47,9 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
     robots move at once, all maps fuse their movement in one
     :class:`BatchedPolygonSLAM` update (most of the work), and observations, rewards and
     infos are built for the whole group. Only the random draws loop over sub-envs in
-    Python, because each owns its random generator. The functions are :mod:`bearing_env.envs.core`'s, which
-    the single env runs with a batch of one, so the two cannot drift apart.
+    Python, because each owns its random generator. The functions are
+    :mod:`bearing_env.envs.core`'s, which the single env runs with a batch of one, so the
+    two cannot drift apart.
 
     For the same per-env seeds and actions it reproduces
     `gym.make_vec(id, num_envs, vectorization_mode="sync")` exactly: observations,
