@@ -132,84 +132,50 @@ def convex_hull(points: np.ndarray, n_points: int, out: np.ndarray) -> int:
     vertices); returns its vertex count. ``out`` must hold ``n_points + 1`` points.
 
     Quickhull, which costs about n log h for h hull vertices: the conservative transfer's
-    clouds have hundreds of points but a few dozen hull vertices. It starts from the
-    quadrilateral of the extreme points, which one pass sorts the points around. A chain
-    from ``a`` to ``b`` owns the points strictly to the right of ``a -> b`` (outside the
-    hull so far); its farthest point ``c`` is a hull vertex, and the chains ``a -> c``
-    and ``c -> b`` own what lies right of them. Points on a line through two hull
-    vertices are dropped.
+    clouds have hundreds of points but a few dozen hull vertices. A chain from ``a`` to
+    ``b`` owns the points strictly to the right of ``a -> b`` (outside the hull so far);
+    its farthest point ``c`` is a hull vertex, and the chains ``a -> c`` and ``c -> b``
+    own what lies right of them. Points on a line through two hull vertices are dropped.
     """
     if n_points == 0:
         return 0
-    # The extreme points left, bottom, right and top (CCW) span a quadrilateral; points
-    # inside it are not hull vertices. Ties go to the next corner's side, so that a point
-    # outside two adjacent edges cannot occur.
-    left = bottom = right = top_most = 0
+    first = last = 0
     for i in range(1, n_points):
-        x, y = points[i].real, points[i].imag
-        p = points[left]
-        if x < p.real or (x == p.real and y < p.imag):
-            left = i
-        p = points[bottom]
-        if y < p.imag or (y == p.imag and x > p.real):
-            bottom = i
-        p = points[right]
-        if x > p.real or (x == p.real and y > p.imag):
-            right = i
-        p = points[top_most]
-        if y > p.imag or (y == p.imag and x < p.real):
-            top_most = i
-    corners = np.empty(4, dtype=np.int64)
-    n_corners = 0
-    for c in (left, bottom, right, top_most):
-        if n_corners == 0 or points[c] != points[corners[n_corners - 1]]:
-            corners[n_corners] = c
-            n_corners += 1
-    if n_corners > 1 and points[corners[n_corners - 1]] == points[corners[0]]:
-        n_corners -= 1
-    out[0] = points[corners[0]]
-    if n_corners == 1:
+        p = points[i]
+        lo, hi = points[first], points[last]
+        if p.real < lo.real or (p.real == lo.real and p.imag < lo.imag):
+            first = i
+        if p.real > hi.real or (p.real == hi.real and p.imag > hi.imag):
+            last = i
+    a, b = points[first], points[last]
+    out[0] = a
+    if a == b:
         return 1
-    # Each point outside the quadrilateral goes to the chain of the first edge it is
-    # outside of (strictly right of it); chains are laid out one after another in index.
-    chain_of = np.empty(n_points, dtype=np.int64)
-    chain_size = np.zeros(4, dtype=np.int64)
+    # Candidate indices, the lower side (right of a -> b) first, then the upper side.
+    index = np.empty(n_points, dtype=np.int64)
+    n_lower = 0
+    n_upper = 0
     for i in range(n_points):
-        chain_of[i] = -1
-        px, py = points[i].real, points[i].imag
-        for e in range(n_corners):
-            a = points[corners[e]]
-            b = points[corners[(e + 1) % n_corners]]
-            if (b.real - a.real) * (py - a.imag) - (b.imag - a.imag) * (px - a.real) < 0.0:
-                chain_of[i] = e
-                chain_size[e] += 1
-                break
-    chain_start = np.zeros(5, dtype=np.int64)
-    for e in range(n_corners):
-        chain_start[e + 1] = chain_start[e] + chain_size[e]
-    index = np.empty(max(1, chain_start[n_corners]), dtype=np.int64)
-    filled = chain_start[:4].copy()
+        side = cross(b - a, points[i] - a)
+        if side < 0.0:
+            index[n_lower] = i
+            n_lower += 1
     for i in range(n_points):
-        e = chain_of[i]
-        if e >= 0:
-            index[filled[e]] = i
-            filled[e] += 1
+        side = cross(b - a, points[i] - a)
+        if side > 0.0:
+            index[n_lower + n_upper] = i
+            n_upper += 1
     # A stack of tasks: hull the chain from point `chain_from` to `chain_to` over the
     # candidates index[start:end]; a task with start < 0 emits point `chain_from` instead.
-    size = 2 * (chain_start[n_corners] + n_corners) + 4
+    size = 2 * n_points + 4
     task_start = np.empty(size, dtype=np.int64)
     task_end = np.empty(size, dtype=np.int64)
     chain_from = np.empty(size, dtype=np.int64)
     chain_to = np.empty(size, dtype=np.int64)
-    top = 0
-    for e in range(n_corners - 1, -1, -1):  # pushed last edge first: popped in CCW order
-        following = corners[(e + 1) % n_corners]
-        if e < n_corners - 1:
-            task_start[top], chain_from[top] = -1, following
-            top += 1
-        task_start[top], task_end[top] = chain_start[e], chain_start[e + 1]
-        chain_from[top], chain_to[top] = corners[e], following
-        top += 1
+    task_start[0], task_end[0], chain_from[0], chain_to[0] = n_lower, n_lower + n_upper, last, first
+    task_start[1], chain_from[1] = -1, last
+    task_start[2], task_end[2], chain_from[2], chain_to[2] = 0, n_lower, first, last
+    top = 3
     k = 1
     while top > 0:
         top -= 1
