@@ -204,7 +204,14 @@ class MapBank:
         self._views: dict[tuple[int, float, str, int], PolygonSLAM] = {}
 
     def batch(self, n_landmarks: int, config: EnvConfig) -> BatchedPolygonSLAM:
+        last = self.__dict__.get("_last")
+        if last is not None and last[0] is config and last[1] == n_landmarks:
+            return last[2]  # the common case: asked again for the same group's batch
         key = (int(n_landmarks), config.epsilon, config.transfer)
+        self._last = (config, n_landmarks, self._batch_for(key, config))
+        return self._last[2]
+
+    def _batch_for(self, key: tuple[int, float, str], config: EnvConfig) -> BatchedPolygonSLAM:
         if key not in self.batches:
             self.batches[key] = BatchedPolygonSLAM(
                 self.num_rows, key[0], config.epsilon, transfer=config.transfer
@@ -651,7 +658,7 @@ def row_info(batched: dict[str, Any], row: int) -> dict[str, Any]:
     """One env's info dict (Python scalars, per-landmark arrays) from batched infos."""
     info: dict[str, Any] = {}
     for key, value in batched.items():
-        if isinstance(value, dict):
+        if type(value) is dict:
             info[key] = row_info(value, row)
         elif value.ndim > 1:
             info[key] = value[row].copy()
