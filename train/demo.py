@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 import bearing_env  # noqa: F401  (registers the ids)
 
-#: The paper's Khepera run is 10 movements; DESIGN.md's reference runs move 25 cm.
+#: The paper's Khepera run is 10 movements; docs/design.md's reference runs move 25 cm.
 DEFAULT_MOVES = 10
 MOVE_LENGTH = 0.25
 GIF_FRAME_SECONDS = 0.8

@@ -52,7 +52,7 @@ FIG11_EPSILONS: tuple[float, ...] = (2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
 PAPER_NOISE_DEG = 2.0
 #: The paper's final errors on the real robot (Sec. 4): 2 and 3 cm with a 20 cm unit.
 PAPER_FINAL_ERRORS = {"L3": 0.10, "L4": 0.15}
-#: Moves of 25 cm on the Khepera field (DESIGN.md's reference runs).
+#: Moves of 25 cm on the Khepera field (the reference runs of docs/design.md).
 KHEPERA_MOVE_LENGTH = 0.25
 #: Moves of about one FL unit in the paper's simulated world (L1-L2 = 0.5 m).
 PAPER_SIM_MOVE_LENGTH = 0.5
