@@ -38,6 +38,8 @@ from __future__ import annotations
 import argparse
 import ast
 import contextlib
+import csv
+import io
 import json
 import math
 import multiprocessing
@@ -256,11 +258,12 @@ def run_task(task: EpisodeTask) -> dict[str, Any]:
 # --------------------------------------------------------------------------------------
 
 
-def atomic_write_text(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` so readers see the old or the new file, never a part."""
+def atomic_write_text(path: Path, text: str, newline: str | None = None) -> None:
+    """Write ``text`` to ``path`` so readers see the old or the new file, never a part.
+    ``newline`` is :func:`open`'s (``""`` for CSV: no line-end translation)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(temporary, "w", encoding="utf-8") as handle:
+    with open(temporary, "w", encoding="utf-8", newline=newline) as handle:
         handle.write(text)
         handle.flush()
         os.fsync(handle.fileno())
@@ -664,7 +667,7 @@ def summary_csv(summary: Mapping[str, Any]) -> str:
         "frame_change_rate",
         "inconsistent_per_episode",
     ]
-    lines = [",".join(header)]
+    rows: list[list[Any]] = []
     for label, stats in summary["policies"].items():
         row: list[Any] = [label, stats["spec"], stats["episodes"]]
         for k in moves:
@@ -681,15 +684,25 @@ def summary_csv(summary: Mapping[str, Any]) -> str:
             stats["frame_change_rate"],
             stats["inconsistent_per_episode"],
         ]
-        lines.append(",".join(_csv_cell(value) for value in row))
-    return "\n".join(lines) + "\n"
+        rows.append(row)
+    return csv_text(header, rows)
 
 
 def _csv_cell(value: Any) -> str:
+    """A cell's text: empty for a missing value, the shortest exact repr for a float."""
     if value is None:
         return ""
-    text = repr(value) if isinstance(value, float) else str(value)
-    return f'"{text}"' if any(c in text for c in ',"\n') and not text.startswith('"') else text
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def csv_text(header: Sequence[str], rows: Iterable[Sequence[Any]]) -> str:
+    """CSV (RFC 4180 quoting by the stdlib ``csv`` module, ``\\n`` line ends) of a header
+    and rows. Write it with ``newline=""`` so quoted line breaks stay as they are."""
+    buffer = io.StringIO(newline="")
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(header)
+    writer.writerows([_csv_cell(value) for value in row] for row in rows)
+    return buffer.getvalue()
 
 
 def episodes_csv(records: Sequence[Mapping[str, Any]], config: CompareConfig) -> str:
@@ -712,7 +725,7 @@ def episodes_csv(records: Sequence[Mapping[str, Any]], config: CompareConfig) ->
         "final_contained",
         *[f"area{k}" for k in range(max_moves + 1)],
     ]
-    lines = [",".join(header)]
+    table: list[list[Any]] = []
     for r in rows:
         area = list(r["area"]) + [r["area"][-1]] * (max_moves + 1 - len(r["area"]))
         cells = [
@@ -728,8 +741,8 @@ def episodes_csv(records: Sequence[Mapping[str, Any]], config: CompareConfig) ->
             r["contained"][-1],
             *area,
         ]
-        lines.append(",".join(_csv_cell(c) for c in cells))
-    return "\n".join(lines) + "\n"
+        table.append(cells)
+    return csv_text(header, table)
 
 
 def plot_curves(summary: Mapping[str, Any], config: CompareConfig, out: Path) -> list[Path]:
@@ -950,8 +963,8 @@ def _write_outputs(
     atomic_write_text(out / "timing.json", json.dumps({"ms_per_move": timing}, indent=1) + "\n")
     if not summary["policies"]:
         return
-    atomic_write_text(out / "summary.csv", summary_csv(summary))
-    atomic_write_text(out / "episodes.csv", episodes_csv(records, config))
+    atomic_write_text(out / "summary.csv", summary_csv(summary), newline="")
+    atomic_write_text(out / "episodes.csv", episodes_csv(records, config), newline="")
     atomic_write_text(out / "report.md", report_markdown(summary, config, command))
     if plots:
         plot_curves(summary, config, out)
