@@ -17,6 +17,11 @@ Outputs (in ``--out``):
 - ``area_vs_moves.png``, ``error_vs_moves.png``;
 - ``timing.json``: policy time per decision (the only output that is not reproducible).
 
+An ``OSError`` while writing (disk full, no permission) ends the command with a one-line
+message naming the file and exit status 2. A line of ``episodes.jsonl`` that is not a
+valid record, other than a torn last line, is a :class:`CorruptLogError` naming its line
+number: delete that line and rerun with ``--resume``, or start again with ``--overwrite``.
+
 Metrics per policy. **Total area** is the sum over landmarks L3, L4, ... of the region
 areas (FL units squared), each capped at the env's ``area_cap`` (default 10), which is
 also the value of a landmark not yet initialised, exactly as in the reward. An episode
@@ -56,6 +61,8 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
+
+from train.errors import fail, with_path, write_error_message
 
 #: Evaluation episodes use seeds from here up; training seeds stay below it.
 EVAL_SEED_START = 1_000_000
@@ -261,20 +268,48 @@ def run_task(task: EpisodeTask) -> dict[str, Any]:
 def atomic_write_text(path: Path, text: str, newline: str | None = None) -> None:
     """Write ``text`` to ``path`` so readers see the old or the new file, never a part.
     ``newline`` is :func:`open`'s (``""`` for CSV: no line-end translation)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
     temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(temporary, "w", encoding="utf-8", newline=newline) as handle:
-        handle.write(text)
-        handle.flush()
-        os.fsync(handle.fileno())
-    os.replace(temporary, path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with open(temporary, "w", encoding="utf-8", newline=newline) as handle:
+            handle.write(text)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(temporary, path)
+    except OSError as error:
+        with contextlib.suppress(OSError):
+            temporary.unlink(missing_ok=True)
+        raise with_path(error, path) from None
 
 
 def atomic_save_figure(figure: Any, path: Path, **kwargs: Any) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
     temporary = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
-    figure.savefig(temporary, **kwargs)
-    os.replace(temporary, path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        figure.savefig(temporary, **kwargs)
+        os.replace(temporary, path)
+    except OSError as error:
+        with contextlib.suppress(OSError):
+            temporary.unlink(missing_ok=True)
+        if error.filename is None or str(error.filename) == str(temporary):
+            error.filename = str(path)
+        raise error from None
+
+
+#: What every record of the episode log must hold (``run_task``'s record).
+RECORD_KEYS = ("policy", "seed", "moves", "max_moves", "area", "error", "contained")
+
+
+class CorruptLogError(ValueError):
+    """A line of ``episodes.jsonl`` other than the last is not a valid episode record."""
+
+    def __init__(self, path: Path, line: int, problem: str) -> None:
+        self.path, self.line = path, line
+        super().__init__(
+            f"{path}, line {line}: {problem}. To recover, delete that line (its episode "
+            "runs again with --resume), or rerun with --overwrite instead of --resume to "
+            "start the comparison again"
+        )
 
 
 class EpisodeLog:
@@ -285,7 +320,8 @@ class EpisodeLog:
 
     def load(self) -> list[dict[str, Any]]:
         """All complete records. A torn last line (the run was killed mid-write) is
-        dropped and the file repaired; any other unreadable line is an error."""
+        dropped and the file repaired; any other unreadable line is a
+        :class:`CorruptLogError` naming its line number."""
         if not self.path.exists():
             return []
         text = self.path.read_text(encoding="utf-8")
@@ -295,12 +331,18 @@ class EpisodeLog:
             if not line.strip():
                 continue
             try:
-                records.append(json.loads(line))
+                record = json.loads(line)
             except json.JSONDecodeError as error:
                 if index == len(lines) - 1:
                     torn = True  # no newline after it: the write was cut short
                     break
-                raise ValueError(f"{self.path}:{index + 1} is not valid JSON: {error}") from error
+                raise CorruptLogError(self.path, index + 1, f"not valid JSON ({error})") from None
+            if not isinstance(record, dict) or any(key not in record for key in RECORD_KEYS):
+                needed = ", ".join(RECORD_KEYS)
+                raise CorruptLogError(
+                    self.path, index + 1, f"not an episode record (it needs {needed})"
+                )
+            records.append(record)
         if torn:
             atomic_write_text(
                 self.path, "".join(json.dumps(r, allow_nan=False) + "\n" for r in records)
@@ -308,11 +350,14 @@ class EpisodeLog:
         return records
 
     def append(self, record: dict[str, Any]) -> None:
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        with open(self.path, "a", encoding="utf-8") as handle:
-            handle.write(json.dumps(record, allow_nan=False) + "\n")
-            handle.flush()
-            os.fsync(handle.fileno())
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            with open(self.path, "a", encoding="utf-8") as handle:
+                handle.write(json.dumps(record, allow_nan=False) + "\n")
+                handle.flush()
+                os.fsync(handle.fileno())
+        except OSError as error:
+            raise with_path(error, self.path) from None
 
     def clear(self) -> None:
         if self.path.exists():
@@ -918,7 +963,14 @@ def run_comparison(
     if overwrite and not resume:
         log.clear()
     if resume and config_path.exists():
-        _check_resumable(json.loads(config_path.read_text(encoding="utf-8")), config)
+        try:
+            existing = json.loads(config_path.read_text(encoding="utf-8"))
+        except json.JSONDecodeError as error:
+            raise RunMismatchError(
+                f"cannot resume: {config_path} is not valid JSON ({error}); rerun with "
+                "--overwrite instead of --resume to start the comparison again"
+            ) from None
+        _check_resumable(existing, config)
     atomic_write_text(config_path, json.dumps(config.to_json(), indent=2) + "\n")
 
     records = log.load()
@@ -1150,8 +1202,14 @@ def main(argv: Sequence[str] | None = None) -> None:
             plots=not args.no_plots,
             command=command,
         )
-    except (FileExistsError, RunMismatchError) as error:
-        parser.error(str(error))
+    except FileExistsError as error:
+        if error.errno is None:  # raised above: the folder holds a comparison already
+            parser.error(str(error))
+        fail(parser.prog, write_error_message(error, out, "--out"))
+    except (RunMismatchError, CorruptLogError) as error:
+        fail(parser.prog, str(error))
+    except OSError as error:
+        fail(parser.prog, write_error_message(error, out, "--out"))
     except KeyboardInterrupt:
         print(
             f"\ninterrupted: finished episodes are saved in {out / LOG_NAME}; "

@@ -115,6 +115,7 @@ from train.callbacks import (
     save_vecnormalize_atomically,
     write_json_atomically,
 )
+from train.errors import fail, write_error_message
 from train.vec_env import (
     MONITOR_INFO_KEYWORDS,
     gym_make_kwargs,
@@ -1098,6 +1099,12 @@ def settings_from_args(args: argparse.Namespace) -> TrainSettings:
     )
 
 
+def _output_of(args: argparse.Namespace) -> Path:
+    """The run folder the arguments name (``--output`` or its default)."""
+    env_id = args.env or DEFAULT_ENV_IDS[args.algo]
+    return Path(args.output or default_output(args.algo, env_id, args.seed))
+
+
 def _print_export(exported: ExportedModel) -> None:
     print(f"exported the {exported.source} model to {exported.model_path}")
     if exported.vecnormalize_path is not None:
@@ -1119,6 +1126,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     except (FileNotFoundError, FileExistsError, ValueError, TypeError) as error:
         print(f"bearing-env train: error: {error}", file=sys.stderr)
         raise SystemExit(2) from error
+    except OSError as error:  # disk full, no permission, a parent that is a file, ...
+        fail("bearing-env train", write_error_message(error, _output_of(args), "--output"))
     speed = (
         f", {result.steps_per_second:.0f} env steps/s over {result.wall_seconds:.1f} s"
         if math.isfinite(result.steps_per_second) and result.wall_seconds > 0.01
