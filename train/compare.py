@@ -62,7 +62,15 @@ import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
-from train.errors import fail, with_path, write_error_message
+from bearing_env.extras import DISTRIBUTIONS, install_command
+from train.errors import (
+    MissingExtraError,
+    available,
+    fail,
+    missing_extra,
+    with_path,
+    write_error_message,
+)
 
 #: Evaluation episodes use seeds from here up; training seeds stay below it.
 EVAL_SEED_START = 1_000_000
@@ -640,14 +648,8 @@ def markdown_table(header: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
 def print_tables(
     summary: Mapping[str, Any], config: CompareConfig, timing: Mapping[str, float]
 ) -> None:
-    from rich.console import Console
-    from rich.table import Table
-
-    console = Console()
-    if not console.is_terminal:
-        console = Console(width=160)  # a log file: no need to fold the tables
     env_text = " ".join(f"{k}={v}" for k, v in config.env_kwargs.items())
-    for title, (header, rows) in (
+    tables = (
         (
             f"Median total area (FL units²) — {config.env_id} {env_text}, "
             f"{config.episodes} episodes",
@@ -655,7 +657,18 @@ def print_tables(
         ),
         ("Mean total area [95% bootstrap CI]", area_mean_rows(summary, config)),
         ("Outcomes", outcome_table_rows(summary, config, timing)),
-    ):
+    )
+    if not available("rich"):  # a plain install: the same tables as markdown
+        for title, (header, rows) in tables:
+            print(f"\n{title}\n\n{markdown_table(header, rows)}")
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    console = Console()
+    if not console.is_terminal:
+        console = Console(width=160)  # a log file: no need to fold the tables
+    for title, (header, rows) in tables:
         table = Table(title=title, show_lines=False)
         for index, column in enumerate(header):
             table.add_column(column, no_wrap=index == 0, overflow="fold")
@@ -664,7 +677,9 @@ def print_tables(
         console.print(table)
 
 
-def report_markdown(summary: Mapping[str, Any], config: CompareConfig, command: str | None) -> str:
+def report_markdown(
+    summary: Mapping[str, Any], config: CompareConfig, command: str | None, plots: bool = True
+) -> str:
     env_text = ", ".join(f"`{k}={v!r}`" for k, v in config.env_kwargs.items()) or "defaults"
     seeds = config.seeds
     parts = [
@@ -686,11 +701,14 @@ def report_markdown(summary: Mapping[str, Any], config: CompareConfig, command: 
         "",
         markdown_table(*outcome_table_rows(summary, config)),
         "",
-        "![total area versus moves](area_vs_moves.png)",
-        "",
-        "![landmark error versus moves](error_vs_moves.png)",
-        "",
     ]
+    if plots:
+        parts += [
+            "![total area versus moves](area_vs_moves.png)",
+            "",
+            "![landmark error versus moves](error_vs_moves.png)",
+            "",
+        ]
     if command:
         parts += ["Regenerate with:", "", "```bash", command, "```", ""]
     return "\n".join(parts)
@@ -870,7 +888,22 @@ def _check_resumable(existing: Mapping[str, Any], config: CompareConfig) -> None
             )
 
 
+class _NoProgress:
+    """Stands in for a tqdm bar when tqdm is not installed."""
+
+    def __enter__(self) -> _NoProgress:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        return None
+
+    def update(self, n: int = 1) -> None:
+        pass
+
+
 def _progress(total: int, initial: int, enabled: bool) -> Any:
+    if not available("tqdm"):
+        return _NoProgress()
     from tqdm.auto import tqdm
 
     return tqdm(
@@ -1017,7 +1050,10 @@ def _write_outputs(
         return
     atomic_write_text(out / "summary.csv", summary_csv(summary), newline="")
     atomic_write_text(out / "episodes.csv", episodes_csv(records, config), newline="")
-    atomic_write_text(out / "report.md", report_markdown(summary, config, command))
+    if plots and not available("matplotlib"):
+        print(f"note: no plots: {MissingExtraError('matplotlib', 'plotting')}", file=sys.stderr)
+        plots = False
+    atomic_write_text(out / "report.md", report_markdown(summary, config, command, plots))
     if plots:
         plot_curves(summary, config, out)
 
@@ -1127,6 +1163,24 @@ def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
     return specs
 
 
+def shipped_policies(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
+    """The shipped models to compare by default: :func:`matching_pretrained`, or none,
+    with a note on stderr, when stable-baselines3 (the ``train`` extra) is missing."""
+    specs = matching_pretrained(env_id, env_kwargs)
+    if specs and not available("stable_baselines3", "torch"):
+        missing = "stable_baselines3" if not available("stable_baselines3") else "torch"
+        names = ", ".join(spec.split(":", 1)[1] for spec in specs)
+        package = DISTRIBUTIONS.get(missing, missing)
+        print(
+            f"note: skipped the shipped models ({names}): they need the package "
+            f"'{package}', which is not installed; install the train extra: "
+            f"{install_command('train')}",
+            file=sys.stderr,
+        )
+        return []
+    return specs
+
+
 def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
     env_kwargs = dict(DEFAULT_ENV_KWARGS)
     if args.env_kwargs is not None:
@@ -1135,7 +1189,7 @@ def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
         env_kwargs.setdefault("max_moves", QUICK_MAX_MOVES)
     policies = args.policies or [
         *(QUICK_POLICIES if args.quick else DEFAULT_POLICIES),
-        *matching_pretrained(args.env, env_kwargs),
+        *shipped_policies(args.env, env_kwargs),
     ]
     episodes = args.episodes or (QUICK_EPISODES if args.quick else 200)
     if episodes < 1:
@@ -1188,6 +1242,11 @@ def main(argv: Sequence[str] | None = None) -> None:
                 make_policy(spec, env)
     except (ValueError, TypeError, FileNotFoundError) as error:
         parser.error(str(error))
+    except ImportError as error:  # an sb3: policy without stable-baselines3, ...
+        clear = missing_extra(error, "this comparison")
+        if clear is None:
+            raise
+        fail(parser.prog, str(clear))
     command = reproducing_command(sys.argv[1:] if argv is None else list(argv))
     started = time.perf_counter()
     try:

@@ -5,37 +5,45 @@
   and exit status :data:`EXIT_ERROR`.
 - A command or call that needs an optional extra that is not installed
   (``render``: pygame; ``train``: stable-baselines3, torch, matplotlib, ...) raises
-  :class:`MissingExtraError`, which names the extra and the ``pip install`` line; the
-  command line prints it and exits with :data:`EXIT_ERROR`.
+  :class:`~bearing_env.extras.MissingExtraError`, which names the extra and the
+  ``pip install`` line; the command line prints it and exits with :data:`EXIT_ERROR`.
 """
 
 from __future__ import annotations
 
 import errno
-import importlib
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
-from types import ModuleType
 from typing import NoReturn
+
+from bearing_env.extras import (
+    MODULE_EXTRAS,
+    MissingExtraError,
+    available,
+    install_command,
+    missing_extra,
+    require,
+)
+
+__all__ = [
+    "EXIT_ERROR",
+    "MODULE_EXTRAS",
+    "MissingExtraError",
+    "available",
+    "exit_on_missing_extra",
+    "fail",
+    "install_command",
+    "missing_extra",
+    "os_error_message",
+    "require",
+    "with_path",
+    "write_error_message",
+]
 
 #: Exit status of a command that failed with a clear message (argparse's, for usage errors).
 EXIT_ERROR = 2
-
-#: The optional extra (``pyproject.toml``) that provides each importable module.
-MODULE_EXTRAS: dict[str, str] = {
-    "pygame": "render",
-    "moviepy": "video",
-    "stable_baselines3": "train",
-    "torch": "train",
-    "matplotlib": "train",
-    "tqdm": "train",
-    "rich": "train",
-    "tensorboard": "train",
-    "yaml": "train",
-    "rl_zoo3": "train",
-}
-#: The pip distribution name of a module, where it differs.
-_DISTRIBUTIONS = {"stable_baselines3": "stable-baselines3", "yaml": "pyyaml"}
 
 _HINTS = {
     getattr(errno, name): hint
@@ -49,49 +57,6 @@ _HINTS = {
     )
     if hasattr(errno, name)
 }
-
-
-def install_command(extra: str) -> str:
-    return f'pip install "bearing_env[{extra}]"'
-
-
-class MissingExtraError(ImportError):
-    """An optional dependency is missing; the message says which extra installs it."""
-
-    def __init__(self, module: str, purpose: str, extra: str | None = None) -> None:
-        top = module.split(".")[0]
-        self.extra = extra or MODULE_EXTRAS.get(top, "train")
-        distribution = _DISTRIBUTIONS.get(top, top)
-        super().__init__(
-            f"{purpose} needs the package '{distribution}', which is not installed: "
-            f"{install_command(self.extra)}",
-            name=top,
-        )
-
-
-def require(module: str, purpose: str, extra: str | None = None) -> ModuleType:
-    """Import ``module``, or raise :class:`MissingExtraError` naming the extra to install."""
-    try:
-        return importlib.import_module(module)
-    except ImportError as error:
-        missing = (error.name or module).split(".")[0]
-        if missing != module.split(".")[0] and missing not in MODULE_EXTRAS:
-            raise  # something else is broken inside the installed package
-        raise MissingExtraError(missing, purpose, extra) from error
-
-
-def missing_extra(error: ImportError) -> MissingExtraError | None:
-    """The :class:`MissingExtraError` an import error amounts to, or None when the
-    missing module is not one of an optional extra's."""
-    if isinstance(error, MissingExtraError):
-        return error
-    name = getattr(error, "name", None)
-    if not isinstance(error, ModuleNotFoundError) or not name:
-        return None
-    top = name.split(".")[0]
-    if top not in MODULE_EXTRAS:
-        return None
-    return MissingExtraError(top, "this command")
 
 
 def with_path(error: OSError, path: str | Path) -> OSError:
@@ -129,3 +94,16 @@ def fail(prog: str, message: str, status: int = EXIT_ERROR) -> NoReturn:
     """Print ``<prog>: error: <message>`` on one line to stderr and exit with ``status``."""
     print(f"{prog}: error: {' '.join(message.split())}", file=sys.stderr)
     raise SystemExit(status)
+
+
+@contextmanager
+def exit_on_missing_extra(prog: str) -> Iterator[None]:
+    """Turn an import error of an optional extra's module, inside the block, into
+    ``<prog>: error: ... pip install "bearing_env[<extra>]"`` and exit status 2."""
+    try:
+        yield
+    except ImportError as error:
+        clear = missing_extra(error, "this command")
+        if clear is None:
+            raise
+        fail(prog, str(clear))

@@ -44,7 +44,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from bearing_env.extras import MissingExtraError, available
 from train.compare import EVAL_SEED_START, atomic_save_figure, atomic_write_text, make_env
+from train.errors import fail
 
 FIG7_MOVEMENTS: tuple[int, ...] = (1, 3, 6, 9)
 FIG11_EPSILONS: tuple[float, ...] = (2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
@@ -561,6 +563,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> None:
     args = build_parser().parse_args(sys.argv[1:] if argv is None else argv)
+    if not available("matplotlib"):
+        fail("bearing-env figures", str(MissingExtraError("matplotlib", "drawing the figures")))
     n_seeds = args.seeds or (QUICK_SEEDS if args.quick else DEFAULT_SEEDS)
     seeds = list(range(args.seed_start, args.seed_start + n_seeds))
     wanted = set(args.only or ("7", "10", "11"))
