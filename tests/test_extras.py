@@ -144,6 +144,25 @@ def test_compare_with_an_sb3_policy_without_sb3_says_to_install_the_train_extra(
     assert "'stable-baselines3'" in line and TRAIN in line
 
 
+def test_the_generalisation_script_without_the_train_extra_says_to_install_it(
+    tmp_path: Path,
+) -> None:
+    code = (
+        "import runpy, sys\n"
+        f"for name in {list(PLAIN_INSTALL_LACKS)!r}:\n    sys.modules[name] = None\n"
+        "sys.argv = ['generalisation.py', '--out', 'g']\n"
+        "runpy.run_module('train.generalisation', run_name='__main__')\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+        cwd=tmp_path, env=env,
+    )
+    line = error_line(result, "generalisation.py")
+    assert "'stable-baselines3'" in line and TRAIN in line
+    assert not (tmp_path / "g").exists()
+
+
 # --------------------------------------------------------------------------------------
 # Library calls
 # --------------------------------------------------------------------------------------
