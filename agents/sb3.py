@@ -7,7 +7,6 @@ exactly as training did (``training=False``: the statistics are frozen).
 
 from __future__ import annotations
 
-import importlib
 import json
 import pickle
 import zipfile
@@ -20,6 +19,7 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from agents.base import Action
+from bearing_env.extras import require
 
 #: File names tried, in order, when ``path`` is a directory.
 MODEL_FILE_NAMES = ("best_model.zip", "model.zip", "final_model.zip")
@@ -136,12 +136,9 @@ def _algorithm_class(name: str) -> Any:
         raise ValueError(
             f"unknown algorithm {name!r}; expected one of {sorted(_ALGORITHM_MODULES)}"
         )
-    try:
-        module = importlib.import_module(_ALGORITHM_MODULES[key])
-    except ImportError as error:
-        raise ImportError(
-            f"{key} needs the package {_ALGORITHM_MODULES[key]!r}: pip install it"
-        ) from error
+    module_name = _ALGORITHM_MODULES[key]
+    extra = "train" if module_name == "stable_baselines3" else None  # sb3_contrib: no extra
+    module = require(module_name, f"a {key} model", extra=extra)
     return getattr(module, key)
 
 
@@ -263,7 +260,8 @@ class SB3Policy:
 
 def _load_vecnormalize(path: Path) -> Any:
     """Unpickle VecNormalize statistics (as ``VecNormalize.load`` does, without a venv)."""
-    from stable_baselines3.common.vec_env import VecNormalize
+    vec_env = require("stable_baselines3.common.vec_env", "VecNormalize statistics", "train")
+    VecNormalize = vec_env.VecNormalize
 
     try:
         with open(path, "rb") as handle:

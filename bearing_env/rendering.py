@@ -19,6 +19,7 @@ import numpy as np
 import shapely
 from numpy.typing import NDArray
 
+from bearing_env.extras import require
 from bearing_env.world import Arena
 
 FloatArray = NDArray[np.float64]
@@ -103,7 +104,7 @@ class Renderer:
             raise ValueError(f"unknown render_mode {render_mode!r}")
         # Keeps pygame's banner out of every test and training log.
         os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
-        import pygame
+        pygame = require("pygame", f"rendering (render_mode={render_mode!r})", extra="render")
 
         self._pygame = pygame
         self.render_mode = render_mode

@@ -37,7 +37,7 @@ KHEPERA_ARENA_SIZE: tuple[float, float] = (1.05, 0.68)
 REFERENCE_ARENA_SIDE: float = KHEPERA_ARENA_SIZE[0]
 
 #: Default move length range on the Khepera field (metres): from a nudge to ~30% of
-#: the field's length. The reference greedy/random runs of DESIGN.md use 0.25 m.
+#: the field's length. The reference runs of docs/design.md use 0.25 m.
 REFERENCE_MOVE_LENGTH: tuple[float, float] = (0.05, 0.30)
 
 #: The Khepera robot's radius: the robot centre stops this far from a wall.

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 import os
 from pathlib import Path
@@ -18,6 +19,7 @@ from train.compare import (
     EpisodeLog,
     RunMismatchError,
     bootstrap_mean_ci,
+    csv_text,
     main,
     parse_env_kwargs,
     policies_from_specs,
@@ -317,3 +319,38 @@ def test_ctrl_c_then_resume_reproduces_the_uninterrupted_run(tmp_path: Path) -> 
     assert (interrupted / "summary.json").read_text() == (
         tmp_path / "whole" / "summary.json"
     ).read_text()
+
+
+#: A label that hand-written CSV quoting corrupts: a quote, a comma, a quoted comma.
+AWKWARD_LABEL = 'say "hi", x'
+
+
+def read_csv(path: Path) -> list[list[str]]:
+    with open(path, encoding="utf-8", newline="") as handle:
+        return list(csv.reader(handle))
+
+
+def test_csv_text_round_trips_quotes_commas_and_line_breaks() -> None:
+    cells = [AWKWARD_LABEL, '"quoted"', "a,b", "two\nlines", "", None, 0.1, 3, True]
+    text = csv_text(["h1", "h,2", 'h"3', "h4", "h5", "h6", "h7", "h8", "h9"], [cells])
+    header, row = list(csv.reader(text.splitlines(keepends=True)))
+    assert header == ["h1", "h,2", 'h"3', "h4", "h5", "h6", "h7", "h8", "h9"]
+    assert row == [AWKWARD_LABEL, '"quoted"', "a,b", "two\nlines", "", "", "0.1", "3", "True"]
+
+
+def test_compare_csv_files_round_trip_an_awkward_label(tmp_path: Path) -> None:
+    """Through the real writer: a run whose policy label holds quotes and commas writes
+    summary.csv and episodes.csv that read back, cell for cell, with the stdlib reader."""
+    config = small_config(episodes=2, policies={AWKWARD_LABEL: "random", "plain": "greedy"})
+    run(config, tmp_path)
+    summary = read_csv(tmp_path / "summary.csv")
+    width = len(summary[0])
+    assert all(len(row) == width for row in summary)
+    assert [row[:2] for row in summary[1:]] == [[AWKWARD_LABEL, "random"], ["plain", "greedy"]]
+    episodes = read_csv(tmp_path / "episodes.csv")
+    width = len(episodes[0])
+    assert all(len(row) == width for row in episodes)
+    assert [row[0] for row in episodes[1:]] == [AWKWARD_LABEL] * 2 + ["plain"] * 2
+    assert [int(row[1]) for row in episodes[1:]] == config.seeds * 2
+    logged = json.loads((tmp_path / "summary.json").read_text(encoding="utf-8"))
+    assert float(summary[1][3]) == logged["policies"][AWKWARD_LABEL]["area_after"]["1"]["median"]

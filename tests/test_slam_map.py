@@ -136,7 +136,7 @@ def test_constructor_accepts_the_documented_choices():
         for policy in INCONSISTENCY_POLICIES:
             slam = PolygonSLAM(3, 1e-3, transfer=transfer, on_inconsistency=policy)
             assert slam.polygons == [None]
-    # Default: the conservative transfer (DESIGN.md: the environment's default must be).
+    # Default: the conservative transfer (docs/design.md section 2.6: the env's default).
     assert PolygonSLAM(4, EPS).transfer == "conservative"
 
 

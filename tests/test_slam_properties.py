@@ -1,4 +1,4 @@
-"""Property tests of the world model against the paper's method (DESIGN.md section 2).
+"""Property tests of the world model against the paper's method (docs/design.md section 2).
 
 * similarity invariance of every FL result;
 * the conservative transfer contains the truth whenever the noise is within +-epsilon,
@@ -185,8 +185,8 @@ def test_containment_holds_with_the_coarsest_edge_sampling():
 
 
 def test_the_suite_is_sharp_enough_to_catch_the_paper_transfer():
-    """The same suite with the paper's vertex hull does lose the truth (DESIGN.md measured
-    3.3% of single moves): the containment test above can fail."""
+    """The same suite with the paper's vertex hull does lose the truth (about 3% of single
+    moves on random layouts, docs/design.md section 4): the containment test above can fail."""
     c = containment_suite("paper", n_episodes=60)
     assert c["single_miss"] + c["seq_miss"] > 0, c
 

@@ -357,6 +357,24 @@ def test_cli_reports_errors_without_a_traceback(
     assert "no run to resume" in capsys.readouterr().err
 
 
+def test_an_export_that_cannot_be_written_fails_in_one_line(
+    tiny_runs: dict[str, TrainResult], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")  # a folder below a regular file cannot be made, even by root
+    destination = blocker / "pretrained" / "ppo_tiny"
+    run = tiny_runs["ppo"].run_dir
+    with pytest.raises(SystemExit) as exit_info:
+        train_module.main(
+            ["--algo", "ppo", "--output", str(run), "--export", str(destination), "--export-only"]
+        )
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith(f"bearing-env train: error: cannot write {destination.parent}")
+    assert "choose another --export" in err
+
+
 # --------------------------------------------------------------------------------------
 # Export for agents/pretrained
 # --------------------------------------------------------------------------------------

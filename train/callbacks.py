@@ -32,6 +32,8 @@ from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
 from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
+from train.errors import with_path
+
 CHECKPOINT_PREFIX = "rl_model"
 _CHECKPOINT_MODEL_PATTERN = re.compile(rf"^{CHECKPOINT_PREFIX}_(\d+)_steps\.zip$")
 #: Files beside the best model (``best/``).
@@ -45,11 +47,14 @@ AREA_REPORT_MOVE = 10
 @contextmanager
 def atomic_path(final_path: Path) -> Iterator[Path]:
     """A temporary path in the same folder, renamed to ``final_path`` if the block succeeds."""
-    final_path.parent.mkdir(parents=True, exist_ok=True)
     temporary = final_path.with_name(f".{final_path.name}.{os.getpid()}.tmp")
     try:
+        final_path.parent.mkdir(parents=True, exist_ok=True)
         yield temporary
         os.replace(temporary, final_path)
+    except OSError as error:
+        # Disk full, no permission, ...: name the file being written, not its temporary.
+        raise with_path(error, final_path) from None
     finally:
         if temporary.exists():
             temporary.unlink()

@@ -10,7 +10,10 @@
     bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (train/hyperparams/*.yml)
 
 Each subcommand forwards its remaining arguments to the module that implements it, so
-``bearing-env demo --help`` shows that module's options.
+``bearing-env demo --help`` shows that module's options. A subcommand that needs an
+optional extra that is not installed (``train``: stable-baselines3, torch, matplotlib, ...;
+``render``: pygame) says which one to install, ``pip install "bearing_env[train]"``, and
+exits with status 2.
 """
 
 from __future__ import annotations
@@ -18,6 +21,8 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+
+from train.errors import exit_on_missing_extra
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "demo": ("train.demo", "random polygonal exploration in the Khepera scenario"),
@@ -45,9 +50,11 @@ def main(argv: list[str] | None = None) -> None:
     if command == "bench" and "--slam" in rest:  # bearing-env bench --slam == bench-slam
         command, rest = "bench-slam", [arg for arg in rest if arg != "--slam"]
     module_name, _ = SUBCOMMANDS[command]
-    module = importlib.import_module(module_name)
     sys.argv = [f"bearing-env {command}", *rest]
-    module.main()
+    # A subcommand whose optional extra is not installed says which one, in one line.
+    with exit_on_missing_extra(f"bearing-env {command}"):
+        module = importlib.import_module(module_name)
+        module.main()
 
 
 if __name__ == "__main__":

@@ -17,6 +17,11 @@ Outputs (in ``--out``):
 - ``area_vs_moves.png``, ``error_vs_moves.png``;
 - ``timing.json``: policy time per decision (the only output that is not reproducible).
 
+An ``OSError`` while writing (disk full, no permission) ends the command with a one-line
+message naming the file and exit status 2. A line of ``episodes.jsonl`` that is not a
+valid record, other than a torn last line, is a :class:`CorruptLogError` naming its line
+number: delete that line and rerun with ``--resume``, or start again with ``--overwrite``.
+
 Metrics per policy. **Total area** is the sum over landmarks L3, L4, ... of the region
 areas (FL units squared), each capped at the env's ``area_cap`` (default 10), which is
 also the value of a landmark not yet initialised, exactly as in the reward. An episode
@@ -38,6 +43,8 @@ from __future__ import annotations
 import argparse
 import ast
 import contextlib
+import csv
+import io
 import json
 import math
 import multiprocessing
@@ -54,6 +61,16 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
+
+from bearing_env.extras import DISTRIBUTIONS, install_command
+from train.errors import (
+    MissingExtraError,
+    available,
+    fail,
+    missing_extra,
+    with_path,
+    write_error_message,
+)
 
 #: Evaluation episodes use seeds from here up; training seeds stay below it.
 EVAL_SEED_START = 1_000_000
@@ -256,22 +273,51 @@ def run_task(task: EpisodeTask) -> dict[str, Any]:
 # --------------------------------------------------------------------------------------
 
 
-def atomic_write_text(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` so readers see the old or the new file, never a part."""
-    path.parent.mkdir(parents=True, exist_ok=True)
+def atomic_write_text(path: Path, text: str, newline: str | None = None) -> None:
+    """Write ``text`` to ``path`` so readers see the old or the new file, never a part.
+    ``newline`` is :func:`open`'s (``""`` for CSV: no line-end translation)."""
     temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(temporary, "w", encoding="utf-8") as handle:
-        handle.write(text)
-        handle.flush()
-        os.fsync(handle.fileno())
-    os.replace(temporary, path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with open(temporary, "w", encoding="utf-8", newline=newline) as handle:
+            handle.write(text)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(temporary, path)
+    except OSError as error:
+        with contextlib.suppress(OSError):
+            temporary.unlink(missing_ok=True)
+        raise with_path(error, path) from None
 
 
 def atomic_save_figure(figure: Any, path: Path, **kwargs: Any) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
     temporary = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
-    figure.savefig(temporary, **kwargs)
-    os.replace(temporary, path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        figure.savefig(temporary, **kwargs)
+        os.replace(temporary, path)
+    except OSError as error:
+        with contextlib.suppress(OSError):
+            temporary.unlink(missing_ok=True)
+        if error.filename is None or str(error.filename) == str(temporary):
+            error.filename = str(path)
+        raise error from None
+
+
+#: What every record of the episode log must hold (``run_task``'s record).
+RECORD_KEYS = ("policy", "seed", "moves", "max_moves", "area", "error", "contained")
+
+
+class CorruptLogError(ValueError):
+    """A line of ``episodes.jsonl`` other than the last is not a valid episode record."""
+
+    def __init__(self, path: Path, line: int, problem: str) -> None:
+        self.path, self.line = path, line
+        super().__init__(
+            f"{path}, line {line}: {problem}. To recover, delete that line (its episode "
+            "runs again with --resume), or rerun with --overwrite instead of --resume to "
+            "start the comparison again"
+        )
 
 
 class EpisodeLog:
@@ -282,7 +328,8 @@ class EpisodeLog:
 
     def load(self) -> list[dict[str, Any]]:
         """All complete records. A torn last line (the run was killed mid-write) is
-        dropped and the file repaired; any other unreadable line is an error."""
+        dropped and the file repaired; any other unreadable line is a
+        :class:`CorruptLogError` naming its line number."""
         if not self.path.exists():
             return []
         text = self.path.read_text(encoding="utf-8")
@@ -292,12 +339,18 @@ class EpisodeLog:
             if not line.strip():
                 continue
             try:
-                records.append(json.loads(line))
+                record = json.loads(line)
             except json.JSONDecodeError as error:
                 if index == len(lines) - 1:
                     torn = True  # no newline after it: the write was cut short
                     break
-                raise ValueError(f"{self.path}:{index + 1} is not valid JSON: {error}") from error
+                raise CorruptLogError(self.path, index + 1, f"not valid JSON ({error})") from None
+            if not isinstance(record, dict) or any(key not in record for key in RECORD_KEYS):
+                needed = ", ".join(RECORD_KEYS)
+                raise CorruptLogError(
+                    self.path, index + 1, f"not an episode record (it needs {needed})"
+                )
+            records.append(record)
         if torn:
             atomic_write_text(
                 self.path, "".join(json.dumps(r, allow_nan=False) + "\n" for r in records)
@@ -305,11 +358,14 @@ class EpisodeLog:
         return records
 
     def append(self, record: dict[str, Any]) -> None:
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        with open(self.path, "a", encoding="utf-8") as handle:
-            handle.write(json.dumps(record, allow_nan=False) + "\n")
-            handle.flush()
-            os.fsync(handle.fileno())
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            with open(self.path, "a", encoding="utf-8") as handle:
+                handle.write(json.dumps(record, allow_nan=False) + "\n")
+                handle.flush()
+                os.fsync(handle.fileno())
+        except OSError as error:
+            raise with_path(error, self.path) from None
 
     def clear(self) -> None:
         if self.path.exists():
@@ -592,14 +648,8 @@ def markdown_table(header: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
 def print_tables(
     summary: Mapping[str, Any], config: CompareConfig, timing: Mapping[str, float]
 ) -> None:
-    from rich.console import Console
-    from rich.table import Table
-
-    console = Console()
-    if not console.is_terminal:
-        console = Console(width=160)  # a log file: no need to fold the tables
     env_text = " ".join(f"{k}={v}" for k, v in config.env_kwargs.items())
-    for title, (header, rows) in (
+    tables = (
         (
             f"Median total area (FL units²) — {config.env_id} {env_text}, "
             f"{config.episodes} episodes",
@@ -607,7 +657,18 @@ def print_tables(
         ),
         ("Mean total area [95% bootstrap CI]", area_mean_rows(summary, config)),
         ("Outcomes", outcome_table_rows(summary, config, timing)),
-    ):
+    )
+    if not available("rich"):  # a plain install: the same tables as markdown
+        for title, (header, rows) in tables:
+            print(f"\n{title}\n\n{markdown_table(header, rows)}")
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    console = Console()
+    if not console.is_terminal:
+        console = Console(width=160)  # a log file: no need to fold the tables
+    for title, (header, rows) in tables:
         table = Table(title=title, show_lines=False)
         for index, column in enumerate(header):
             table.add_column(column, no_wrap=index == 0, overflow="fold")
@@ -616,7 +677,9 @@ def print_tables(
         console.print(table)
 
 
-def report_markdown(summary: Mapping[str, Any], config: CompareConfig, command: str | None) -> str:
+def report_markdown(
+    summary: Mapping[str, Any], config: CompareConfig, command: str | None, plots: bool = True
+) -> str:
     env_text = ", ".join(f"`{k}={v!r}`" for k, v in config.env_kwargs.items()) or "defaults"
     seeds = config.seeds
     parts = [
@@ -638,11 +701,14 @@ def report_markdown(summary: Mapping[str, Any], config: CompareConfig, command: 
         "",
         markdown_table(*outcome_table_rows(summary, config)),
         "",
-        "![total area versus moves](area_vs_moves.png)",
-        "",
-        "![landmark error versus moves](error_vs_moves.png)",
-        "",
     ]
+    if plots:
+        parts += [
+            "![total area versus moves](area_vs_moves.png)",
+            "",
+            "![landmark error versus moves](error_vs_moves.png)",
+            "",
+        ]
     if command:
         parts += ["Regenerate with:", "", "```bash", command, "```", ""]
     return "\n".join(parts)
@@ -664,7 +730,7 @@ def summary_csv(summary: Mapping[str, Any]) -> str:
         "frame_change_rate",
         "inconsistent_per_episode",
     ]
-    lines = [",".join(header)]
+    rows: list[list[Any]] = []
     for label, stats in summary["policies"].items():
         row: list[Any] = [label, stats["spec"], stats["episodes"]]
         for k in moves:
@@ -681,15 +747,25 @@ def summary_csv(summary: Mapping[str, Any]) -> str:
             stats["frame_change_rate"],
             stats["inconsistent_per_episode"],
         ]
-        lines.append(",".join(_csv_cell(value) for value in row))
-    return "\n".join(lines) + "\n"
+        rows.append(row)
+    return csv_text(header, rows)
 
 
 def _csv_cell(value: Any) -> str:
+    """A cell's text: empty for a missing value, the shortest exact repr for a float."""
     if value is None:
         return ""
-    text = repr(value) if isinstance(value, float) else str(value)
-    return f'"{text}"' if any(c in text for c in ',"\n') and not text.startswith('"') else text
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def csv_text(header: Sequence[str], rows: Iterable[Sequence[Any]]) -> str:
+    """CSV (RFC 4180 quoting by the stdlib ``csv`` module, ``\\n`` line ends) of a header
+    and rows. Write it with ``newline=""`` so quoted line breaks stay as they are."""
+    buffer = io.StringIO(newline="")
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(header)
+    writer.writerows([_csv_cell(value) for value in row] for row in rows)
+    return buffer.getvalue()
 
 
 def episodes_csv(records: Sequence[Mapping[str, Any]], config: CompareConfig) -> str:
@@ -712,7 +788,7 @@ def episodes_csv(records: Sequence[Mapping[str, Any]], config: CompareConfig) ->
         "final_contained",
         *[f"area{k}" for k in range(max_moves + 1)],
     ]
-    lines = [",".join(header)]
+    table: list[list[Any]] = []
     for r in rows:
         area = list(r["area"]) + [r["area"][-1]] * (max_moves + 1 - len(r["area"]))
         cells = [
@@ -728,8 +804,8 @@ def episodes_csv(records: Sequence[Mapping[str, Any]], config: CompareConfig) ->
             r["contained"][-1],
             *area,
         ]
-        lines.append(",".join(_csv_cell(c) for c in cells))
-    return "\n".join(lines) + "\n"
+        table.append(cells)
+    return csv_text(header, table)
 
 
 def plot_curves(summary: Mapping[str, Any], config: CompareConfig, out: Path) -> list[Path]:
@@ -812,7 +888,22 @@ def _check_resumable(existing: Mapping[str, Any], config: CompareConfig) -> None
             )
 
 
+class _NoProgress:
+    """Stands in for a tqdm bar when tqdm is not installed."""
+
+    def __enter__(self) -> _NoProgress:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        return None
+
+    def update(self, n: int = 1) -> None:
+        pass
+
+
 def _progress(total: int, initial: int, enabled: bool) -> Any:
+    if not available("tqdm"):
+        return _NoProgress()
     from tqdm.auto import tqdm
 
     return tqdm(
@@ -905,7 +996,14 @@ def run_comparison(
     if overwrite and not resume:
         log.clear()
     if resume and config_path.exists():
-        _check_resumable(json.loads(config_path.read_text(encoding="utf-8")), config)
+        try:
+            existing = json.loads(config_path.read_text(encoding="utf-8"))
+        except json.JSONDecodeError as error:
+            raise RunMismatchError(
+                f"cannot resume: {config_path} is not valid JSON ({error}); rerun with "
+                "--overwrite instead of --resume to start the comparison again"
+            ) from None
+        _check_resumable(existing, config)
     atomic_write_text(config_path, json.dumps(config.to_json(), indent=2) + "\n")
 
     records = log.load()
@@ -950,9 +1048,12 @@ def _write_outputs(
     atomic_write_text(out / "timing.json", json.dumps({"ms_per_move": timing}, indent=1) + "\n")
     if not summary["policies"]:
         return
-    atomic_write_text(out / "summary.csv", summary_csv(summary))
-    atomic_write_text(out / "episodes.csv", episodes_csv(records, config))
-    atomic_write_text(out / "report.md", report_markdown(summary, config, command))
+    atomic_write_text(out / "summary.csv", summary_csv(summary), newline="")
+    atomic_write_text(out / "episodes.csv", episodes_csv(records, config), newline="")
+    if plots and not available("matplotlib"):
+        print(f"note: no plots: {MissingExtraError('matplotlib', 'plotting')}", file=sys.stderr)
+        plots = False
+    atomic_write_text(out / "report.md", report_markdown(summary, config, command, plots))
     if plots:
         plot_curves(summary, config, out)
 
@@ -1062,6 +1163,24 @@ def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
     return specs
 
 
+def shipped_policies(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
+    """The shipped models to compare by default: :func:`matching_pretrained`, or none,
+    with a note on stderr, when stable-baselines3 (the ``train`` extra) is missing."""
+    specs = matching_pretrained(env_id, env_kwargs)
+    if specs and not available("stable_baselines3", "torch"):
+        missing = "stable_baselines3" if not available("stable_baselines3") else "torch"
+        names = ", ".join(spec.split(":", 1)[1] for spec in specs)
+        package = DISTRIBUTIONS.get(missing, missing)
+        print(
+            f"note: skipped the shipped models ({names}): they need the package "
+            f"'{package}', which is not installed; install the train extra: "
+            f"{install_command('train')}",
+            file=sys.stderr,
+        )
+        return []
+    return specs
+
+
 def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
     env_kwargs = dict(DEFAULT_ENV_KWARGS)
     if args.env_kwargs is not None:
@@ -1070,7 +1189,7 @@ def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
         env_kwargs.setdefault("max_moves", QUICK_MAX_MOVES)
     policies = args.policies or [
         *(QUICK_POLICIES if args.quick else DEFAULT_POLICIES),
-        *matching_pretrained(args.env, env_kwargs),
+        *shipped_policies(args.env, env_kwargs),
     ]
     episodes = args.episodes or (QUICK_EPISODES if args.quick else 200)
     if episodes < 1:
@@ -1123,6 +1242,11 @@ def main(argv: Sequence[str] | None = None) -> None:
                 make_policy(spec, env)
     except (ValueError, TypeError, FileNotFoundError) as error:
         parser.error(str(error))
+    except ImportError as error:  # an sb3: policy without stable-baselines3, ...
+        clear = missing_extra(error, "this comparison")
+        if clear is None:
+            raise
+        fail(parser.prog, str(clear))
     command = reproducing_command(sys.argv[1:] if argv is None else list(argv))
     started = time.perf_counter()
     try:
@@ -1137,8 +1261,14 @@ def main(argv: Sequence[str] | None = None) -> None:
             plots=not args.no_plots,
             command=command,
         )
-    except (FileExistsError, RunMismatchError) as error:
-        parser.error(str(error))
+    except FileExistsError as error:
+        if error.errno is None:  # raised above: the folder holds a comparison already
+            parser.error(str(error))
+        fail(parser.prog, write_error_message(error, out, "--out"))
+    except (RunMismatchError, CorruptLogError) as error:
+        fail(parser.prog, str(error))
+    except OSError as error:
+        fail(parser.prog, write_error_message(error, out, "--out"))
     except KeyboardInterrupt:
         print(
             f"\ninterrupted: finished episodes are saved in {out / LOG_NAME}; "

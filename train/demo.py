@@ -3,7 +3,8 @@
 Runs a few episodes of the random polygonal policy (a random rotation on the spot, then a
 straight line of fixed length, as the Khepera robot did in the paper), prints the total
 uncertainty area and the mean landmark error after every move, and saves an animation
-of the first episode to ``outputs/``.
+of the first episode to ``outputs/``. The animation needs pygame (the ``render`` extra);
+without it the demo runs, prints its tables, and says how to install it.
 
     python -m train.demo [--episodes 3] [--moves 10] [--seed 0] [--out outputs]
 """
@@ -13,6 +14,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -21,8 +23,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 import bearing_env  # noqa: F401  (registers the ids)
+from bearing_env.extras import MissingExtraError, available
+from train.errors import fail, write_error_message
 
-#: The paper's Khepera run is 10 movements; DESIGN.md's reference runs move 25 cm.
+#: The paper's Khepera run is 10 movements; docs/design.md's reference runs move 25 cm.
 DEFAULT_MOVES = 10
 MOVE_LENGTH = 0.25
 GIF_FRAME_SECONDS = 0.8
@@ -92,6 +96,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out", type=Path, default=Path("outputs"))
     args = parser.parse_args(argv)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    rendering = available("pygame")
 
     env = gym.make(
         "BearingSLAM-v0",
@@ -99,7 +104,7 @@ def main(argv: list[str] | None = None) -> None:
         move_length=MOVE_LENGTH,
         max_moves=args.moves,
         max_episode_steps=args.moves,
-        render_mode="rgb_array",
+        render_mode="rgb_array" if rendering else None,
     )
     started = time.perf_counter()
     print(
@@ -110,7 +115,9 @@ def main(argv: list[str] | None = None) -> None:
     frames: list[NDArray[np.uint8]] = []
     for episode in range(args.episodes):
         seed = args.seed + episode
-        rows, episode_frames = run_episode(env, seed, args.moves, record=episode == 0)
+        rows, episode_frames = run_episode(
+            env, seed, args.moves, record=rendering and episode == 0
+        )
         frames = frames or episode_frames
         print(f"\nepisode {episode} (seed {seed})")
         print(" move  total area  max area  mean error  contains  updated  reward")
@@ -130,8 +137,15 @@ def main(argv: list[str] | None = None) -> None:
         f"{np.median(totals):.4f} FL units^2, median mean error {np.median(errors):.4f} FL "
         f"units ({np.median(errors) * 20:.1f} cm)"
     )
-    args.out.mkdir(parents=True, exist_ok=True)
-    saved = save_animation(frames, args.out / "demo_khepera.gif")
+    if not rendering:
+        reason = MissingExtraError("pygame", "the animation", extra="render")
+        print(f"no animation: {reason}", file=sys.stderr)
+        return
+    try:
+        args.out.mkdir(parents=True, exist_ok=True)
+        saved = save_animation(frames, args.out / "demo_khepera.gif")
+    except OSError as error:
+        fail("bearing-env demo", write_error_message(error, args.out, "--out"))
     print(f"animation of episode 0: {saved}   ({time.perf_counter() - started:.1f} s)")
 
 

@@ -44,7 +44,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from bearing_env.extras import MissingExtraError, available
 from train.compare import EVAL_SEED_START, atomic_save_figure, atomic_write_text, make_env
+from train.errors import fail
 
 FIG7_MOVEMENTS: tuple[int, ...] = (1, 3, 6, 9)
 FIG11_EPSILONS: tuple[float, ...] = (2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
@@ -52,7 +54,7 @@ FIG11_EPSILONS: tuple[float, ...] = (2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
 PAPER_NOISE_DEG = 2.0
 #: The paper's final errors on the real robot (Sec. 4): 2 and 3 cm with a 20 cm unit.
 PAPER_FINAL_ERRORS = {"L3": 0.10, "L4": 0.15}
-#: Moves of 25 cm on the Khepera field (DESIGN.md's reference runs).
+#: Moves of 25 cm on the Khepera field (the reference runs of docs/design.md).
 KHEPERA_MOVE_LENGTH = 0.25
 #: Moves of about one FL unit in the paper's simulated world (L1-L2 = 0.5 m).
 PAPER_SIM_MOVE_LENGTH = 0.5
@@ -561,6 +563,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> None:
     args = build_parser().parse_args(sys.argv[1:] if argv is None else argv)
+    if not available("matplotlib"):
+        fail("bearing-env figures", str(MissingExtraError("matplotlib", "drawing the figures")))
     n_seeds = args.seeds or (QUICK_SEEDS if args.quick else DEFAULT_SEEDS)
     seeds = list(range(args.seed_start, args.seed_start + n_seeds))
     wanted = set(args.only or ("7", "10", "11"))

@@ -8,7 +8,8 @@ median total area after 10 moves per policy and count.
 
 The total area is summed over the mapped landmarks (L3, L4, ...), so it grows with the
 count; compare policies within a column. ``--max-landmarks`` must equal the observation
-slots the model was trained with.
+slots the model was trained with. It needs the ``train`` extra (the shipped model runs
+on stable-baselines3); without it, it says so in one line and exits with status 2.
 """
 
 from __future__ import annotations
@@ -19,8 +20,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-from rich.console import Console
-from rich.table import Table
+from bearing_env.extras import available
+from train.errors import MissingExtraError, fail
 
 DEFAULT_BASELINES = ("random", "parallax", "greedy")
 
@@ -80,6 +81,11 @@ def main() -> None:
     args = parser.parse_args()
     if min(args.counts) < 3 or max(args.counts) > args.max_landmarks:
         parser.error(f"--counts must lie in [3, --max-landmarks={args.max_landmarks}]")
+    for module in ("stable_baselines3", "torch", "rich"):
+        if not available(module):
+            fail(parser.prog, str(MissingExtraError(module, "this command")))
+    from rich.console import Console
+    from rich.table import Table
 
     medians = run_counts(
         args.model, args.counts, args.episodes, args.max_landmarks, args.workers, args.out,

@@ -115,6 +115,7 @@ from train.callbacks import (
     save_vecnormalize_atomically,
     write_json_atomically,
 )
+from train.errors import fail, write_error_message
 from train.vec_env import (
     MONITOR_INFO_KEYWORDS,
     gym_make_kwargs,
@@ -1098,6 +1099,12 @@ def settings_from_args(args: argparse.Namespace) -> TrainSettings:
     )
 
 
+def _output_of(args: argparse.Namespace) -> Path:
+    """The run folder the arguments name (``--output`` or its default)."""
+    env_id = args.env or DEFAULT_ENV_IDS[args.algo]
+    return Path(args.output or default_output(args.algo, env_id, args.seed))
+
+
 def _print_export(exported: ExportedModel) -> None:
     print(f"exported the {exported.source} model to {exported.model_path}")
     if exported.vecnormalize_path is not None:
@@ -1108,17 +1115,14 @@ def _print_export(exported: ExportedModel) -> None:
 def main(argv: Sequence[str] | None = None) -> None:
     parser = build_parser()
     args = parser.parse_args(sys.argv[1:] if argv is None else list(argv))
-    try:
+    if args.export_only and args.export is None:
+        parser.error("--export-only needs --export DIR/NAME")
+    with _clear_errors(args):
         settings = settings_from_args(args)
         if args.export_only:
-            if args.export is None:
-                parser.error("--export-only needs --export DIR/NAME")
             _print_export(export_run(settings.output, args.export))
             return
         result = train(settings)
-    except (FileNotFoundError, FileExistsError, ValueError, TypeError) as error:
-        print(f"bearing-env train: error: {error}", file=sys.stderr)
-        raise SystemExit(2) from error
     speed = (
         f", {result.steps_per_second:.0f} env steps/s over {result.wall_seconds:.1f} s"
         if math.isfinite(result.steps_per_second) and result.wall_seconds > 0.01
@@ -1130,7 +1134,24 @@ def main(argv: Sequence[str] | None = None) -> None:
         print(f"interrupted: checkpoint {where}; continue with --resume", file=sys.stderr)
         raise SystemExit(EXIT_INTERRUPTED)
     if args.export is not None:
-        _print_export(export_run(settings.output, args.export))
+        with _clear_errors(args):
+            _print_export(export_run(settings.output, args.export))
+
+
+@contextlib.contextmanager
+def _clear_errors(args: argparse.Namespace) -> Iterator[None]:
+    """Bad settings and files, and OSErrors while writing (disk full, no permission, a
+    parent that is a file), end the command with one line and exit status 2."""
+    try:
+        yield
+    except (FileNotFoundError, FileExistsError, ValueError, TypeError) as error:
+        print(f"bearing-env train: error: {error}", file=sys.stderr)
+        raise SystemExit(2) from error
+    except OSError as error:
+        output = _output_of(args)
+        in_run = str(error.filename or output).startswith(str(output))
+        option = "--export" if args.export is not None and not in_run else "--output"
+        fail("bearing-env train", write_error_message(error, output, option))
 
 
 if __name__ == "__main__":

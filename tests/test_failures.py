@@ -1,0 +1,236 @@
+"""Clear failures instead of tracebacks: OSErrors while writing outputs, and a corrupt
+episode log under ``compare --resume``."""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from train import compare
+from train.compare import LOG_NAME, CorruptLogError, EpisodeLog
+from train.errors import EXIT_ERROR, os_error_message, with_path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+COMPARE_ARGS = [
+    "--policies", "random", "--env-kwargs", "scenario=khepera", "max_moves=3",
+    "--episodes", "3", "--no-progress", "--no-plots", "--bootstrap", "50",
+]
+
+
+def run_cli(*args: str, timeout: float = 300) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
+    return subprocess.run(
+        [sys.executable, "-m", "train.cli", *args],
+        capture_output=True, text=True, timeout=timeout, cwd=ROOT, env=env,
+    )
+
+
+def one_line_error(stderr: str, prog: str) -> str:
+    """The single stderr line of a clean failure (no traceback, no usage)."""
+    lines = [line for line in stderr.splitlines() if line.strip()]
+    assert "Traceback" not in stderr, stderr
+    assert len(lines) == 1, stderr
+    assert lines[0].startswith(f"{prog}: error: "), stderr
+    return lines[0]
+
+
+def compare_exit(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    """Run ``compare.main`` expecting a clean failure; its one-line message."""
+    with pytest.raises(SystemExit) as exit_info:
+        compare.main(argv)
+    assert exit_info.value.code == EXIT_ERROR
+    return one_line_error(capsys.readouterr().err, "bearing-env compare")
+
+
+@pytest.fixture
+def a_file(tmp_path: Path) -> Path:
+    """A regular file: a path below it cannot be created, even by root."""
+    path = tmp_path / "not_a_folder"
+    path.write_text("x")
+    return path
+
+
+# --------------------------------------------------------------------------------------
+# The message itself
+# --------------------------------------------------------------------------------------
+
+
+def test_the_message_names_the_path_and_the_reason() -> None:
+    full = OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))  # as write() raises it: no path
+    assert with_path(full, "/out/summary.json") is full
+    assert full.filename == "/out/summary.json"
+    assert os_error_message(full) == (
+        "/out/summary.json: No space left on device (the disk is full)"
+    )
+    temporary = PermissionError(errno.EACCES, "Permission denied", "/out/.run.json.7.tmp")
+    with_path(temporary, "/out/run.json")  # the final name, not the temporary one
+    assert os_error_message(temporary).startswith("/out/run.json: Permission denied")
+    named = OSError(errno.EROFS, "Read-only file system", "/elsewhere")
+    assert with_path(named, "/out/x").filename == "/elsewhere"  # an error's own path stays
+
+
+# --------------------------------------------------------------------------------------
+# bearing-env compare
+# --------------------------------------------------------------------------------------
+
+
+def test_compare_into_a_folder_below_a_file_fails_in_one_line(a_file: Path) -> None:
+    out = a_file / "out"
+    result = run_cli("compare", *COMPARE_ARGS, "--out", str(out))
+    assert result.returncode == EXIT_ERROR, result.stderr
+    line = one_line_error(result.stderr, "bearing-env compare")
+    assert str(out) in line and "Not a directory" in line and "--out" in line
+
+
+def test_compare_on_a_full_disk_names_the_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    def disk_full(fd: int) -> None:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(compare.os, "fsync", disk_full)
+    out = tmp_path / "out"
+    line = compare_exit([*COMPARE_ARGS, "--out", str(out)], capsys)
+    assert str(out / "config.json") in line  # the first file written
+    assert "No space left on device" in line and "free some space" in line
+    assert not [p for p in out.iterdir() if p.name.endswith(".tmp")]  # no temporary left
+
+
+def test_compare_without_permission_names_the_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    write = compare.atomic_write_text
+
+    def refuse_the_report(path: Path, text: str, newline: str | None = None) -> None:
+        if path.name == "report.md":
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(path))
+        write(path, text, newline)
+
+    monkeypatch.setattr(compare, "atomic_write_text", refuse_the_report)
+    out = tmp_path / "out"
+    line = compare_exit([*COMPARE_ARGS, "--out", str(out)], capsys)
+    assert str(out / "report.md") in line
+    assert "Permission denied" in line and "make the folder writable" in line
+
+
+def test_an_episode_log_that_cannot_be_appended_names_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def disk_full(fd: int) -> None:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(compare.os, "fsync", disk_full)
+    log = EpisodeLog(tmp_path / LOG_NAME)
+    with pytest.raises(OSError, match="No space left on device") as error:
+        log.append({"policy": "x"})
+    assert error.value.filename == str(log.path)
+
+
+def _finished_log(out: Path) -> list[str]:
+    compare.main([*COMPARE_ARGS, "--out", str(out)])
+    return (out / LOG_NAME).read_text(encoding="utf-8").splitlines()
+
+
+def test_a_corrupt_middle_line_is_reported_with_its_number_and_the_way_out(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out"
+    lines = _finished_log(out)
+    expected = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    assert len(lines) == 3
+    damaged = [lines[0], lines[1][: len(lines[1]) // 2], lines[2]]  # a cut-short line 2
+    (out / LOG_NAME).write_text("\n".join(damaged) + "\n", encoding="utf-8")
+    capsys.readouterr()
+
+    line = compare_exit([*COMPARE_ARGS, "--out", str(out), "--resume"], capsys)
+    assert f"{out / LOG_NAME}, line 2: not valid JSON" in line
+    assert "delete that line" in line and "--overwrite" in line
+
+    # The documented way out works: delete the line, resume, and get the same results.
+    (out / LOG_NAME).write_text("\n".join([lines[0], lines[2]]) + "\n", encoding="utf-8")
+    compare.main([*COMPARE_ARGS, "--out", str(out), "--resume"])
+    resumed = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    assert resumed == expected
+
+
+def test_a_valid_json_line_that_is_no_record_is_corrupt(tmp_path: Path) -> None:
+    path = tmp_path / LOG_NAME
+    good: dict[str, Any] = dict.fromkeys(compare.RECORD_KEYS, 0)
+    path.write_text(json.dumps(good) + "\n[1, 2]\n" + json.dumps(good) + "\n")
+    with pytest.raises(CorruptLogError, match=r"line 2: not an episode record") as error:
+        EpisodeLog(path).load()
+    assert error.value.line == 2
+
+
+def test_a_corrupt_log_is_reported_on_the_command_line_without_a_traceback(
+    tmp_path: Path,
+) -> None:
+    out = tmp_path / "out"
+    lines = _finished_log(out)
+    (out / LOG_NAME).write_text(lines[0] + "\n{oops\n" + lines[2] + "\n", encoding="utf-8")
+    result = run_cli("compare", *COMPARE_ARGS, "--out", str(out), "--resume")
+    assert result.returncode == EXIT_ERROR
+    line = one_line_error(result.stderr, "bearing-env compare")
+    assert "line 2" in line and "delete that line" in line
+
+
+def test_a_corrupt_config_is_reported_under_resume(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out"
+    _finished_log(out)
+    (out / "config.json").write_text("{not json", encoding="utf-8")
+    capsys.readouterr()
+    line = compare_exit([*COMPARE_ARGS, "--out", str(out), "--resume"], capsys)
+    assert "config.json is not valid JSON" in line and "--overwrite" in line
+
+
+# --------------------------------------------------------------------------------------
+# bearing-env train
+# --------------------------------------------------------------------------------------
+
+TRAIN_ARGS = [
+    "--algo", "ppo", "--timesteps", "64", "--n-envs", "1", "--vec-env", "dummy",
+    "--eval-freq", "0", "--no-progress", "--no-tensorboard",
+    "--hyperparams", "n_steps=64", "batch_size=64",
+]
+
+
+def test_train_into_a_folder_below_a_file_fails_in_one_line(a_file: Path) -> None:
+    pytest.importorskip("stable_baselines3")
+    run = a_file / "run"
+    result = run_cli("train", *TRAIN_ARGS, "--output", str(run))
+    assert result.returncode == EXIT_ERROR, result.stderr
+    line = one_line_error(result.stderr, "bearing-env train")
+    assert str(run) in line and "Not a directory" in line and "--output" in line
+
+
+def test_train_on_a_full_disk_names_the_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pytest.importorskip("stable_baselines3")
+    from train import train as train_module
+
+    original = Path.write_text
+
+    def disk_full(self: Path, *args: Any, **kwargs: Any) -> int:
+        if self.name.endswith(".tmp"):  # the atomic writers' temporary files
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return original(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "write_text", disk_full)
+    run = tmp_path / "run"
+    with pytest.raises(SystemExit) as exit_info:
+        train_module.main([*TRAIN_ARGS, "--output", str(run)])
+    assert exit_info.value.code == EXIT_ERROR
+    line = one_line_error(capsys.readouterr().err, "bearing-env train")
+    assert str(run / "run.json") in line and "No space left on device" in line
+    assert not [p for p in run.iterdir() if p.name.endswith(".tmp")]

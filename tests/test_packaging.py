@@ -1,0 +1,62 @@
+"""Packaging metadata: the MIT license in SPDX form, shipped in the distribution."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+tomllib = pytest.importorskip("tomllib")
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _pyproject() -> dict:
+    return tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+
+
+def test_license_is_an_spdx_expression_with_its_file() -> None:
+    project = _pyproject()["project"]
+    assert project["license"] == "MIT"
+    assert project["license-files"] == ["LICENSE"]
+    # The SPDX form replaces license classifiers; setuptools refuses both together.
+    assert not any(c.startswith("License ::") for c in project.get("classifiers", []))
+
+
+def test_build_system_requires_a_setuptools_that_reads_spdx_licenses() -> None:
+    requires = _pyproject()["build-system"]["requires"]
+    versions = [re.fullmatch(r"setuptools>=(\d+)(\.\d+)*", r) for r in requires]
+    (match,) = [m for m in versions if m]
+    assert int(match.group(1)) >= 77
+
+
+def test_license_file_is_mit_for_the_bearing_env_developers() -> None:
+    text = (ROOT / "LICENSE").read_text(encoding="utf-8")
+    assert text.startswith("MIT License\n")
+    assert "Copyright (c) 2026 the bearing_env developers" in text
+    assert "THE SOFTWARE IS PROVIDED \"AS IS\", WITHOUT WARRANTY OF ANY KIND" in text
+
+
+@pytest.mark.slow
+def test_the_wheel_carries_the_license_without_a_deprecation_warning(tmp_path: Path) -> None:
+    result = subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "-v", "--no-deps", "-w", str(tmp_path), str(ROOT)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert result.returncode == 0, result.stderr[-2000:]
+    log = result.stdout + result.stderr
+    assert "project.license` as a TOML table is deprecated" not in log
+    assert "License classifiers are deprecated" not in log
+    (wheel,) = tmp_path.glob("bearing_env-*.whl")
+    with zipfile.ZipFile(wheel) as archive:
+        names = archive.namelist()
+        (metadata,) = [n for n in names if n.endswith(".dist-info/METADATA")]
+        text = archive.read(metadata).decode()
+        assert "License-Expression: MIT" in text.splitlines()
+        assert any(n.endswith(".dist-info/licenses/LICENSE") for n in names)

@@ -1,0 +1,109 @@
+"""One-line failures for the command line, instead of tracebacks.
+
+- An ``OSError`` while writing outputs (disk full, no permission, a parent that is a
+  file, a read-only file system) ends the command with ``<prog>: error: <path>: <reason>``
+  and exit status :data:`EXIT_ERROR`.
+- A command or call that needs an optional extra that is not installed
+  (``render``: pygame; ``train``: stable-baselines3, torch, matplotlib, ...) raises
+  :class:`~bearing_env.extras.MissingExtraError`, which names the extra and the
+  ``pip install`` line; the command line prints it and exits with :data:`EXIT_ERROR`.
+"""
+
+from __future__ import annotations
+
+import errno
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import NoReturn
+
+from bearing_env.extras import (
+    MODULE_EXTRAS,
+    MissingExtraError,
+    available,
+    install_command,
+    missing_extra,
+    require,
+)
+
+__all__ = [
+    "EXIT_ERROR",
+    "MODULE_EXTRAS",
+    "MissingExtraError",
+    "available",
+    "exit_on_missing_extra",
+    "fail",
+    "install_command",
+    "missing_extra",
+    "os_error_message",
+    "require",
+    "with_path",
+    "write_error_message",
+]
+
+#: Exit status of a command that failed with a clear message (argparse's, for usage errors).
+EXIT_ERROR = 2
+
+_HINTS = {
+    getattr(errno, name): hint
+    for name, hint in (
+        ("ENOSPC", "the disk is full"),
+        ("EDQUOT", "the disk quota is exceeded"),
+        ("EACCES", "no permission to write there"),
+        ("EPERM", "no permission to write there"),
+        ("EROFS", "the file system is read-only"),
+        ("ENOTDIR", "a parent of that path is a file, not a folder"),
+    )
+    if hasattr(errno, name)
+}
+
+
+def with_path(error: OSError, path: str | Path) -> OSError:
+    """Give an ``OSError`` raised while writing ``path`` that path, when it names none or
+    only a temporary file beside it; returns the error, for ``raise``."""
+    if error.filename is None or str(error.filename).endswith(".tmp"):
+        error.filename = str(path)
+    return error
+
+
+def os_error_message(error: OSError, path: str | Path | None = None) -> str:
+    """``<path>: <reason> (<hint>)`` for an ``OSError``, on one line."""
+    where = error.filename if error.filename is not None else path
+    reason = error.strerror or str(error) or type(error).__name__
+    hint = _HINTS.get(error.errno) if error.errno is not None else None
+    text = f"{where}: {reason}" if where is not None else reason
+    if hint and hint.lower() != reason.lower():
+        text += f" ({hint})"
+    return " ".join(text.split())
+
+
+def write_error_message(error: OSError, path: str | Path | None, option: str) -> str:
+    """``cannot write <path>: <reason> (<hint>); <what to do>`` for an ``OSError`` raised
+    while writing a command's outputs into the folder given by ``option``."""
+    if error.errno in (errno.ENOSPC, getattr(errno, "EDQUOT", None)):
+        advice = f"free some space, or choose another {option}"
+    elif error.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+        advice = f"make the folder writable, or choose another {option}"
+    else:
+        advice = f"choose another {option}"
+    return f"cannot write {os_error_message(error, path)}; {advice}"
+
+
+def fail(prog: str, message: str, status: int = EXIT_ERROR) -> NoReturn:
+    """Print ``<prog>: error: <message>`` on one line to stderr and exit with ``status``."""
+    print(f"{prog}: error: {' '.join(message.split())}", file=sys.stderr)
+    raise SystemExit(status)
+
+
+@contextmanager
+def exit_on_missing_extra(prog: str) -> Iterator[None]:
+    """Turn an import error of an optional extra's module, inside the block, into
+    ``<prog>: error: ... pip install "bearing_env[<extra>]"`` and exit status 2."""
+    try:
+        yield
+    except ImportError as error:
+        clear = missing_extra(error, "this command")
+        if clear is None:
+            raise
+        fail(prog, str(clear))
