@@ -463,3 +463,17 @@ def sample_polygon(rng: np.random.Generator, poly: shapely.Polygon, n: int) -> n
     inside = w @ v
     pick = rng.uniform(size=n) < 0.5
     return np.where(pick, boundary, inside)
+
+
+@SETTINGS
+@given(seed=SEEDS, n=st.integers(1, 40), duplicates=st.booleans())
+def test_the_small_hull_equals_the_general_hull(seed, n, duplicates):
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(size=n) + 1j * rng.normal(size=n)
+    if duplicates:
+        pts = np.concatenate([pts, pts[::2]])
+    out = np.empty(pts.size + 1, dtype=complex)
+    small = out[: kernels.small_convex_hull(pts, pts.size, out)].copy()
+    general = convex_hull(pts)
+    # Both start at the leftmost (then lowest) point and go counter-clockwise.
+    np.testing.assert_array_equal(small, general)
