@@ -93,7 +93,8 @@ SECTIONS: tuple[str, ...] = ("single", "vector", "slam", "startup", "planning", 
 PPO_KINDS: tuple[str, ...] = ("batched", "subproc", "dummy")
 DEFAULT_NUM_ENVS: tuple[int, ...] = (1, 4, 16, 64, 256)
 DEFAULT_SINGLE_LANDMARKS: tuple[int, ...] = (4, 16, 64)
-DEFAULT_JSON = Path(__file__).resolve().parent / "results" / "bench_env.json"
+#: Relative to the working directory, so an installed package never writes into itself.
+DEFAULT_JSON = Path("outputs") / "bench_env.json"
 DEFAULT_SECONDS = 2.0
 DEFAULT_PPO_ENVS = 16
 DEFAULT_PPO_STEPS = 4096
