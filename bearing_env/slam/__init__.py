@@ -12,7 +12,8 @@ Public API:
 * :func:`transfer_polygon` / :func:`transfer_point`: the FR -> FL transfer of a region
   or a point, as shapely geometry (one movement, for inspection and tests).
 * :func:`world_to_fl` / :func:`fl_to_world`: frame conversions given L1 and L2.
-* :mod:`bearing_env.slam.geometry`: the batched kernels underneath.
+* :mod:`bearing_env.slam.kernels`: the compiled kernels underneath (numba), and
+  :mod:`bearing_env.slam.geometry`: their entry points for one-off polygon geometry.
 """
 
 from bearing_env.slam.api import fr_region, transfer_point, transfer_polygon
