@@ -129,10 +129,12 @@ def test_sigkill_then_resume_gives_the_uninterrupted_counts(
 
 
 class StopAtCall(StopOnRequestCallback):
-    """Sets the stop request at the 13th vec step: in the middle of the second rollout."""
+    """Sets the stop request at the 13th vec step: in the middle of PPO's second rollout."""
+
+    at_call = 13
 
     def _on_step(self) -> bool:
-        if self.n_calls == 13:
+        if self.n_calls == self.at_call:
             self.request.set("SIGINT")
         return super()._on_step()
 
@@ -167,3 +169,51 @@ def test_an_old_record_left_running_gets_its_killed_segment() -> None:
          "status": "killed"}
     ]  # fmt: skip
     assert train_module._segments_after_a_kill({**old, "status": "finished"}, at) == []
+
+
+DQN_HYPERPARAMS = {
+    "learning_starts": 0,
+    "train_freq": 4,  # 4 vec steps of 2 envs: an update every 8 env steps
+    "gradient_steps": 1,
+    "batch_size": 8,
+    "buffer_size": 1_000,
+    "target_update_interval": 16,
+    "policy_kwargs": "dict(net_arch=[16])",
+}
+
+
+def dqn_settings(run: Path, **changes: Any) -> TrainSettings:
+    return settings(
+        run,
+        algo="dqn",
+        env_id="BearingSLAMDiscrete-v0",
+        hyperparam_overrides=dict(DQN_HYPERPARAMS),
+        timesteps=200,
+        checkpoint_freq=10_000,
+        **changes,
+    )
+
+
+class StopAtDqnCall(StopAtCall):
+    at_call = 15
+
+
+def test_a_dqn_stop_mid_rollout_rewinds_the_replay_buffer(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    train(dqn_settings(tmp_path / "whole"))
+    whole = load_model(tmp_path / "whole" / "model.zip", "dqn")
+    assert (whole._n_updates, whole.num_timesteps) == (25, 200)
+
+    run = tmp_path / "stopped"
+    with monkeypatch.context() as patch:
+        # Vec step 15, the third of the fourth rollout: steps 13 and 14 are in the buffer.
+        patch.setattr(train_module, "StopOnRequestCallback", StopAtDqnCall)
+        stopped = train(dqn_settings(run))
+    assert stopped.checkpoint is not None and stopped.num_timesteps == 24  # not 30
+    assert stopped.model.replay_buffer.size() == 12  # per env: steps 13 and 14 dropped
+    saved = load_model(stopped.checkpoint.model_path, "dqn")
+    assert (saved._n_updates, saved.num_timesteps, saved._n_calls) == (3, 24, 12)
+
+    resumed = train(dqn_settings(run, resume=True))
+    assert (resumed.model._n_updates, resumed.model.num_timesteps) == (25, 200)
