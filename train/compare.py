@@ -17,6 +17,12 @@ Outputs (in ``--out``):
 - ``area_vs_moves.png``, ``error_vs_moves.png``;
 - ``timing.json``: policy time per decision (the only output that is not reproducible).
 
+With ``--workers N`` the episodes run in a pool of spawned processes that exit with the
+command: if it is killed (SIGKILL, out of memory), the kernel ends them on Linux
+(``prctl(PR_SET_PDEATHSIG)``) and elsewhere they notice their parent is gone within half
+a second; multiprocessing's resource tracker then exits too, so nothing is left holding
+the caller's stdout or stderr open.
+
 An ``OSError`` while writing (disk full, no permission) ends the command with a one-line
 message naming the file and exit status 2. A line of ``episodes.jsonl`` that is not a
 valid record, other than a torn last line, is a :class:`CorruptLogError` naming its line

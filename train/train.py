@@ -41,7 +41,7 @@ same episodes at every evaluation. Both ranges lie below ``train.compare``'s tes
 
 **Run folder** (``--output``, default ``runs/<algo>_<env>_seed<seed>``)::
 
-    run.json                 settings, seeds, status, timesteps, per-segment timing
+    run.json                 settings, seeds, status, timesteps, per-segment status/timing
     model.zip                final model (written when the run reaches its budget)
     vecnormalize.pkl         its VecNormalize statistics (when the config normalises)
     best/best_model.zip      best model on the validation episodes
@@ -53,10 +53,21 @@ same episodes at every evaluation. Both ranges lie below ``train.compare``'s tes
                              batched.monitor.csv for all envs of --vec-env batched
     tensorboard/             TensorBoard logs (``tensorboard --logdir runs``)
 
-**Interruptions.** Ctrl-C (or SIGTERM) stops at the next env step and saves a checkpoint
-(a second Ctrl-C stops at once, and still saves); the command then exits with status 130.
-``--resume`` continues from the newest checkpoint with the replay buffer (SAC, DQN) and
-the VecNormalize statistics, keeping the timestep count (``--timesteps`` is the total).
+**Interruptions.** A checkpoint counts only steps its model was trained on: periodic
+checkpoints are written at the first update boundary (the start of a rollout, after
+``train()`` consumed the previous one) at or past each multiple of ``--checkpoint-freq``.
+Ctrl-C (or SIGTERM) stops at the next env step and saves the state of the last update
+boundary: the steps of the partial rollout are dropped (counts, VecNormalize statistics,
+replay-buffer position) and collected again on resume. A second Ctrl-C stops at once and
+saves the same way (if it lands inside ``train()``, the weights may already hold part of
+that update). The command then exits with status 130. ``--resume`` continues from the
+newest checkpoint with the replay buffer (SAC, DQN) and the VecNormalize statistics,
+keeping the timestep count (``--timesteps`` is the total), so a run killed at any moment
+(SIGKILL included) and resumed ends with the ``num_timesteps`` and number of updates of
+an uninterrupted run. ``run.json`` lists the running segment from its start and updates
+its ``end_timesteps`` at each checkpoint; a segment whose process died (the record still
+says ``running``) is marked ``killed`` on ``--resume``, ending at the checkpoint the run
+resumes from. Each segment's ``status`` is ``finished``, ``interrupted`` or ``killed``.
 
 **Export.** ``--export DIR/NAME`` copies the best model (else the final one) of the run to
 ``DIR/NAME.zip``, its statistics to ``DIR/NAME_vecnormalize.pkl`` and a description to
