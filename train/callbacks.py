@@ -6,9 +6,20 @@
   buffer (``rl_model_replay_buffer_<N>_steps.pkl``), the names SB3's own
   ``CheckpointCallback`` uses. Every file is written to a temporary name and renamed, and
   the model ``.zip`` is written last, so a checkpoint whose ``.zip`` exists is complete.
-- :class:`PeriodicCheckpointCallback`: a checkpoint every ``save_freq`` env steps.
+- :class:`PeriodicCheckpointCallback`: a checkpoint every ``save_freq`` env steps, taken
+  at the first *update boundary* at or past each multiple: the start of a rollout, which
+  SB3 reaches only after ``train()`` has consumed the previous rollout. A checkpoint
+  therefore never counts a step its model has not been trained on, and a run killed at
+  any moment (SIGKILL included) resumes with as many updates per counted step as a run
+  that was never stopped. The callback also remembers the state at the last boundary
+  (:class:`UpdateBoundary`), so that a run stopped in the middle of a rollout can
+  :func:`rewind_to_boundary` and save that instead of the partial rollout.
 - :class:`StopOnRequestCallback`: ends ``learn()`` cleanly at the next env step once a
   :class:`StopRequest` is set (by the Ctrl-C handler).
+
+SB3's own ``CheckpointCallback`` is not used: it saves from ``_on_step`` on a call count,
+in the middle of a rollout (the steps of the partial rollout are counted but were never
+trained on), writes in place and does not prune; only its file names are kept.
 - :class:`FixedSeedEvalCallback`: SB3's ``EvalCallback`` that plays the same validation
   episodes (fixed reset seeds) at every evaluation, logs the total uncertainty area, saves
   the VecNormalize statistics beside the best model, and carries its history over a
@@ -20,9 +31,9 @@ from __future__ import annotations
 import json
 import os
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -149,27 +160,108 @@ class CheckpointStore:
                 old.replay_buffer_path.unlink(missing_ok=True)
 
 
-class PeriodicCheckpointCallback(BaseCallback):
-    """Saves a checkpoint each time the run passes a multiple of ``save_freq`` env steps."""
+@dataclass
+class UpdateBoundary:
+    """What a model counts at an update boundary (the start of a rollout, after ``train()``).
 
-    def __init__(self, store: CheckpointStore, save_freq: int, verbose: int = 0) -> None:
+    Between two boundaries SB3 changes no weights, only these counters, the VecNormalize
+    statistics and, off-policy, the replay buffer's write position: restoring them
+    (:func:`rewind_to_boundary`) turns a model stopped mid-rollout back into the model of
+    the boundary, with the partial rollout's steps no longer counted.
+    """
+
+    num_timesteps: int
+    counters: dict[str, int] = field(default_factory=dict)
+    normalizer_stats: dict[str, Any] = field(default_factory=dict)
+    buffer_position: tuple[int, bool] | None = None
+
+
+#: Per-step counters of SB3 algorithms besides ``num_timesteps`` (DQN's target-network
+#: period counts ``_n_calls``).
+_BOUNDARY_COUNTERS = ("_n_calls", "_episode_num")
+
+
+def update_boundary(model: BaseAlgorithm) -> UpdateBoundary:
+    counters = {
+        name: int(getattr(model, name)) for name in _BOUNDARY_COUNTERS if hasattr(model, name)
+    }
+    normalizer = model.get_vec_normalize_env()
+    stats: dict[str, Any] = {}
+    if normalizer is not None:
+        stats = {
+            name: getattr(normalizer, name).copy()
+            for name in ("obs_rms", "ret_rms")
+            if getattr(normalizer, name, None) is not None
+        }
+    position = None
+    if isinstance(model, OffPolicyAlgorithm) and model.replay_buffer is not None:
+        position = (int(model.replay_buffer.pos), bool(model.replay_buffer.full))
+    return UpdateBoundary(int(model.num_timesteps), counters, stats, position)
+
+
+def rewind_to_boundary(model: BaseAlgorithm, boundary: UpdateBoundary) -> int:
+    """Forget the steps collected since ``boundary``; returns how many were dropped.
+
+    The dropped transitions of an off-policy replay buffer are left beyond its write
+    position (unsampled, overwritten next); when the buffer had already wrapped, the
+    slots they overwrote keep them instead of the oldest transitions.
+    """
+    dropped = int(model.num_timesteps) - boundary.num_timesteps
+    model.num_timesteps = boundary.num_timesteps
+    for name, value in boundary.counters.items():
+        setattr(model, name, value)
+    normalizer = model.get_vec_normalize_env()
+    if normalizer is not None:
+        for name, stats in boundary.normalizer_stats.items():
+            setattr(normalizer, name, stats.copy())
+    if boundary.buffer_position is not None and isinstance(model, OffPolicyAlgorithm):
+        buffer = model.replay_buffer
+        if buffer is not None:
+            buffer.pos, buffer.full = boundary.buffer_position
+    return dropped
+
+
+class PeriodicCheckpointCallback(BaseCallback):
+    """Saves a checkpoint at the first update boundary at or past each multiple of
+    ``save_freq`` env steps, and remembers the last boundary (:attr:`boundary`).
+
+    ``on_save`` is called with each checkpoint written (the trainer updates ``run.json``).
+    """
+
+    def __init__(
+        self,
+        store: CheckpointStore,
+        save_freq: int,
+        verbose: int = 0,
+        on_save: Callable[[Checkpoint], None] | None = None,
+    ) -> None:
         super().__init__(verbose)
         if save_freq < 1:
             raise ValueError(f"save_freq must be >= 1 env steps, got {save_freq}")
         self.store = store
         self.save_freq = save_freq
+        self.on_save = on_save
         self._next_save = save_freq
+        #: The state after the last ``train()``: at the start of the current rollout.
+        self.boundary: UpdateBoundary | None = None
 
     def _on_training_start(self) -> None:
         done = int(self.model.num_timesteps)
         self._next_save = (done // self.save_freq + 1) * self.save_freq
 
-    def _on_step(self) -> bool:
-        if self.num_timesteps >= self._next_save:
+    def _on_rollout_start(self) -> None:
+        # SB3 calls this before each rollout, after train() consumed the previous one.
+        self.boundary = update_boundary(self.model)
+        done = self.boundary.num_timesteps
+        if done >= self._next_save:
             checkpoint = self.store.save(self.model)
-            self._next_save = (self.num_timesteps // self.save_freq + 1) * self.save_freq
+            self._next_save = (done // self.save_freq + 1) * self.save_freq
             if self.verbose >= 1:
                 print(f"checkpoint: {checkpoint.model_path}")
+            if self.on_save is not None:
+                self.on_save(checkpoint)
+
+    def _on_step(self) -> bool:
         return True
 
 
@@ -187,14 +279,22 @@ class StopRequest:
 
 
 class StopOnRequestCallback(BaseCallback):
-    """Stops ``learn()`` at the next env step once ``request`` is set."""
+    """Stops ``learn()`` at the next env step once ``request`` is set.
+
+    :attr:`stopped_mid_rollout` tells that it did: SB3 then leaves ``learn()`` without
+    training on the partial rollout (see :func:`rewind_to_boundary`).
+    """
 
     def __init__(self, request: StopRequest) -> None:
         super().__init__(verbose=0)
         self.request = request
+        self.stopped_mid_rollout = False
 
     def _on_step(self) -> bool:
-        return not self.request
+        if self.request:
+            self.stopped_mid_rollout = True
+            return False
+        return True
 
 
 class FixedSeedEvalCallback(EvalCallback):

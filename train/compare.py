@@ -17,6 +17,12 @@ Outputs (in ``--out``):
 - ``area_vs_moves.png``, ``error_vs_moves.png``;
 - ``timing.json``: policy time per decision (the only output that is not reproducible).
 
+With ``--workers N`` the episodes run in a pool of spawned processes that exit with the
+command: if it is killed (SIGKILL, out of memory), the kernel ends them on Linux
+(``prctl(PR_SET_PDEATHSIG)``) and elsewhere they notice their parent is gone within half
+a second; multiprocessing's resource tracker then exits too, so nothing is left holding
+the caller's stdout or stderr open.
+
 An ``OSError`` while writing (disk full, no permission) ends the command with a one-line
 message naming the file and exit status 2. A line of ``episodes.jsonl`` that is not a
 valid record, other than a torn last line, is a :class:`CorruptLogError` naming its line
@@ -49,7 +55,9 @@ import json
 import math
 import multiprocessing
 import os
+import signal
 import sys
+import threading
 import time
 import zlib
 from collections.abc import Iterable, Iterator, Mapping, Sequence
@@ -927,6 +935,39 @@ def _pending_tasks(config: CompareConfig, done: set[tuple[str, int]]) -> list[Ep
     ]
 
 
+#: How often a worker checks that its parent is alive (where ``PR_SET_PDEATHSIG`` is missing).
+PARENT_POLL_SECONDS = 0.5
+_PR_SET_PDEATHSIG = 1
+
+
+def _exit_with_parent(parent_pid: int) -> None:
+    """Worker initializer: end this worker when the ``compare`` process that started it dies.
+
+    A ``ProcessPoolExecutor`` worker waits on its task queue, which never reports EOF when
+    the parent is SIGKILLed (the workers hold both ends of it): it would live on, holding
+    the caller's stdout and stderr open, and so would multiprocessing's resource tracker,
+    which exits once every process that shares its pipe has gone. On Linux the kernel
+    sends the worker SIGKILL when its parent dies (``prctl(PR_SET_PDEATHSIG)``); elsewhere,
+    and as a fallback, a daemon thread sees ``os.getppid()`` change within
+    :data:`PARENT_POLL_SECONDS` and exits.
+    """
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() != parent_pid:  # the parent died before the prctl
+        os._exit(1)
+
+    def watch() -> None:
+        while os.getppid() == parent_pid:
+            time.sleep(PARENT_POLL_SECONDS)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
+
+
 def _run_pending(
     tasks: Sequence[EpisodeTask], workers: int, log: EpisodeLog, bar: Any
 ) -> Iterator[dict[str, Any]]:
@@ -939,7 +980,12 @@ def _run_pending(
         return
     # spawn: torch and pygame state must not be forked; each worker imports afresh.
     context = multiprocessing.get_context("spawn")
-    executor = ProcessPoolExecutor(max_workers=workers, mp_context=context)
+    executor = ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=context,
+        initializer=_exit_with_parent,
+        initargs=(os.getpid(),),
+    )
     try:
         futures = [executor.submit(run_task, task) for task in tasks]
         for future in as_completed(futures):

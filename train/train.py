@@ -41,7 +41,7 @@ same episodes at every evaluation. Both ranges lie below ``train.compare``'s tes
 
 **Run folder** (``--output``, default ``runs/<algo>_<env>_seed<seed>``)::
 
-    run.json                 settings, seeds, status, timesteps, per-segment timing
+    run.json                 settings, seeds, status, timesteps, per-segment status/timing
     model.zip                final model (written when the run reaches its budget)
     vecnormalize.pkl         its VecNormalize statistics (when the config normalises)
     best/best_model.zip      best model on the validation episodes
@@ -53,10 +53,21 @@ same episodes at every evaluation. Both ranges lie below ``train.compare``'s tes
                              batched.monitor.csv for all envs of --vec-env batched
     tensorboard/             TensorBoard logs (``tensorboard --logdir runs``)
 
-**Interruptions.** Ctrl-C (or SIGTERM) stops at the next env step and saves a checkpoint
-(a second Ctrl-C stops at once, and still saves); the command then exits with status 130.
-``--resume`` continues from the newest checkpoint with the replay buffer (SAC, DQN) and
-the VecNormalize statistics, keeping the timestep count (``--timesteps`` is the total).
+**Interruptions.** A checkpoint counts only steps its model was trained on: periodic
+checkpoints are written at the first update boundary (the start of a rollout, after
+``train()`` consumed the previous one) at or past each multiple of ``--checkpoint-freq``.
+Ctrl-C (or SIGTERM) stops at the next env step and saves the state of the last update
+boundary: the steps of the partial rollout are dropped (counts, VecNormalize statistics,
+replay-buffer position) and collected again on resume. A second Ctrl-C stops at once and
+saves the same way (if it lands inside ``train()``, the weights may already hold part of
+that update). The command then exits with status 130. ``--resume`` continues from the
+newest checkpoint with the replay buffer (SAC, DQN) and the VecNormalize statistics,
+keeping the timestep count (``--timesteps`` is the total), so a run killed at any moment
+(SIGKILL included) and resumed ends with the ``num_timesteps`` and number of updates of
+an uninterrupted run. ``run.json`` lists the running segment from its start and updates
+its ``end_timesteps`` at each checkpoint; a segment whose process died (the record still
+says ``running``) is marked ``killed`` on ``--resume``, ending at the checkpoint the run
+resumes from. Each segment's ``status`` is ``finished``, ``interrupted`` or ``killed``.
 
 **Export.** ``--export DIR/NAME`` copies the best model (else the final one) of the run to
 ``DIR/NAME.zip``, its statistics to ``DIR/NAME_vecnormalize.pkl`` and a description to
@@ -111,6 +122,7 @@ from train.callbacks import (
     StopRequest,
     atomic_path,
     callback_calls,
+    rewind_to_boundary,
     save_model_atomically,
     save_vecnormalize_atomically,
     write_json_atomically,
@@ -752,6 +764,36 @@ def _resolve_run(settings: TrainSettings) -> tuple[dict[str, Any], Checkpoint | 
     return raw, checkpoint
 
 
+def _segments_after_a_kill(
+    previous_record: dict[str, Any], checkpoint: Checkpoint | None
+) -> list[dict[str, Any]]:
+    """The segments of the run being resumed, the one a killed process left "running"
+    marked "killed" at the timesteps of the checkpoint the run resumes from.
+
+    A record that still says "running" was left by a process that died without finishing
+    (SIGKILL, power loss, out of memory). Older records did not list the running segment;
+    it is added.
+    """
+    segments = [dict(item) for item in previous_record.get("segments", [])]
+    if previous_record.get("status") != "running":
+        return segments
+    resumed_at = checkpoint.timesteps if checkpoint is not None else 0
+    if segments and segments[-1].get("status") == "running":
+        killed = segments[-1]
+    else:
+        start = int(segments[-1]["end_timesteps"]) if segments else 0
+        killed = {
+            "start_timesteps": start,
+            "n_envs": previous_record.get("n_envs"),
+            "vec_env": previous_record.get("vec_env"),
+        }
+        segments.append(killed)
+    killed["status"] = "killed"
+    # The steps after its last checkpoint are lost; none of them is counted.
+    killed["end_timesteps"] = max(resumed_at, int(killed["start_timesteps"]))
+    return segments
+
+
 def train(settings: TrainSettings) -> TrainResult:
     """Train (or resume) a run; see the module docstring for the files it writes."""
     algorithm_class = algorithm_class_for(settings.algo)
@@ -847,10 +889,32 @@ def train(settings: TrainSettings) -> TrainResult:
                     VALIDATION_SEED_START + settings.eval_episodes,
                 ],
             },
-            "segments": list(previous_record.get("segments", [])),
+            "segments": _segments_after_a_kill(previous_record, checkpoint),
             "versions": _versions(),
         }
+        learn_start = time.perf_counter()
+        remaining = target - int(model.num_timesteps)
+        segment: dict[str, Any] | None = None
+        if remaining > 0:
+            # Written now and at every checkpoint, so a killed process leaves its segment
+            # (marked "killed" on --resume) with the timesteps of its last checkpoint.
+            segment = {
+                "start_timesteps": start_timesteps,
+                "end_timesteps": start_timesteps,
+                "n_envs": n_envs,
+                "vec_env": vec_env_kind,
+                "status": "running",
+                "wall_seconds": 0.0,
+            }
+            record["segments"].append(segment)
         write_json_atomically(files.record, record)
+
+        def record_checkpoint(saved_checkpoint: Checkpoint) -> None:
+            assert segment is not None
+            segment["end_timesteps"] = saved_checkpoint.timesteps
+            segment["wall_seconds"] = round(time.perf_counter() - learn_start, 3)
+            record["num_timesteps"] = saved_checkpoint.timesteps
+            write_json_atomically(files.record, record)
 
         store = CheckpointStore(files.checkpoints, keep=settings.keep_checkpoints)
         stop_request = StopRequest()
@@ -865,15 +929,14 @@ def train(settings: TrainSettings) -> TrainResult:
         )
         if checkpoint is not None:
             eval_callback.restore_history()
-        callbacks: list[BaseCallback] = [
-            StopOnRequestCallback(stop_request),
-            PeriodicCheckpointCallback(store, settings.checkpoint_freq, verbose=settings.verbose),
-            eval_callback,
-        ]
+        stop_callback = StopOnRequestCallback(stop_request)
+        checkpoint_callback = PeriodicCheckpointCallback(
+            store, settings.checkpoint_freq, verbose=settings.verbose, on_save=record_checkpoint
+        )
+        callbacks: list[BaseCallback] = [stop_callback, checkpoint_callback, eval_callback]
 
-        remaining = target - int(model.num_timesteps)
         interrupted = False
-        learn_start = time.perf_counter()
+        stopped_at_once = False
         if remaining <= 0:
             print(f"{settings.output}: already at {model.num_timesteps} >= {target} timesteps")
         else:
@@ -887,8 +950,19 @@ def train(settings: TrainSettings) -> TrainResult:
                         tb_log_name=settings.algo.upper(),
                     )
                 except KeyboardInterrupt:
-                    interrupted = True
+                    interrupted = stopped_at_once = True
         interrupted = interrupted or bool(stop_request)
+        boundary = checkpoint_callback.boundary
+        if (stop_callback.stopped_mid_rollout or stopped_at_once) and boundary is not None:
+            # learn() left without training on the partial rollout: save the model of the
+            # last update boundary, which counts only the steps it was trained on.
+            dropped = rewind_to_boundary(model, boundary)
+            if dropped > 0 and settings.verbose >= 0:
+                print(
+                    f"stopped in a rollout: its {dropped} steps were not trained on and are "
+                    f"not counted; the checkpoint is at {model.num_timesteps} timesteps",
+                    file=sys.stderr,
+                )
         wall_seconds = time.perf_counter() - learn_start
         steps_done = int(model.num_timesteps) - start_timesteps
         saved = store.save(model) if remaining > 0 else checkpoint
@@ -898,16 +972,12 @@ def train(settings: TrainSettings) -> TrainResult:
             if normalizer is not None:
                 save_vecnormalize_atomically(normalizer, files.final_vecnormalize)
         steps_per_second = steps_done / wall_seconds if wall_seconds > 0 else math.nan
-        if remaining > 0:
-            record["segments"].append(
-                {
-                    "start_timesteps": start_timesteps,
-                    "end_timesteps": int(model.num_timesteps),
-                    "n_envs": n_envs,
-                    "vec_env": vec_env_kind,
-                    "wall_seconds": round(wall_seconds, 3),
-                    "steps_per_second": round(steps_per_second, 1),
-                }
+        if segment is not None:
+            segment.update(
+                end_timesteps=int(model.num_timesteps),
+                status="interrupted" if interrupted else "finished",
+                wall_seconds=round(wall_seconds, 3),
+                steps_per_second=round(steps_per_second, 1),
             )
         record["num_timesteps"] = int(model.num_timesteps)
         record["status"] = "interrupted" if interrupted else "finished"
