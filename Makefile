@@ -16,6 +16,7 @@ $(STAMP): pyproject.toml constraints.txt
 
 test: $(STAMP)
 	$(PY) -m ruff check bearing_env agents train tests benchmarks
+	$(PY) -m mypy bearing_env agents
 	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m "not slow"
 
 demo: $(STAMP)

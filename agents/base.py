@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, cast, runtime_checkable
 
 import gymnasium as gym
 import numpy as np
@@ -23,6 +23,9 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from agents.env_access import bearing_env_of
+
+if TYPE_CHECKING:
+    from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
 
 #: Policies draw their own random numbers from ``default_rng([seed, POLICY_STREAM])``,
 #: not ``default_rng(seed)``: the env seeds its generator from the same episode seed, and
@@ -84,8 +87,10 @@ class ActionCodec:
         )
         self.discrete = isinstance(env.action_space, spaces.Discrete)
         if self.discrete:
-            self.turn_table = np.asarray(base.turn_angles, dtype=np.float64)
-            self.length_table = np.asarray(base.move_lengths, dtype=np.float64)
+            # The action tables are the discrete env's (the env a Discrete space implies).
+            grid = cast("BearingSLAMDiscreteEnv", base)
+            self.turn_table = np.asarray(grid.turn_angles, dtype=np.float64)
+            self.length_table = np.asarray(grid.move_lengths, dtype=np.float64)
         elif not isinstance(env.action_space, spaces.Box) or env.action_space.shape != (2,):
             raise TypeError(
                 f"unsupported action space {env.action_space!r}: expected the Box(2,) of "

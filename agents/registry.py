@@ -94,6 +94,8 @@ def _string(text: str) -> str:
 
 def _split_options(text: str) -> list[str]:
     """Split on commas that are not inside brackets (so ``lengths=(0.1,0.2)`` survives)."""
+    items: list[str]
+    current: list[str]
     items, depth, current = [], 0, []
     for char in text:
         if char in "([{":

@@ -294,7 +294,7 @@ class Renderer:
     def _draw_footer(self) -> None:
         pygame = self._pygame
         y = self.size[1] - FOOTER_HEIGHT // 2
-        x = PADDING
+        x: float = PADDING
         pygame.draw.polygon(self._canvas, FRAME_LANDMARK, _star(np.array([x + 6, y]), 7, 3))
         x = self._footer_text("true landmark", x + 16, y)
         pygame.draw.circle(self._canvas, PALETTE[0], (x + 6, y), 5, width=2)

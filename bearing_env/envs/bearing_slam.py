@@ -80,8 +80,9 @@ class Setting(Generic[T]):
 
     def __get__(self, env: Any, owner: type | None = None) -> T:
         if env is None:
+            # why: read on the class, a descriptor gives itself (as property does), not a T
             return self  # type: ignore[return-value]
-        return getattr(env.config, self.field)  # type: ignore[no-any-return]
+        return getattr(env.config, self.field)
 
     def __set__(self, env: Any, value: T) -> None:
         if self.read_only is not None:
@@ -514,7 +515,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         return float(turns[0]), float(lengths[0])
 
 
-def observation_space(config: EnvConfig) -> spaces.Box:
+def observation_space(config: EnvConfig) -> spaces.Box[np.float32]:
     """The observation space of envs with ``config`` (see the Observation Space section)."""
     log_min, log_max = math.log(AREA_FLOOR), math.log(config.area_cap)
     robot_low = [-FL_COORD_LIMIT, -FL_COORD_LIMIT, log_min, 0, -1, -1, 0, 0, 0]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from gymnasium import spaces
@@ -91,7 +91,7 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
         **settings: Any,
     ) -> None:
         # The keyword settings are BearingSLAMEnv's; EnvConfig.create names any unknown one.
-        grid = {"n_turns": n_turns, "n_move_lengths": n_move_lengths}
+        grid: dict[str, Any] = {"n_turns": n_turns, "n_move_lengths": n_move_lengths}
         defaults = {"n_turns": DEFAULT_N_TURNS, "n_move_lengths": None}
         if config is None:
             config = EnvConfig.create(**settings, **grid)
@@ -116,9 +116,8 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
         """One action index as an array of shape () (ValueError otherwise)."""
         values = np.asarray(action)
         if values.shape != ():
-            raise ValueError(
-                f"action must be an integer in [0, {self.action_space.n}), got {action!r}"
-            )
+            n = cast(spaces.Discrete, self.action_space).n  # this env's space is Discrete
+            raise ValueError(f"action must be an integer in [0, {n}), got {action!r}")
         return values
 
     def _decode_batch(self, actions: NDArray[Any]) -> tuple[FloatArray, FloatArray]:

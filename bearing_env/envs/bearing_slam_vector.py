@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from types import SimpleNamespace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from gymnasium.utils import seeding
@@ -186,7 +186,8 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             # generator carries on (or is made from fresh entropy the first time).
             if row_seed is not None or self._rngs[row] is None:
                 self._rngs[row], _ = seeding.np_random(row_seed)
-        observations = np.zeros(self.observation_space.shape, dtype=np.float32)
+        shape = cast("tuple[int, ...]", self.observation_space.shape)  # a Box: never None
+        observations = np.zeros(shape, dtype=np.float32)
         infos = self._reset_rows(np.arange(self.num_envs), observations, {})
         self._autoreset_envs[:] = False
         self._elapsed_steps[:] = 0
@@ -218,7 +219,8 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             for config, rows in self._groups(np.flatnonzero(~resetting))
         ]
 
-        observations = np.zeros(self.observation_space.shape, dtype=np.float32)
+        shape = cast("tuple[int, ...]", self.observation_space.shape)  # a Box: never None
+        observations = np.zeros(shape, dtype=np.float32)
         rewards = np.zeros(n, dtype=np.float64)
         terminations = np.zeros(n, dtype=bool)
         truncations = np.zeros(n, dtype=bool)
@@ -481,6 +483,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
     ) -> dict[str, Any]:
         """What ``_add_info`` would build from each row's info, for many rows at once."""
         for key, value in batched.items():
+            array: Any
             if isinstance(value, dict):
                 array = self._merge_rows(infos.get(key, {}), value, rows)
             else:

@@ -22,7 +22,7 @@ import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -209,8 +209,10 @@ class EnvConfig:
             object.__setattr__(self, name, value)
 
         choice(self.scenario, tuple(SCENARIOS), "scenario")
-        if not isinstance(self.arena, Arena):
-            normalise("arena", _resolve_arena(self.arena, SCENARIOS[self.scenario].arena_size))
+        # Direct construction and replace() may still hold a raw (width, height) here.
+        arena = cast("tuple[float, float] | Arena", self.arena)
+        if not isinstance(arena, Arena):
+            normalise("arena", _resolve_arena(arena, SCENARIOS[self.scenario].arena_size))
         lo, hi = _resolve_count_pair(self.landmark_counts)
         normalise("landmark_counts", (lo, hi))
         if self.landmarks is not None:

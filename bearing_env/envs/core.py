@@ -33,6 +33,7 @@ from bearing_env.envs import kernels
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import CONTAINMENT_TOLERANCE, BatchedPolygonSLAM
+from bearing_env.slam.geometry import wrap_angle
 from bearing_env.world import (
     REFERENCE_MIN_BASELINE,
     Arena,
@@ -42,7 +43,6 @@ from bearing_env.world import (
     random_layout,
     random_start,
     true_bearings,
-    wrap_angle,
 )
 
 FloatArray = NDArray[np.float64]
@@ -277,11 +277,11 @@ class WorldView:
 
     @property
     def _state(self) -> BatchState:
-        return self._owner._state  # type: ignore[no-any-return]
+        return self._owner._state
 
     @property
     def _config(self) -> EnvConfig:
-        return self._owner._row_config(self._row)  # type: ignore[no-any-return]
+        return self._owner._row_config(self._row)
 
     @property
     def arena(self) -> Arena:

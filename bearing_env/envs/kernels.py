@@ -14,10 +14,10 @@ import math
 import numpy as np
 from numba import njit
 
-from bearing_env.slam.kernels import contains_point, wrap
+from bearing_env.slam.kernels import JitOptions, contains_point, wrap
 from bearing_env.world import bearing, straight_move
 
-_JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
+_JIT: JitOptions = {"cache": True, "nogil": True, "error_model": "numpy"}
 
 #: Indices of the robot block's features (see core.ROBOT_FEATURES).
 _ROBOT_FEATURES = 9

@@ -187,7 +187,8 @@ class BatchedPolygonSLAM:
         frame = np.empty(n_rows, dtype=np.int8)
         landmark = np.empty((n_rows, n_mapped), dtype=np.int8)
         bad = np.empty(n_rows, dtype=np.int64)
-        arguments = (
+        # Any: the kernels take these mixed arguments (and the state arrays) positionally.
+        arguments: tuple[Any, ...] = (
             b1,
             b2,
             rows,

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 import os
+from typing import Literal, TypedDict
 
 import numba
 import numpy as np
@@ -69,13 +70,23 @@ LANDMARK_UNBOUNDED = 1
 LANDMARK_INCONSISTENT = 2
 LANDMARK_SKIPPED = 3
 
-_JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
+
+class JitOptions(TypedDict):
+    """The keyword options every kernel is compiled with (typed for ``njit(**_JIT)``)."""
+
+    cache: bool
+    nogil: bool
+    error_model: Literal["python", "numpy"]
+
+
+_JIT: JitOptions = {"cache": True, "nogil": True, "error_model": "numpy"}
 
 # OpenMP's default busy-waiting made prange several times slower than serial code on a
 # 2-core machine; numba's own workqueue layer waits passively. A layer chosen by the user
 # (NUMBA_THREADING_LAYER) is left alone.
 if "NUMBA_THREADING_LAYER" not in os.environ:
-    numba.config.THREADING_LAYER = "workqueue"
+    # why: numba.config defines its settings at import through globals(), unseen by mypy
+    numba.config.THREADING_LAYER = "workqueue"  # type: ignore[attr-defined]
 
 
 def threads() -> int:
