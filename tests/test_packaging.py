@@ -60,3 +60,21 @@ def test_the_wheel_carries_the_license_without_a_deprecation_warning(tmp_path: P
         text = archive.read(metadata).decode()
         assert "License-Expression: MIT" in text.splitlines()
         assert any(n.endswith(".dist-info/licenses/LICENSE") for n in names)
+
+
+def test_the_sdist_carries_the_tests_with_their_helpers(tmp_path: Path) -> None:
+    import tarfile
+
+    from setuptools import build_meta
+
+    name = build_meta.build_sdist(str(tmp_path))
+    with tarfile.open(tmp_path / name) as sdist:
+        names = {
+            Path(*Path(member).parts[1:]).as_posix()
+            for member in sdist.getnames()
+            if "/" in member
+        }
+    repository_tests = {f"tests/{p.name}" for p in (ROOT / "tests").glob("*.py")}
+    assert repository_tests <= names, sorted(repository_tests - names)
+    assert {"LICENSE", "docs/design.md"} <= names
+    assert not [n for n in names if n.endswith((".nbi", ".nbc", ".pyc"))]
