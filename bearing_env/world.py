@@ -87,6 +87,12 @@ class Arena:
         return min(REFERENCE_WALL_MARGIN * self.scale, 0.25 * min(self.width, self.height))
 
     @property
+    def min_baseline(self) -> float:
+        """The shortest move (metres) that counts as a move: a robot that cannot travel at
+        least this far (facing the wall, up to rounding) stays where it is."""
+        return REFERENCE_MIN_BASELINE * self.scale
+
+    @property
     def default_move_length(self) -> tuple[float, float]:
         """Default move length range (metres) at this arena's scale."""
         lo, hi = REFERENCE_MOVE_LENGTH
@@ -449,7 +455,7 @@ class World:
 
     @property
     def min_baseline(self) -> float:
-        return REFERENCE_MIN_BASELINE * self.arena.scale
+        return self.arena.min_baseline
 
     def turn(self, angle: float) -> None:
         """Turn on the spot by ``angle`` radians (CCW positive)."""

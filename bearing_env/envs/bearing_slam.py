@@ -29,16 +29,14 @@ from bearing_env.envs.config import (
     EnvConfig,
 )
 from bearing_env.envs.core import (
-    BEARING_FEATURES,
     FL_COORD_LIMIT,
-    LANDMARK_FEATURES,
-    ROBOT_FEATURES,
     BatchState,
     MapBank,
     WorldView,
     observation_size,
     observation_slices,
 )
+from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
 from bearing_env.slam import PolygonSLAM
 from bearing_env.world import Arena, NoiseModel
 

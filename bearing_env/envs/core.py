@@ -31,11 +31,11 @@ from numpy.typing import NDArray
 
 from bearing_env.envs import kernels
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig
+from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import CONTAINMENT_TOLERANCE, BatchedPolygonSLAM
 from bearing_env.slam.geometry import wrap_angle
 from bearing_env.world import (
-    REFERENCE_MIN_BASELINE,
     Arena,
     NoiseDraws,
     NoiseModel,
@@ -53,22 +53,6 @@ ComplexArray = NDArray[np.complex128]
 #: FL coordinates in the observation are clipped to +-this (the frame is |L1 - L2| = 1, so
 #: this is 50 baselines away: far beyond any landmark of a sensible layout).
 FL_COORD_LIMIT = 50.0
-
-#: Observation layout: the robot block first, then one block per mapped landmark slot
-#: (landmarks L3, L4, ...), then one block per bearing slot (L1, L2, L3, ...).
-ROBOT_FEATURES: tuple[str, ...] = (
-    "robot_x",
-    "robot_y",
-    "robot_log_area",
-    "robot_unknown",
-    "heading_cos",
-    "heading_sin",
-    "progress",
-    "last_frame_changed",
-    "last_move_blocked",
-)
-LANDMARK_FEATURES: tuple[str, ...] = ("present", "uninitialised", "x", "y", "log_area")
-BEARING_FEATURES: tuple[str, ...] = ("present", "cos", "sin")
 
 #: Trajectory slots allocated per row at first; the array doubles when a row fills it.
 INITIAL_TRAJECTORY_SLOTS = 32
@@ -315,7 +299,7 @@ class WorldView:
 
     @property
     def min_baseline(self) -> float:
-        return REFERENCE_MIN_BASELINE * self.arena.scale
+        return self.arena.min_baseline
 
     def true_bearings(self) -> FloatArray:
         """Noise-free bearings (n,) of all landmarks, relative to the heading, [-pi, pi)."""
@@ -447,7 +431,7 @@ def step(
     """
     n = int(state.n_landmarks[rows[0]])
     arena, noise, epsilon = config.arena, config.noise, config.epsilon
-    min_baseline = REFERENCE_MIN_BASELINE * arena.scale
+    min_baseline = arena.min_baseline
     size = rows.size
     # Each row draws its first reading's noise, then its second's, from its generator.
     first_draws, second_draws = noise.draw_movement_rows(rngs, n, epsilon)

@@ -19,10 +19,27 @@ from bearing_env.world import bearing, straight_move
 
 _JIT: JitOptions = {"cache": True, "nogil": True, "error_model": "numpy"}
 
-#: Indices of the robot block's features (see core.ROBOT_FEATURES).
-_ROBOT_FEATURES = 9
-_LANDMARK_FEATURES = 5
-_BEARING_FEATURES = 3
+#: Observation layout: the robot block first, then one block per mapped landmark slot
+#: (landmarks L3, L4, ...), then one block per bearing slot (L1, L2, L3, ...).
+#: :func:`write_observations` writes them in this order; the block sizes below are
+#: numba compile-time constants.
+ROBOT_FEATURES: tuple[str, ...] = (
+    "robot_x",
+    "robot_y",
+    "robot_log_area",
+    "robot_unknown",
+    "heading_cos",
+    "heading_sin",
+    "progress",
+    "last_frame_changed",
+    "last_move_blocked",
+)
+LANDMARK_FEATURES: tuple[str, ...] = ("present", "uninitialised", "x", "y", "log_area")
+BEARING_FEATURES: tuple[str, ...] = ("present", "cos", "sin")
+
+_ROBOT_FEATURES = len(ROBOT_FEATURES)
+_LANDMARK_FEATURES = len(LANDMARK_FEATURES)
+_BEARING_FEATURES = len(BEARING_FEATURES)
 
 
 @njit(**_JIT)
