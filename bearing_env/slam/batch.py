@@ -29,18 +29,34 @@ from bearing_env.slam.transfer import TRANSFERS
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
-#: Frame statuses, as codes (index into this tuple) and as the strings of the public API.
-FRAME_STATUSES: tuple[str, ...] = (
-    "ok",
-    "l1_unbounded",
-    "l2_unbounded",
-    "l1_l2_overlap",
-    "l1_l2_too_close",
+#: Frame statuses, as codes (index into this tuple; the kernels' constants) and as the
+#: strings of the public API.
+FRAME_STATUSES: tuple[str, ...] = tuple(
+    name
+    for _, name in sorted(
+        {
+            kernels.FRAME_OK: "ok",
+            kernels.FRAME_L1_UNBOUNDED: "l1_unbounded",
+            kernels.FRAME_L2_UNBOUNDED: "l2_unbounded",
+            kernels.FRAME_L1_L2_OVERLAP: "l1_l2_overlap",
+            kernels.FRAME_L1_L2_TOO_CLOSE: "l1_l2_too_close",
+        }.items()
+    )
 )
 FRAME_CODE = {name: code for code, name in enumerate(FRAME_STATUSES)}
 
 #: Landmark statuses, as codes and strings.
-LANDMARK_STATUSES: tuple[str, ...] = ("updated", "unbounded", "inconsistent", "skipped")
+LANDMARK_STATUSES: tuple[str, ...] = tuple(
+    name
+    for _, name in sorted(
+        {
+            kernels.LANDMARK_UPDATED: "updated",
+            kernels.LANDMARK_UNBOUNDED: "unbounded",
+            kernels.LANDMARK_INCONSISTENT: "inconsistent",
+            kernels.LANDMARK_SKIPPED: "skipped",
+        }.items()
+    )
+)
 LANDMARK_CODE = {name: code for code, name in enumerate(LANDMARK_STATUSES)}
 
 INCONSISTENCY_POLICIES = ("restart", "keep")
