@@ -20,14 +20,14 @@ test: $(STAMP)
 	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m "not slow"
 
 demo: $(STAMP)
-	SDL_VIDEODRIVER=dummy $(PY) -m train.demo
-	SDL_VIDEODRIVER=dummy $(PY) -m train.compare --quick
+	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.demo
+	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.compare --quick
 
 bench: $(STAMP)
-	$(PY) benchmarks/bench_env.py
+	$(PY) -m bearing_env.benchmarks.bench_env
 
 bench-slam: $(STAMP)
-	$(PY) benchmarks/bench_slam.py
+	$(PY) -m bearing_env.benchmarks.bench_slam
 
 lint: $(STAMP)
 	$(PY) -m ruff check bearing_env agents train tests benchmarks

@@ -2,7 +2,7 @@
 
 Every policy is built from the env it acts in, ``Policy(env, **options)``, and driven with
 ``reset(seed)`` at the start of an episode and ``act(observation, info) -> action`` at
-every step (see :class:`agents.base.Policy`). All work on both registered ids:
+every step (see :class:`bearing_env.agents.base.Policy`). All work on both registered ids:
 
 - :class:`RandomPolygonal`: the paper's random rotation then straight line;
 - :class:`Parallax`: move across the line of sight of the most uncertain landmark;
@@ -14,10 +14,10 @@ every step (see :class:`agents.base.Policy`). All work on both registered ids:
 :func:`make_policy` builds one from a spec string such as ``"greedy:n_turns=16"``.
 """
 
-from agents.base import ActionCodec, Movement, Policy
-from agents.heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
-from agents.registry import POLICY_CLASSES, PolicySpec, make_policy, parse_policy_spec
-from agents.sb3 import ModelLoadError, SB3Policy, pretrained_names, pretrained_record
+from .base import ActionCodec, Movement, Policy
+from .heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
+from .registry import POLICY_CLASSES, PolicySpec, make_policy, parse_policy_spec
+from .sb3 import ModelLoadError, SB3Policy, pretrained_names, pretrained_record
 
 __all__ = [
     "POLICY_CLASSES",

@@ -22,7 +22,7 @@ import numpy as np
 from gymnasium import spaces
 from numpy.typing import NDArray
 
-from agents.env_access import bearing_env_of
+from .env_access import bearing_env_of
 
 if TYPE_CHECKING:
     from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv

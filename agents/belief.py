@@ -40,10 +40,11 @@ import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
-from agents.base import Movement, wrap_angle
-from agents.env_access import bearing_env_of
 from bearing_env.envs.bearing_slam import BEARING_FEATURES, ROBOT_FEATURES, observation_slices
 from bearing_env.slam import PolygonSLAM
+
+from .base import Movement, wrap_angle
+from .env_access import bearing_env_of
 
 #: Minimum bearing change (in units of epsilon) for a triangulation to give a scale sample.
 MIN_PARALLAX_EPSILONS = 4.0

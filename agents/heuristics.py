@@ -10,22 +10,23 @@ import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
-from agents.base import Action, ActionCodec, Movement, policy_rng, wrap_angle
-from agents.belief import (
+from bearing_env.slam import PolygonSLAM, world_to_fl
+
+from .base import Action, ActionCodec, Movement, policy_rng, wrap_angle
+from .belief import (
     ObservationReader,
     ObservationView,
     PoseBelief,
     RobotBelief,
     spread_turn,
 )
-from agents.env_access import bearing_env_of, slam_of, world_of
-from agents.planning import (
+from .env_access import bearing_env_of, slam_of, world_of
+from .planning import (
     SimulatedMove,
     landmark_positions_fl,
     simulate_potentials,
     uncertainty_potential,
 )
-from bearing_env.slam import PolygonSLAM, world_to_fl
 
 #: Turns tried by the bootstrap move on the continuous id (every 5 degrees).
 BOOTSTRAP_TURNS = 72
@@ -258,7 +259,7 @@ class GreedyOneStep(MovementPolicy):
     default; on the discrete id the table's turns x its ``lengths`` longest lengths), it
     simulates the SLAM update on a copy of the robot's map with noise-free bearings from
     the *estimated* map (L1 = 0, L2 = 1, the landmark centroids, the robot's believed pose:
-    see :mod:`agents.belief`) and takes the move whose predicted sum of capped log areas
+    see :mod:`bearing_env.agents.belief`) and takes the move whose predicted sum of capped log areas
     is lowest, i.e. the largest expected decrease of the env's default potential.
     Landmarks not yet initialised count at the env's ``area_cap`` and cannot be simulated
     (no predicted progress). It never reads ground truth: no ``info``, no world.
@@ -272,7 +273,7 @@ class GreedyOneStep(MovementPolicy):
     walls with moves too short to change frames.
 
     Scoring fuses every candidate into its own copy of the map in one batched update
-    (``PolygonSLAM.replicate``; see :func:`agents.planning.simulate_potentials`).
+    (``PolygonSLAM.replicate``; see :func:`bearing_env.agents.planning.simulate_potentials`).
 
     Args:
         env: the env it acts in (either id).

@@ -22,9 +22,9 @@ from typing import Any
 
 import gymnasium as gym
 
-from agents.base import Policy
-from agents.heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
-from agents.sb3 import SB3Policy
+from .base import Policy
+from .heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
+from .sb3 import SB3Policy
 
 
 def pretrained_policy(env: gym.Env, name: str, **options: Any) -> SB3Policy:

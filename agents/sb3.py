@@ -18,8 +18,9 @@ import numpy as np
 from gymnasium import spaces
 from numpy.typing import NDArray
 
-from agents.base import Action
 from bearing_env.extras import require
+
+from .base import Action
 
 #: File names tried, in order, when ``path`` is a directory.
 MODEL_FILE_NAMES = ("best_model.zip", "model.zip", "final_model.zip")

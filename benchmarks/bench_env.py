@@ -7,7 +7,7 @@
 
 Absolute rates drift on shared machines, so every figure is also given as a ratio to
 Gymnasium's CartPole-v1 ``env.step`` rate (``gym.make("CartPole-v1")`` with its default
-wrappers, :func:`benchmarks.bench_slam.cartpole_steps_per_second`). The reference is
+wrappers, :func:`bearing_env.benchmarks.bench_slam.cartpole_steps_per_second`). The reference is
 measured at the start, again before each section (before each PPO variant), and at the
 end; each figure is divided by the reference measured closest to it in time, and also by
 the start reference.
@@ -24,7 +24,7 @@ Sections:
   the baseline) for each ``--num-envs``. Rates are env transitions per second summed over
   the sub-envs; in NEXT_STEP autoreset mode the reset-only sub-steps that follow an
   episode's end count in the time but not as transitions.
-- ``slam``: ``PolygonSLAM.update`` alone (:mod:`benchmarks.bench_slam`'s readings), both
+- ``slam``: ``PolygonSLAM.update`` alone (:mod:`bearing_env.benchmarks.bench_slam`'s readings), both
   transfers, 4 and 64 landmarks.
 - ``startup``: the compiled core's start-up, in fresh processes: compiling from an empty
   numba cache (a new ``NUMBA_CACHE_DIR``), then, with that cache warm, the time from the
@@ -34,7 +34,8 @@ Sections:
   scores 16 candidate moves on copies of the map), Khepera scenario, the median over the
   moves of several episodes. Seconds, not a ratio.
 - ``ppo``: SB3 ``PPO with ``train/hyperparams/ppo.yml``'s settings for BearingSLAM-v0
-  (VecNormalize included) on ``--ppo-envs`` envs built by ``train.train.make_training_env``
+  (VecNormalize included) on ``--ppo-envs`` envs built by
+  ``bearing_env.train.train.make_training_env``
   for each vec env kind (batched, subproc with spawn, dummy). The rate is env steps per
   second of wall time of ``model.learn()``, measured after a warm-up ``learn()`` of one
   rollout, so process start-up and torch initialisation are excluded. PPO always finishes
@@ -45,7 +46,7 @@ Sections:
   during the run favours no kind.
 
 When the batched pieces are missing (no ``vector_entry_point`` on the spec, or no
-``"batched"`` in ``train.train.VEC_ENV_KINDS``), the rows fall back to ``sync`` and
+``"batched"`` in ``bearing_env.train.train.VEC_ENV_KINDS``), the rows fall back to ``sync`` and
 ``dummy`` and are labelled as fallbacks; the targets that depend on them say so.
 
 Targets (printed as met / not met and stored in the JSON):
@@ -83,10 +84,10 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+from bearing_env.benchmarks.bench_slam import cartpole_steps_per_second
 from gymnasium.vector import AutoresetMode
 
 import bearing_env
-from benchmarks.bench_slam import cartpole_steps_per_second
 
 ENV_ID = "BearingSLAM-v0"
 SECTIONS: tuple[str, ...] = ("single", "vector", "slam", "startup", "planning", "ppo")
@@ -283,7 +284,7 @@ def bench_single(bench: Bench, landmarks: Sequence[int]) -> list[dict[str, Any]]
 
 
 def bench_slam_updates(bench: Bench) -> list[dict[str, Any]]:
-    from benchmarks.bench_slam import updates_per_second
+    from bearing_env.benchmarks.bench_slam import updates_per_second
 
     bench.measure_reference("slam")
     rows: list[dict[str, Any]] = []
@@ -340,7 +341,7 @@ def bench_startup() -> dict[str, Any]:
 
 def bench_planning(episodes: int) -> dict[str, Any]:
     """GreedyOneStep's act() time per move, Khepera, seeded episodes."""
-    from agents import GreedyOneStep
+    from bearing_env.agents import GreedyOneStep
 
     env = gym.make(ENV_ID, scenario="khepera")
     policy = GreedyOneStep(env)
@@ -483,7 +484,7 @@ def vector_label(row: dict[str, Any]) -> str:
 
 
 def available_vec_env_kinds() -> tuple[str, ...]:
-    from train.train import VEC_ENV_KINDS
+    from bearing_env.train.train import VEC_ENV_KINDS
 
     return tuple(VEC_ENV_KINDS)
 
@@ -492,7 +493,7 @@ def ppo_settings(
     env_kwargs: dict[str, Any], overrides: dict[str, Any]
 ) -> tuple[dict[str, Any], dict[str, Any] | None, dict[str, Any]]:
     """(PPO constructor kwargs, VecNormalize kwargs or None, env kwargs) from ppo.yml."""
-    from train.train import parse_hyperparameters, read_hyperparameters
+    from bearing_env.train.train import parse_hyperparameters, read_hyperparameters
 
     raw = read_hyperparameters("ppo", ENV_ID)
     raw.update(overrides)
@@ -583,10 +584,9 @@ def build_ppo_run(
     overrides: dict[str, Any],
 ) -> PPORun:
     """Build PPO on one vec env kind and warm it up (one rollout and one update)."""
+    from bearing_env.train.train import make_training_env
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
-
-    from train.train import make_training_env
 
     available = available_vec_env_kinds()
     measured_with = kind if kind in available else "dummy"
@@ -634,7 +634,10 @@ def bench_ppo(
     median round, and its ratio to SubprocVecEnv is the median of the per-round ratios.
     """
     if "batched" in kinds and "batched" not in available_vec_env_kinds():
-        log("  train.train.VEC_ENV_KINDS has no 'batched': that row uses dummy (fallback)")
+        log(
+            "  bearing_env.train.train.VEC_ENV_KINDS has no 'batched':"
+            " that row uses dummy (fallback)"
+        )
     runs: list[PPORun] = []
     try:
         with torch_threads(1):  # as bearing-env train (--torch-threads 1)
@@ -1306,7 +1309,7 @@ def run(settings: Settings) -> dict[str, Any]:
 def main(argv: Sequence[str] | None = None) -> dict[str, Any] | None:
     arguments = sys.argv[1:] if argv is None else list(argv)
     if "--slam" in arguments:  # forward to the world-model benchmark, which has its own options
-        from benchmarks import bench_slam
+        from bearing_env.benchmarks import bench_slam
 
         sys.argv = ["bench_slam", *(arg for arg in arguments if arg != "--slam")]
         bench_slam.main()

@@ -12,9 +12,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import pytest
-
-import bearing_env  # noqa: F401  (registers the ids)
-from agents import (
+from bearing_env.agents import (
     ActionCodec,
     GreedyOneStep,
     GreedyOracle,
@@ -26,7 +24,9 @@ from agents import (
     make_policy,
     parse_policy_spec,
 )
-from agents.belief import scale_sample, triangulate_fr
+from bearing_env.agents.belief import scale_sample, triangulate_fr
+
+import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.slam import world_to_fl
 
 ENV_IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")

@@ -9,13 +9,12 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import bearing_env.train.train
 import gymnasium as gym
 import pytest
+from bearing_env.benchmarks import bench_env
+from bearing_env.train import cli
 from gymnasium.vector import AutoresetMode
-
-import train.train
-from benchmarks import bench_env
-from train import cli
 
 MACHINE_KEYS = {"platform", "cpu_count", "numpy", "python", "gymnasium"}
 FIGURE_KEYS = {
@@ -136,9 +135,9 @@ def test_batched_rows_are_not_fallbacks_when_available(
 ) -> None:
     """With a vector entry point and a "batched" vec env kind, nothing is labelled fallback."""
     monkeypatch.setattr(gym.spec(bench_env.ENV_ID), "vector_entry_point", stand_in_vector_env)
-    kinds = tuple(dict.fromkeys((*train.train.VEC_ENV_KINDS, "batched")))
-    monkeypatch.setattr(train.train, "VEC_ENV_KINDS", kinds)
-    make_training_env = train.train.make_training_env
+    kinds = tuple(dict.fromkeys((*bearing_env.train.train.VEC_ENV_KINDS, "batched")))
+    monkeypatch.setattr(bearing_env.train.train, "VEC_ENV_KINDS", kinds)
+    make_training_env = bearing_env.train.train.make_training_env
 
     def make_with_batched(
         env_id: str, env_kwargs: dict[str, Any], n_envs: int, kind: str, monitor_dir: Path | None
@@ -147,7 +146,7 @@ def test_batched_rows_are_not_fallbacks_when_available(
             env_id, env_kwargs, n_envs, "dummy" if kind == "batched" else kind, monitor_dir
         )
 
-    monkeypatch.setattr(train.train, "make_training_env", make_with_batched)
+    monkeypatch.setattr(bearing_env.train.train, "make_training_env", make_with_batched)
     results, _ = run_quick(
         tmp_path, "--sections", "vector,ppo", "--num-envs", "2", "--ppo-kinds", "batched"
     )
@@ -212,7 +211,7 @@ def test_cli_bench_runs_bench_env(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     monkeypatch.setattr(sys, "argv", ["bearing-env"])  # cli.main rewrites sys.argv
-    assert cli.SUBCOMMANDS["bench"][0] == "benchmarks.bench_env"
+    assert cli.SUBCOMMANDS["bench"][0] == "bearing_env.benchmarks.bench_env"
     path = tmp_path / "cli.json"
     cli.main(["bench", "--quick", "--sections", "single", "--landmarks", "4", "--json", str(path)])
     results = json.loads(path.read_text())

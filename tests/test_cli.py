@@ -5,8 +5,7 @@ import subprocess
 import sys
 
 import pytest
-
-from train.cli import SUBCOMMANDS
+from bearing_env.train.cli import SUBCOMMANDS
 
 
 @pytest.mark.parametrize("command", sorted(SUBCOMMANDS))
@@ -18,7 +17,7 @@ def test_every_subcommand_has_a_main(command: str) -> None:
 @pytest.mark.parametrize("command", sorted(SUBCOMMANDS))
 def test_subcommand_help_runs(command: str) -> None:
     result = subprocess.run(
-        [sys.executable, "-m", "train.cli", command, "--help"],
+        [sys.executable, "-m", "bearing_env.train.cli", command, "--help"],
         capture_output=True,
         text=True,
         timeout=120,
@@ -29,7 +28,10 @@ def test_subcommand_help_runs(command: str) -> None:
 
 def test_unknown_subcommand_is_rejected() -> None:
     result = subprocess.run(
-        [sys.executable, "-m", "train.cli", "fly"], capture_output=True, text=True, timeout=60
+        [sys.executable, "-m", "bearing_env.train.cli", "fly"],
+        capture_output=True,
+        text=True,
+        timeout=60,
     )
     assert result.returncode != 0
     assert "invalid choice" in result.stderr

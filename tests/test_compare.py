@@ -10,9 +10,8 @@ from typing import Any
 
 import numpy as np
 import pytest
-
-from train import cli
-from train.compare import (
+from bearing_env.train import cli
+from bearing_env.train.compare import (
     EVAL_SEED_START,
     LOG_NAME,
     CompareConfig,
@@ -217,7 +216,7 @@ def test_command_line_runs_and_resumes(tmp_path: Path, capsys: pytest.CaptureFix
 
 
 def test_the_report_quotes_the_command_that_reproduces_the_results() -> None:
-    from train.compare import reproducing_command
+    from bearing_env.train.compare import reproducing_command
 
     argv = ["--episodes", "9", "--resume", "--stop-after", "3", "--no-progress", "--out", "o"]
     assert reproducing_command(argv) == "bearing-env compare --episodes 9 --out o"
@@ -265,7 +264,7 @@ def test_bearing_env_dispatches_compare(
 
 
 def test_atomic_outputs_leave_no_partial_files(tmp_path: Path) -> None:
-    from train.compare import atomic_write_text
+    from bearing_env.train.compare import atomic_write_text
 
     target = tmp_path / "deep" / "file.json"
     atomic_write_text(target, "{}\n")
@@ -290,7 +289,7 @@ def test_ctrl_c_then_resume_reproduces_the_uninterrupted_run(tmp_path: Path) -> 
     root = Path(__file__).resolve().parents[1]
 
     def command(out: Path, *extra: str) -> list[str]:
-        return [sys.executable, "-m", "train.compare", *args, "--out", str(out), *extra]
+        return [sys.executable, "-m", "bearing_env.train.compare", *args, "--out", str(out), *extra]
 
     interrupted = tmp_path / "interrupted"
     process = subprocess.Popen(

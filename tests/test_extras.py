@@ -3,7 +3,7 @@ that needs the ``render`` or ``train`` extra says which one to install, without 
 traceback, and ``compare`` runs the heuristics without stable-baselines3.
 
 A plain install is simulated by making the extras' modules unimportable
-(``sys.modules[name] = None``) in a fresh interpreter before ``train.cli.main`` runs.
+(``sys.modules[name] = None``) in a fresh interpreter before ``bearing_env.train.cli.main`` runs.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from pathlib import Path
 
 import gymnasium as gym
 import pytest
+from bearing_env.train.errors import EXIT_ERROR, exit_on_missing_extra
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.extras import (
@@ -26,7 +27,6 @@ from bearing_env.extras import (
     missing_extra,
     require,
 )
-from train.errors import EXIT_ERROR, exit_on_missing_extra
 
 ROOT = Path(__file__).resolve().parents[1]
 RENDER = 'pip install "bearing_env[render]"'
@@ -38,7 +38,7 @@ _PLAIN_CLI = """
 import sys
 for name in {blocked!r}:
     sys.modules[name] = None
-from train.cli import main
+from bearing_env.train.cli import main
 main({argv!r})
 """
 
@@ -128,7 +128,7 @@ def test_compare_quick_without_sb3_runs_the_heuristics_and_skips_the_shipped_mod
 def test_compare_quick_with_every_extra_includes_the_shipped_model(tmp_path: Path) -> None:
     """The counterpart of the test above: the skip happens only without SB3."""
     pytest.importorskip("stable_baselines3")
-    from train.compare import shipped_policies
+    from bearing_env.train.compare import shipped_policies
 
     assert shipped_policies("bearing_env:BearingSLAM-v0", {"scenario": "khepera"}) == [
         "pretrained:ppo_khepera"
@@ -151,7 +151,7 @@ def test_the_generalisation_script_without_the_train_extra_says_to_install_it(
         "import runpy, sys\n"
         f"for name in {list(PLAIN_INSTALL_LACKS)!r}:\n    sys.modules[name] = None\n"
         "sys.argv = ['generalisation.py', '--out', 'g']\n"
-        "runpy.run_module('train.generalisation', run_name='__main__')\n"
+        "runpy.run_module('bearing_env.train.generalisation', run_name='__main__')\n"
     )
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     result = subprocess.run(
@@ -184,7 +184,7 @@ def test_rendering_without_pygame_names_the_render_extra(monkeypatch: pytest.Mon
 def test_a_shipped_model_without_sb3_names_the_train_extra(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    from agents import SB3Policy
+    from bearing_env.agents import SB3Policy
 
     monkeypatch.setitem(sys.modules, "stable_baselines3", None)
     with gym.make("BearingSLAM-v0", scenario="khepera") as env:

@@ -12,10 +12,9 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-
-from train import compare
-from train.compare import LOG_NAME, CorruptLogError, EpisodeLog
-from train.errors import EXIT_ERROR, os_error_message, with_path
+from bearing_env.train import compare
+from bearing_env.train.compare import LOG_NAME, CorruptLogError, EpisodeLog
+from bearing_env.train.errors import EXIT_ERROR, os_error_message, with_path
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -28,7 +27,7 @@ COMPARE_ARGS = [
 def run_cli(*args: str, timeout: float = 300) -> subprocess.CompletedProcess[str]:
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
     return subprocess.run(
-        [sys.executable, "-m", "train.cli", *args],
+        [sys.executable, "-m", "bearing_env.train.cli", *args],
         capture_output=True, text=True, timeout=timeout, cwd=ROOT, env=env,
     )
 
@@ -217,7 +216,7 @@ def test_train_on_a_full_disk_names_the_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     pytest.importorskip("stable_baselines3")
-    from train import train as train_module
+    from bearing_env.train import train as train_module
 
     original = Path.write_text
 

@@ -7,9 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from train import cli
-from train.figures import (
+from bearing_env.train import cli
+from bearing_env.train.figures import (
     FIG7_MOVEMENTS,
     figure7,
     figure10,

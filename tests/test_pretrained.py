@@ -8,9 +8,9 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
+from bearing_env.agents import SB3Policy, pretrained_names, pretrained_record
 
 import bearing_env  # noqa: F401  (registers the ids)
-from agents import SB3Policy, pretrained_names, pretrained_record
 
 SHIPPED = ("ppo_khepera", "ppo_random")
 
@@ -40,7 +40,7 @@ def test_a_shipped_model_acts_on_the_env_of_its_record(name: str) -> None:
 
 def test_generalisation_table_covers_every_policy_and_count(tmp_path: Path) -> None:
     out = tmp_path / "generalisation"
-    command = [sys.executable, "-m", "train.generalisation", "--model", "ppo_random",
+    command = [sys.executable, "-m", "bearing_env.train.generalisation", "--model", "ppo_random",
                "--counts", "3", "--episodes", "1", "--workers", "1", "--out", str(out)]  # fmt: skip
     result = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
@@ -52,7 +52,7 @@ def test_generalisation_table_covers_every_policy_and_count(tmp_path: Path) -> N
 
 def test_generalisation_rejects_counts_beyond_the_observation_slots() -> None:
     result = subprocess.run(
-        [sys.executable, "-m", "train.generalisation", "--counts", "12"],
+        [sys.executable, "-m", "bearing_env.train.generalisation", "--counts", "12"],
         capture_output=True,
         text=True,
         timeout=120,

@@ -22,15 +22,14 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import bearing_env.train.train as train_module
 import gymnasium as gym
 import numpy as np
 import pytest
 import yaml
-
-import train.train as train_module
-from agents import SB3Policy
-from train.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
-from train.train import (
+from bearing_env.agents import SB3Policy
+from bearing_env.train.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
+from bearing_env.train.train import (
     EXIT_INTERRUPTED,
     MAX_EVAL_EPISODES,
     TRAINING_SEED_LIMIT,
@@ -242,7 +241,7 @@ def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path: Path) -> None:
     """The real command, SubprocVecEnv with spawn, Ctrl-C sent to the whole process group."""
     run = tmp_path / "interrupted"
     command = [
-        PYTHON, "-m", "train.cli", "train", "--algo", "ppo", "--output", str(run),
+        PYTHON, "-m", "bearing_env.train.cli", "train", "--algo", "ppo", "--output", str(run),
         "--vec-env", "subproc", "--n-envs", "2", "--timesteps", "1000000", "--seed", "5",
         "--hyperparams", "n_steps=16", "batch_size=32", "n_epochs=1", f"policy_kwargs={TINY_NET}",
         "--checkpoint-freq", "32", "--eval-freq", "0", "--no-progress", "--no-tensorboard",
@@ -421,12 +420,12 @@ def test_export_writes_the_pretrained_layout(
 def test_exported_models_load_by_name_and_join_the_comparison(
     tiny_runs: dict[str, TrainResult], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import agents.sb3
-    from agents import make_policy, pretrained_names
-    from train.compare import matching_pretrained
+    import bearing_env.agents.sb3
+    from bearing_env.agents import make_policy, pretrained_names
+    from bearing_env.train.compare import matching_pretrained
 
     folder = tmp_path / "pretrained"
-    monkeypatch.setattr(agents.sb3, "PRETRAINED_DIR", folder)
+    monkeypatch.setattr(bearing_env.agents.sb3, "PRETRAINED_DIR", folder)
     assert pretrained_names() == []
     export_run(tiny_runs["ppo"].run_dir, folder / "ppo_tiny")
     assert pretrained_names() == ["ppo_tiny"]
@@ -518,7 +517,7 @@ def test_hyperparameter_parsing_follows_rl_zoo3() -> None:
 
 
 def test_seed_ranges_are_disjoint_and_validation_episodes_repeat() -> None:
-    import train.compare as compare
+    import bearing_env.train.compare as compare
     assert TRAINING_SEED_LIMIT <= VALIDATION_SEED_START
     assert VALIDATION_SEED_START + MAX_EVAL_EPISODES <= compare.EVAL_SEED_START
     assert training_seed_start(7, 10**9, 8) + 8 <= TRAINING_SEED_LIMIT
@@ -601,6 +600,6 @@ def test_env_factory_raises_the_time_limit_with_max_moves() -> None:
 
 
 def test_train_is_a_bearing_env_subcommand() -> None:
-    from train.cli import SUBCOMMANDS
+    from bearing_env.train.cli import SUBCOMMANDS
 
-    assert SUBCOMMANDS["train"][0] == "train.train"
+    assert SUBCOMMANDS["train"][0] == "bearing_env.train.train"

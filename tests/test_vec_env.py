@@ -1,4 +1,5 @@
-"""``train.vec_env``: the SB3 adapter for Gymnasium vector envs, and ``--vec-env batched``.
+"""``bearing_env.train.vec_env``: the SB3 adapter for Gymnasium vector envs, and
+``--vec-env batched``.
 
 The adapter must be indistinguishable from a ``DummyVecEnv`` of the single envs that
 training used before (``EnvFactory``: ``SuccessInfo`` and ``Monitor``), so the reference is
@@ -14,16 +15,15 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import bearing_env.train.train as train_module
 import gymnasium as gym
 import numpy as np
 import pytest
+from bearing_env.train.train import EnvFactory, TrainSettings, resolve_vec_env_kind, train
+from bearing_env.train.vec_env import GymnasiumVecEnv, gym_make_kwargs, make_batched_vec_env
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 from stable_baselines3 import DQN, PPO
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, VecNormalize
-
-import train.train as train_module
-from train.train import EnvFactory, TrainSettings, resolve_vec_env_kind, train
-from train.vec_env import GymnasiumVecEnv, gym_make_kwargs, make_batched_vec_env
 
 ENV_IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
 ENDING_KWARGS: dict[str, Any] = {"scenario": "khepera", "target_area": 0.5, "max_moves": 10}

@@ -38,12 +38,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from bearing_env.train.errors import with_path
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
 from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
-
-from train.errors import with_path
 
 CHECKPOINT_PREFIX = "rl_model"
 _CHECKPOINT_MODEL_PATTERN = re.compile(rf"^{CHECKPOINT_PREFIX}_(\d+)_steps\.zip$")
@@ -301,7 +300,7 @@ class FixedSeedEvalCallback(EvalCallback):
     """``EvalCallback`` on fixed validation episodes, with area metrics and resumable history.
 
     The eval env's sub-envs must expose ``rewind_episode_seeds()`` (see
-    ``train.train.EpisodeSeedCycle``): it is called before every evaluation, so every
+    ``bearing_env.train.train.EpisodeSeedCycle``): it is called before every evaluation, so every
     evaluation plays the same episodes and the best model is chosen on a fixed set.
 
     Besides SB3's ``eval/mean_reward``, it logs ``eval/median_total_area_10`` (total area

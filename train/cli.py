@@ -22,15 +22,33 @@ import argparse
 import importlib
 import sys
 
-from train.errors import exit_on_missing_extra
+from bearing_env.train.errors import exit_on_missing_extra
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
-    "demo": ("train.demo", "random polygonal exploration in the Khepera scenario"),
-    "bench": ("benchmarks.bench_env", "env, vector env and PPO steps/s vs CartPole-v1"),
-    "bench-slam": ("benchmarks.bench_slam", "world-model update() throughput vs CartPole-v1"),
-    "train": ("train.train", "train PPO/SAC/DQN agents with stable-baselines3 (train/hyperparams)"),
-    "compare": ("train.compare", "compare exploration policies on fixed evaluation episodes"),
-    "figures": ("train.figures", "reproduce the paper's Figs. 7, 10 and 11 in simulation"),
+    "demo": (
+        "bearing_env.train.demo",
+        "random polygonal exploration in the Khepera scenario",
+    ),
+    "bench": (
+        "bearing_env.benchmarks.bench_env",
+        "env, vector env and PPO steps/s vs CartPole-v1",
+    ),
+    "bench-slam": (
+        "bearing_env.benchmarks.bench_slam",
+        "world-model update() throughput vs CartPole-v1",
+    ),
+    "train": (
+        "bearing_env.train.train",
+        "train PPO/SAC/DQN agents with stable-baselines3 (train/hyperparams)",
+    ),
+    "compare": (
+        "bearing_env.train.compare",
+        "compare exploration policies on fixed evaluation episodes",
+    ),
+    "figures": (
+        "bearing_env.train.figures",
+        "reproduce the paper's Figs. 7, 10 and 11 in simulation",
+    ),
 }
 
 

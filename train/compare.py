@@ -4,7 +4,7 @@ Every policy plays the same episodes: episode ``i`` resets the env with seed
 ``seed_start + i`` (default ``EVAL_SEED_START = 1_000_000``). Training code keeps its
 seeds below that (``TRAINING_SEED_LIMIT``), so evaluation episodes are never trained on.
 The policy's own randomness is seeded from the same episode seed through a separate
-stream (``agents.base.policy_rng``).
+stream (``bearing_env.agents.base.policy_rng``).
 
 Outputs (in ``--out``):
 
@@ -68,10 +68,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
-from numpy.typing import NDArray
-
-from bearing_env.extras import DISTRIBUTIONS, install_command
-from train.errors import (
+from bearing_env.train.errors import (
     MissingExtraError,
     available,
     fail,
@@ -79,6 +76,9 @@ from train.errors import (
     with_path,
     write_error_message,
 )
+from numpy.typing import NDArray
+
+from bearing_env.extras import DISTRIBUTIONS, install_command
 
 #: Evaluation episodes use seeds from here up; training seeds stay below it.
 EVAL_SEED_START = 1_000_000
@@ -113,7 +113,7 @@ def _json_normalised(value: Any) -> Any:
 class CompareConfig:
     """One comparison: which policies, which env, which episodes.
 
-    ``policies`` maps each report label to its policy spec string (``agents.registry``).
+    ``policies`` maps each report label to its policy spec string (``bearing_env.agents.registry``).
     """
 
     policies: dict[str, str]
@@ -143,7 +143,7 @@ class CompareConfig:
 
 def policies_from_specs(specs: Sequence[str]) -> dict[str, str]:
     """Report labels for policy spec strings (unique; duplicates get ``#2``, ``#3``...)."""
-    from agents.registry import parse_policy_spec
+    from bearing_env.agents.registry import parse_policy_spec
 
     labelled: dict[str, str] = {}
     for spec in specs:
@@ -263,7 +263,7 @@ class EpisodeTask:
 
 def run_task(task: EpisodeTask) -> dict[str, Any]:
     """Run one (policy, seed) episode in this process; the logged record."""
-    from agents.registry import make_policy
+    from bearing_env.agents.registry import make_policy
 
     env_key = f"{task.env_id}|{task.env_kwargs_json}"
     env = _ENVS.get(env_key)
@@ -542,7 +542,7 @@ def _fmt(value: float | None, digits: int = 3) -> str:
 
 
 def _display_label(label: str, config: CompareConfig) -> str:
-    from agents.registry import POLICY_CLASSES, parse_policy_spec
+    from bearing_env.agents.registry import POLICY_CLASSES, parse_policy_spec
 
     cls = POLICY_CLASSES[parse_policy_spec(config.policies[label]).kind]
     return f"{label} (privileged)" if getattr(cls, "privileged", False) else label
@@ -550,7 +550,7 @@ def _display_label(label: str, config: CompareConfig) -> str:
 
 def _reference_label(config: CompareConfig) -> str | None:
     """The random polygonal policy the others are compared with, if it was run."""
-    from agents.registry import parse_policy_spec
+    from bearing_env.agents.registry import parse_policy_spec
 
     for label, spec in config.policies.items():
         if parse_policy_spec(spec).kind == "random":
@@ -1192,7 +1192,7 @@ def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
 
     ``max_moves`` is ignored: it only sets how long an episode runs.
     """
-    from agents import pretrained_names, pretrained_record
+    from bearing_env.agents import pretrained_names, pretrained_record
 
     def plain(kwargs: dict[str, Any]) -> dict[str, Any]:
         # Through JSON, as the record was written: tuples and lists compare equal.
@@ -1281,7 +1281,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     try:
         config, out = config_from_args(args)
         # Fail fast on a bad env or policy spec, before any worker starts.
-        from agents.registry import make_policy
+        from bearing_env.agents.registry import make_policy
 
         with contextlib.closing(make_env(config.env_id, config.env_kwargs)) as env:
             for spec in config.policies.values():

@@ -42,11 +42,16 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from bearing_env.train.compare import (
+    EVAL_SEED_START,
+    atomic_save_figure,
+    atomic_write_text,
+    make_env,
+)
+from bearing_env.train.errors import fail
 from numpy.typing import NDArray
 
 from bearing_env.extras import MissingExtraError, available
-from train.compare import EVAL_SEED_START, atomic_save_figure, atomic_write_text, make_env
-from train.errors import fail
 
 FIG7_MOVEMENTS: tuple[int, ...] = (1, 3, 6, 9)
 FIG11_EPSILONS: tuple[float, ...] = (2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
@@ -82,7 +87,8 @@ def random_polygonal_trace(
     env_kwargs: dict[str, Any], seed: int, moves: int, keep_polygons: bool = False
 ) -> Trace:
     """Run the random polygonal policy for ``moves`` movements and record the map."""
-    from agents import RandomPolygonal
+    from bearing_env.agents import RandomPolygonal
+
     from bearing_env.envs.bearing_slam import BEARING_FEATURES, observation_slices
     from bearing_env.slam import world_to_fl
 

@@ -4,7 +4,7 @@ Runs ``bearing-env compare`` on random layouts (evaluation seeds, unseen in trai
 each landmark count, including counts the policy never saw, and prints one table of the
 median total area after 10 moves per policy and count.
 
-    python -m train.generalisation --model ppo_random --counts 3 4 6 8 10 --episodes 50
+    python -m bearing_env.train.generalisation --model ppo_random --counts 3 4 6 8 10 --episodes 50
 
 The total area is summed over the mapped landmarks (L3, L4, ...), so it grows with the
 count; compare policies within a column. ``--max-landmarks`` must equal the observation
@@ -20,8 +20,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+from bearing_env.train.errors import MissingExtraError, fail
+
 from bearing_env.extras import available
-from train.errors import MissingExtraError, fail
 
 DEFAULT_BASELINES = ("random", "parallax", "greedy")
 
@@ -42,7 +43,7 @@ def run_counts(
         command = [
             sys.executable,
             "-m",
-            "train.compare",
+            "bearing_env.train.compare",
             "--env-kwargs",
             "scenario=random",
             f"n_landmarks={count}",

@@ -21,7 +21,7 @@ instead), and ``--hyperparams k=v ...`` over the entry itself. Values are Python
 when they parse as one, strings otherwise.
 
 **Vectorisation** (``--vec-env``). ``batched`` runs the ``n_envs`` training envs as one
-Gymnasium vector env in this process, through ``train.vec_env``'s SB3 adapter: the id's
+Gymnasium vector env in this process, through ``bearing_env.train.vec_env``'s SB3 adapter: the id's
 natively batched ``vector_entry_point`` when it registers one (one batched
 computation steps every env), else a ``SyncVectorEnv`` of single envs. ``subproc`` runs
 one single env per worker process (spawn), ``dummy`` all of them in this process.
@@ -36,7 +36,7 @@ own random stream, where ``s = --seed`` for a new run and ``(seed + t) mod (9000
 n_envs)`` for a segment resumed at timestep ``t``: every training seed is below
 ``VALIDATION_SEED_START = 900000``. The periodic evaluation that picks the best model
 plays validation episode ``k`` with seed ``900000 + k`` (``k < --eval-episodes``), the
-same episodes at every evaluation. Both ranges lie below ``train.compare``'s test seeds
+same episodes at every evaluation. Both ranges lie below ``bearing_env.train.compare``'s test seeds
 (1000000 and up), so neither training nor model selection ever sees a test episode.
 
 **Run folder** (``--output``, default ``runs/<algo>_<env>_seed<seed>``)::
@@ -96,21 +96,7 @@ import gymnasium as gym
 import numpy as np
 import torch
 import yaml
-from stable_baselines3 import DQN, PPO, SAC
-from stable_baselines3.common.base_class import BaseAlgorithm
-from stable_baselines3.common.callbacks import BaseCallback
-from stable_baselines3.common.monitor import Monitor
-from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
-from stable_baselines3.common.vec_env import (
-    DummyVecEnv,
-    SubprocVecEnv,
-    VecEnv,
-    VecMonitor,
-    VecNormalize,
-)
-
-import bearing_env
-from train.callbacks import (
+from bearing_env.train.callbacks import (
     BEST_MODEL_NAME,
     BEST_SUMMARY_NAME,
     BEST_VECNORMALIZE_NAME,
@@ -127,14 +113,28 @@ from train.callbacks import (
     save_vecnormalize_atomically,
     write_json_atomically,
 )
-from train.errors import fail, write_error_message
-from train.vec_env import (
+from bearing_env.train.errors import fail, write_error_message
+from bearing_env.train.vec_env import (
     MONITOR_INFO_KEYWORDS,
     gym_make_kwargs,
     has_vector_entry_point,
     make_batched_vec_env,
     monitor_csv_path,
 )
+from stable_baselines3 import DQN, PPO, SAC
+from stable_baselines3.common.base_class import BaseAlgorithm
+from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.monitor import Monitor
+from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
+from stable_baselines3.common.vec_env import (
+    DummyVecEnv,
+    SubprocVecEnv,
+    VecEnv,
+    VecMonitor,
+    VecNormalize,
+)
+
+import bearing_env
 
 ALGORITHMS: dict[str, type[BaseAlgorithm]] = {"ppo": PPO, "sac": SAC, "dqn": DQN}
 DEFAULT_ENV_IDS: dict[str, str] = {
@@ -148,7 +148,7 @@ HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
 #: VALIDATION_SEED_START + k; training seeds stay below it.
 VALIDATION_SEED_START = 900_000
 TRAINING_SEED_LIMIT = VALIDATION_SEED_START
-#: Validation seeds stay below this (``train.compare``'s test episodes start here).
+#: Validation seeds stay below this (``bearing_env.train.compare``'s test episodes start here).
 TEST_SEED_START = 1_000_000
 MAX_EVAL_EPISODES = TEST_SEED_START - VALIDATION_SEED_START
 
@@ -166,7 +166,7 @@ RUN_FORMAT_VERSION = 1
 EXIT_INTERRUPTED = 130
 
 #: How the training envs run: ``batched`` is one Gymnasium vector env (the id's natively
-#: batched ``vector_entry_point``, else a ``SyncVectorEnv``) behind ``train.vec_env``'s
+#: batched ``vector_entry_point``, else a ``SyncVectorEnv``) behind ``bearing_env.train.vec_env``'s
 #: adapter; ``subproc`` one process per env (spawn); ``dummy`` all envs in this process.
 VEC_ENV_KINDS: tuple[str, ...] = ("batched", "subproc", "dummy")
 #: ``--vec-env`` also takes ``auto``: ``batched`` when the env id registers a batched
