@@ -143,12 +143,16 @@ class NoiseModel:
             epsilon / 2 (so ~95% of readings fall within +-epsilon).
         outlier_rate: probability, per landmark per reading, that the bearing is replaced
             by a uniformly random angle (a mis-identified blob in the panoramic image).
+        detection_rate: probability, per landmark per reading, that the landmark is seen
+            at all; a missed landmark's bearing is NaN (occlusion, a missed detection),
+            which the SLAM skips for that movement.
     """
 
     kind: str = "uniform"
     bound_deg: float | None = None
     sigma_deg: float | None = None
     outlier_rate: float = 0.0
+    detection_rate: float = 1.0
 
     def __post_init__(self) -> None:
         if self.kind not in NOISE_KINDS:
@@ -170,6 +174,12 @@ class NoiseModel:
         if not 0.0 <= float(rate) <= 1.0:
             raise ValueError(f"noise outlier_rate must be in [0, 1], got {rate!r}")
         object.__setattr__(self, "outlier_rate", float(rate))
+        rate = self.detection_rate
+        if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)):
+            raise TypeError(f"noise detection_rate must be a number, got {rate!r}")
+        if not 0.0 < float(rate) <= 1.0:
+            raise ValueError(f"noise detection_rate must be in (0, 1], got {rate!r}")
+        object.__setattr__(self, "detection_rate", float(rate))
 
     @classmethod
     def parse(cls, spec: NoiseModel | Mapping[str, Any] | str | None) -> NoiseModel:
@@ -183,7 +193,13 @@ class NoiseModel:
         if isinstance(spec, str):
             return cls(kind=spec)
         if isinstance(spec, Mapping):
-            unknown = set(spec) - {"kind", "bound_deg", "sigma_deg", "outlier_rate"}
+            unknown = set(spec) - {
+                "kind",
+                "bound_deg",
+                "sigma_deg",
+                "outlier_rate",
+                "detection_rate",
+            }
             if unknown:
                 raise TypeError(f"unknown noise fields {sorted(unknown)!r} in {dict(spec)!r}")
             return cls(**spec)
@@ -217,14 +233,17 @@ class NoiseModel:
         """The random draws of one reading of ``size`` bearings per robot (row ``i`` from
         ``rngs[i]``); :func:`apply_noise` turns true bearings into the reading.
 
-        Each robot draws its noise, then (with outliers) both outlier arrays in full, so
-        the stream of draws does not depend on which landmarks turn out to be outliers.
+        Each robot draws its noise, then (with outliers) both outlier arrays in full, then
+        (with missed detections) which landmarks it misses, so the stream of draws does
+        not depend on which landmarks turn out to be outliers or missed. A missed bearing
+        is an outlier whose replacement is NaN.
         """
         rows = len(rngs)
         offsets = np.zeros((rows, size))
         outliers = self.outlier_rate > 0.0
-        is_outlier = np.zeros((rows, size), dtype=bool) if outliers else None
-        replacement = np.zeros((rows, size)) if outliers else None
+        misses = self.detection_rate < 1.0
+        is_outlier = np.zeros((rows, size), dtype=bool) if outliers or misses else None
+        replacement = np.zeros((rows, size)) if outliers or misses else None
         bound = epsilon if self.bound_deg is None else math.radians(self.bound_deg)
         sigma = 0.5 * epsilon if self.sigma_deg is None else math.radians(self.sigma_deg)
         for row, rng in enumerate(rngs):
@@ -232,9 +251,13 @@ class NoiseModel:
                 offsets[row] = rng.uniform(-bound, bound, size)
             elif self.kind == "gaussian":
                 offsets[row] = rng.normal(0.0, sigma, size)
-            if is_outlier is not None and replacement is not None:
+            if outliers and is_outlier is not None and replacement is not None:
                 is_outlier[row] = rng.random(size) < self.outlier_rate
                 replacement[row] = rng.uniform(-np.pi, np.pi, size)
+            if misses and is_outlier is not None and replacement is not None:
+                missed = rng.random(size) >= self.detection_rate
+                is_outlier[row] |= missed
+                replacement[row, missed] = np.nan
         return NoiseDraws(offsets, is_outlier, replacement)
 
 
@@ -246,7 +269,7 @@ class NoiseModel:
         Without outliers a robot's two readings take one call of its generator (the
         stream is the same as two calls: both distributions draw element by element).
         """
-        if self.outlier_rate > 0.0 or self.kind == "none":
+        if self.outlier_rate > 0.0 or self.detection_rate < 1.0 or self.kind == "none":
             return self.draw_rows(rngs, size, epsilon), self.draw_rows(rngs, size, epsilon)
         both = self.draw_rows(rngs, 2 * size, epsilon).offsets
         return NoiseDraws(both[:, :size], None, None), NoiseDraws(both[:, size:], None, None)

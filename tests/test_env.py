@@ -43,6 +43,7 @@ INFO_KEYS = {
     "robot_error",
     "frame_changed",
     "inconsistent",
+    "outliers",
     "path_length",
     "rewards",
 }

@@ -85,8 +85,20 @@ def test_make_vec_returns_the_batched_env_with_the_spec_time_limit(env_id: str) 
         {"n_landmarks": 6, "transfer": "paper"},
         {"n_landmarks": 5, "noise": {"kind": "uniform", "bound_deg": 4.0}, "max_moves": 7},
         {"scenario": "khepera", "noise": {"kind": "gaussian", "outlier_rate": 0.2}},
+        {
+            "n_landmarks": 6,
+            "noise": {"kind": "uniform", "outlier_rate": 0.1, "detection_rate": 0.9},
+            "fusion": "relaxed",
+            "max_outliers": 3,
+        },
     ],
-    ids=["khepera", "random-paper", "random-outside-epsilon", "gaussian-outliers"],
+    ids=[
+        "khepera",
+        "random-paper",
+        "random-outside-epsilon",
+        "gaussian-outliers",
+        "relaxed-outliers",
+    ],
 )
 def test_reproduces_sync_vector_env_exactly(
     env_id: str, mode: AutoresetMode, kwargs: dict[str, Any]

@@ -86,3 +86,28 @@ def test_bearing_env_dispatches_figures(tmp_path: Path) -> None:
     assert_png(tmp_path / "fig11_epsilon.png")
     summary = json.loads((tmp_path / "figures.json").read_text())
     assert set(summary) == {"fig11"} and "r_squared" in summary["fig11"]["linear_fit"]
+
+
+def test_robustness_figure_compares_the_fusions_on_the_same_seeds(tmp_path: Path) -> None:
+    from bearing_env.train.figures import (
+        ROBUST_FUSIONS,
+        ROBUST_NOISE_FACTORS,
+        ROBUST_OUTLIER_RATES,
+        figure_robustness,
+    )
+
+    path, data = figure_robustness(tmp_path, [1_000_000, 1_000_001], moves=8)
+    assert_png(path)
+    for sweep, values in (
+        ("outlier_rate", ROBUST_OUTLIER_RATES),
+        ("noise_factor", ROBUST_NOISE_FACTORS),
+    ):
+        assert data[sweep]["values"] == list(values)
+        for label in ROBUST_FUSIONS:
+            points = data[sweep][label]
+            assert len(points) == len(values)
+            assert all(0.0 <= p["containment"] <= 1.0 for p in points)
+    # Without outliers and within epsilon, every fusion is the strict intersection.
+    clean = [data["outlier_rate"][label][0] for label in ROBUST_FUSIONS]
+    assert all(p == clean[0] for p in clean)
+    assert clean[0]["containment"] == 1.0

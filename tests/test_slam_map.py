@@ -144,7 +144,6 @@ def test_constructor_accepts_the_documented_choices():
 @pytest.mark.parametrize(
     "bad",
     [
-        [0.1, float("nan"), 0.3, 0.4],
         [0.1, 0.2, float("inf"), 0.4],
         [-float("inf"), 0.2, 0.3, 0.4],
         [0.1, 0.2, 0.3],  # too short
@@ -736,12 +735,17 @@ def test_an_update_without_the_robot_maps_the_same_landmarks_and_keeps_the_old_r
     assert full.robot_counts[0] > 0 and lean.robot_counts[0] == 0
 
 
-@pytest.mark.parametrize("transfer", ["conservative", "paper"])
-def test_the_threaded_kernel_gives_the_serial_kernels_maps_bit_for_bit(transfer):
+@pytest.mark.parametrize(
+    ("transfer", "fusion"),
+    [("conservative", "intersect"), ("paper", "intersect"), ("conservative", "relaxed")],
+)
+def test_the_threaded_kernel_gives_the_serial_kernels_maps_bit_for_bit(transfer, fusion):
     episodes = [random_episode(np.random.default_rng(40 + i), 5, 8) for i in range(16)]
-    readings = [episode.readings(EPS) for episode in episodes]
-    serial = BatchedPolygonSLAM(16, 5, EPS, transfer=transfer)
-    threaded = BatchedPolygonSLAM(16, 5, EPS, transfer=transfer)
+    # Noise beyond epsilon, so that the relaxed fusion has regions to leave out.
+    readings = [episode.readings(2.5 * EPS) for episode in episodes]
+    settings = {"transfer": transfer, "fusion": fusion, "window": 4}
+    serial = BatchedPolygonSLAM(16, 5, EPS, **settings)
+    threaded = BatchedPolygonSLAM(16, 5, EPS, **settings)
     rows = np.arange(16)
     for move in range(8):
         b1 = np.array([r[move][0] for r in readings])
@@ -753,7 +757,8 @@ def test_the_threaded_kernel_gives_the_serial_kernels_maps_bit_for_bit(transfer)
             bad = np.empty(16, dtype=np.int64)
             arguments = (
                 b1, b2, rows, EPS, transfer == "conservative", 3, False, True,
-                *(getattr(batch, name) for name in STATE_ARRAYS), frame, landmark, bad,
+                batch.max_outliers, *(getattr(batch, name) for name in STATE_ARRAYS),
+                frame, landmark, bad,
             )
             if threads:
                 kernels.update_maps_parallel(threads, *arguments)  # 4 blocks, any cores
@@ -765,3 +770,5 @@ def test_the_threaded_kernel_gives_the_serial_kernels_maps_bit_for_bit(transfer)
     for name in STATE_ARRAYS:
         np.testing.assert_array_equal(getattr(serial, name), getattr(threaded, name), name)
     assert serial.n_frame_changes.sum() > 16  # real fusions were compared
+    if fusion == "relaxed":
+        assert serial.outliers.sum() > 0  # and regions were left out

@@ -38,6 +38,7 @@ from bearing_env.envs.core import (
 )
 from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
 from bearing_env.slam import PolygonSLAM
+from bearing_env.slam.batch import DEFAULT_MAX_OUTLIERS
 from bearing_env.world import Arena, NoiseModel
 
 __all__ = [
@@ -188,8 +189,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     | 12 + 5j | L(j+3) estimate y in FL | -50 | 50 |
     | 13 + 5j | log-area of L(j+3)'s region (`log(area_cap)` if not initialised) | log(1e-10) | * |
     | B + 3k | bearing slot k (landmark L(k+1)): 1 if the landmark exists | 0 | 1 |
-    | B + 3k + 1 | cos of the latest bearing of L(k+1) | -1 | 1 |
-    | B + 3k + 2 | sin of the latest bearing of L(k+1) | -1 | 1 |
+    | B + 3k + 1 | cos of the latest bearing of L(k+1) (0 if that reading missed it) | -1 | 1 |
+    | B + 3k + 2 | sin of the latest bearing of L(k+1) (0 if that reading missed it) | -1 | 1 |
 
     with `j = 0 .. M-3`, `k = 0 .. M-1`, `B = 9 + 5 * (M - 2)` and `*` = `max(log(area_cap),
     0)` (0 keeps the all-zero padding inside the space when `area_cap < 1`). The latest bearings
@@ -232,7 +233,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     position; inf if not initialised), `landmark_contains_truth` (bool), `total_area`
     (sum of `landmark_area`), `robot_error` (robot region centroid to the robot's true FL
     position; inf before the first frame change), `frame_changed` (bool), `inconsistent`
-    (empty intersections this step), `path_length` (metres moved this step), and
+    (empty intersections this step; with `fusion="relaxed"`, this movement's regions
+    that were left out), `outliers` (per landmark, the regions its region leaves out so
+    far; always 0 with `"intersect"`), `path_length` (metres moved this step), and
     `rewards` (the named reward parts).
 
     ## Arguments
@@ -254,7 +257,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     - `epsilon_deg`: the SLAM's bearing error bound in degrees, in (0, 45); default 2.
     - `noise`: the true sensor noise: a `NoiseModel`, a mapping of its fields
       (`kind` = `"uniform"` | `"gaussian"` | `"none"`, `bound_deg`, `sigma_deg`,
-      `outlier_rate`) or a kind name; default uniform within +-epsilon.
+      `outlier_rate`, `detection_rate`: a missed landmark's bearing is NaN, and the map
+      skips it for that movement) or a kind name; default uniform within +-epsilon.
     - `transfer`: `"conservative"` (default; regions contain the truth whenever the noise
       is within +-epsilon) or `"paper"` (the paper's vertex hull).
     - `reward`: `"log_area"` (default) or `"area"`.
@@ -266,6 +270,16 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     - `area_cap`: the area counted for an uninitialised landmark, in `(1e-10, 1e6]`;
       default 10.
     - `max_landmarks`: observation slots (at most 1024); default `max(8, n_landmarks)`.
+    - `fusion`: how a landmark's regions are combined over movements: `"intersect"`
+      (default; the paper's intersection) or `"relaxed"` (the q-relaxed intersection
+      over a window of the last 8 movements: it leaves out up to `max_outliers` regions
+      per landmark, and whole movements that are outliers for most landmarks, as a
+      misread L1 or L2 makes them; see `bearing_env.slam.PolygonSLAM`).
+    - `max_outliers`: with `"relaxed"`, the most regions per landmark left out, 0..7;
+      default 2.
+    - `on_inconsistency`: `"restart"` (default: a landmark whose regions contradict
+      each other restarts from the newest one) or `"keep"` (it keeps its old region).
+      With `"relaxed"`, this applies beyond `max_outliers`.
     - `render_mode`: `None`, `"human"` or `"rgb_array"`.
     - `config`: an `EnvConfig` (`bearing_env.envs.config`) holding all the settings
       above but `render_mode`, instead of the keywords (`EnvConfig.create(...)` takes
@@ -275,7 +289,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     Every setting is also an attribute (`env.area_cap`, `env.path_cost`, ...; `reward`
     is `env.reward_kind`); assigning one replaces `env.config` with a validated copy.
     `max_landmarks` is read-only (it fixes the observation space). A change of
-    `epsilon_deg` or `transfer` gives the env a new, empty map.
+    `epsilon_deg`, `transfer`, `fusion`, `max_outliers` or `on_inconsistency` gives the
+    env a new, empty map.
 
     ## Version History
 
@@ -299,6 +314,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     move_cost: Setting[float] = Setting("move_cost")
     area_cap: Setting[float] = Setting("area_cap")
     max_landmarks: Setting[int] = Setting("max_landmarks", read_only=FIXES_THE_SPACES)
+    fusion: Setting[str] = Setting("fusion")
+    max_outliers: Setting[int] = Setting("max_outliers")
+    on_inconsistency: Setting[str] = Setting("on_inconsistency")
 
     def __init__(
         self,
@@ -317,6 +335,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         move_cost: float = 0.0,
         area_cap: float = DEFAULT_AREA_CAP,
         max_landmarks: int | None = None,
+        fusion: str = "intersect",
+        max_outliers: int = DEFAULT_MAX_OUTLIERS,
+        on_inconsistency: str = "restart",
         render_mode: str | None = None,
         config: EnvConfig | None = None,
     ) -> None:
@@ -337,6 +358,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             "move_cost": move_cost,
             "area_cap": area_cap,
             "max_landmarks": max_landmarks,
+            "fusion": fusion,
+            "max_outliers": max_outliers,
+            "on_inconsistency": on_inconsistency,
         }
         self._setup(settings_from(config, settings, _CONTINUOUS_DEFAULTS), render_mode)
 

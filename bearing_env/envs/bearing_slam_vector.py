@@ -30,6 +30,7 @@ LANDMARK_INFO_PADDING: dict[str, Any] = {
     "landmark_area": np.inf,
     "landmark_error": np.inf,
     "landmark_contains_truth": False,
+    "outliers": 0,
 }
 
 IntArray = NDArray[np.int64]
@@ -80,9 +81,9 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
       `gym.make` adds (`gym.make_vec` passes the registered 20); None for no limit.
     - `render_mode`: None or `"rgb_array"` (`render()` returns a tuple of frames).
     - `n_landmarks=(lo, hi)` works too. The per-landmark info arrays (`landmark_area`,
-      `landmark_error`, `landmark_contains_truth`) are then padded to `max_landmarks - 2`
-      entries (with inf, inf and False) so they batch; Gymnasium's own vector envs cannot
-      batch them at all.
+      `landmark_error`, `landmark_contains_truth`, `outliers`) are then padded to
+      `max_landmarks - 2` entries (with inf, inf, False and 0) so they batch; Gymnasium's
+      own vector envs cannot batch them at all.
     - `config`: an `EnvConfig`, or every other keyword: as for the single environment
       (`scenario`, `n_landmarks`, `epsilon_deg`, ...), validated by it.
 

@@ -27,7 +27,8 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from bearing_env.slam import TRANSFERS
+from bearing_env.slam import FUSIONS, INCONSISTENCY_POLICIES, TRANSFERS
+from bearing_env.slam.batch import DEFAULT_MAX_OUTLIERS, DEFAULT_WINDOW
 from bearing_env.world import SCENARIOS, Arena, NoiseModel
 
 #: Default episode length in moves; also the registered ``max_episode_steps``.
@@ -107,6 +108,10 @@ def choice(value: Any, choices: Sequence[str], name: str) -> str:
     return value
 
 
+#: ``EnvConfig.map_settings``: the world model's keyword settings as a hashable tuple.
+MapSettings = tuple[tuple[str, Any], ...]
+
+
 def _is_pair_like(value: Any) -> bool:
     return not isinstance(value, (str, bytes)) and isinstance(value, (Sequence, np.ndarray))
 
@@ -138,6 +143,9 @@ class EnvConfig:
     max_landmarks: int
     n_turns: int = DEFAULT_N_TURNS
     n_move_lengths: int = DEFAULT_N_MOVE_LENGTHS
+    fusion: str = "intersect"
+    max_outliers: int = DEFAULT_MAX_OUTLIERS
+    on_inconsistency: str = "restart"
 
     # ------------------------------------------------------------------------------------
     # Construction
@@ -163,6 +171,9 @@ class EnvConfig:
         max_landmarks: int | None = None,
         n_turns: int = DEFAULT_N_TURNS,
         n_move_lengths: int | None = None,
+        fusion: str = "intersect",
+        max_outliers: int = DEFAULT_MAX_OUTLIERS,
+        on_inconsistency: str = "restart",
     ) -> EnvConfig:
         """A validated config from the envs' keyword arguments, with the scenario's
         defaults for what is left out."""
@@ -199,6 +210,9 @@ class EnvConfig:
             max_landmarks=max_landmarks,
             n_turns=n_turns,
             n_move_lengths=n_move_lengths,
+            fusion=fusion,
+            max_outliers=max_outliers,
+            on_inconsistency=on_inconsistency,
         )
 
     def __post_init__(self) -> None:
@@ -252,6 +266,10 @@ class EnvConfig:
         normalise("max_landmarks", int_at_most(max_landmarks, MAX_N_LANDMARKS, "max_landmarks"))
         normalise("n_turns", int_at_least(self.n_turns, 1, "n_turns"))
         normalise("n_move_lengths", int_at_least(self.n_move_lengths, 1, "n_move_lengths"))
+        choice(self.fusion, FUSIONS, "fusion")
+        max_outliers = int_at_least(self.max_outliers, 0, "max_outliers")
+        normalise("max_outliers", int_at_most(max_outliers, DEFAULT_WINDOW - 1, "max_outliers"))
+        choice(self.on_inconsistency, INCONSISTENCY_POLICIES, "on_inconsistency")
 
     def replace(self, **changes: Any) -> EnvConfig:
         """A copy with some fields changed (validated)."""
@@ -268,6 +286,18 @@ class EnvConfig:
     def epsilon(self) -> float:
         """The SLAM's bearing error bound, radians."""
         return math.radians(self.epsilon_deg)
+
+    @property
+    def map_settings(self) -> MapSettings:
+        """The world model's settings (``BatchedPolygonSLAM`` keywords), as a hashable
+        key: envs whose maps share them can share a batch."""
+        return (
+            ("epsilon", self.epsilon),
+            ("transfer", self.transfer),
+            ("fusion", self.fusion),
+            ("max_outliers", self.max_outliers),
+            ("on_inconsistency", self.on_inconsistency),
+        )
 
     @property
     def fixed_landmarks(self) -> NDArray[np.float64] | None:

@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env.envs import kernels
-from bearing_env.envs.config import AREA_FLOOR, EnvConfig
+from bearing_env.envs.config import AREA_FLOOR, EnvConfig, MapSettings
 from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import CONTAINMENT_TOLERANCE, BatchedPolygonSLAM
@@ -184,27 +184,26 @@ class MapBank:
 
     def __init__(self, num_rows: int) -> None:
         self.num_rows = num_rows
-        self.batches: dict[tuple[int, float, str], BatchedPolygonSLAM] = {}
-        self._views: dict[tuple[int, float, str, int], PolygonSLAM] = {}
+        self.batches: dict[tuple[int, MapSettings], BatchedPolygonSLAM] = {}
+        self._views: dict[tuple[int, MapSettings, int], PolygonSLAM] = {}
 
     def batch(self, n_landmarks: int, config: EnvConfig) -> BatchedPolygonSLAM:
         last = self.__dict__.get("_last")
         if last is not None and last[0] is config and last[1] == n_landmarks:
             return last[2]  # the common case: asked again for the same group's batch
-        key = (int(n_landmarks), config.epsilon, config.transfer)
-        self._last = (config, n_landmarks, self._batch_for(key, config))
+        key = (int(n_landmarks), config.map_settings)
+        self._last = (config, n_landmarks, self._batch_for(key))
         return self._last[2]
 
-    def _batch_for(self, key: tuple[int, float, str], config: EnvConfig) -> BatchedPolygonSLAM:
+    def _batch_for(self, key: tuple[int, MapSettings]) -> BatchedPolygonSLAM:
         if key not in self.batches:
-            self.batches[key] = BatchedPolygonSLAM(
-                self.num_rows, key[0], config.epsilon, transfer=config.transfer
-            )
+            n_landmarks, settings = key
+            self.batches[key] = BatchedPolygonSLAM(self.num_rows, n_landmarks, **dict(settings))
         return self.batches[key]
 
     def view(self, n_landmarks: int, config: EnvConfig, row: int) -> PolygonSLAM:
         """Row ``row``'s map as a :class:`PolygonSLAM` (the same object every time)."""
-        key = (int(n_landmarks), config.epsilon, config.transfer, int(row))
+        key = (int(n_landmarks), config.map_settings, int(row))
         if key not in self._views:
             self._views[key] = PolygonSLAM.view(self.batch(n_landmarks, config), row)
         return self._views[key]
@@ -235,8 +234,9 @@ def switch_maps(
     state: BatchState, maps: MapBank, row: int, old: EnvConfig, new: EnvConfig
 ) -> None:
     """After a config change of row ``row``: an empty map if the map's settings (epsilon,
-    transfer) changed, since the row may have stale state in that other map batch."""
-    if (new.epsilon, new.transfer) != (old.epsilon, old.transfer):
+    transfer, fusion, ...) changed, since the row may have stale state in that other map
+    batch."""
+    if new.map_settings != old.map_settings:
         maps.batch(int(state.n_landmarks[row]), new).reset([row])
 
 
@@ -629,6 +629,7 @@ def infos(
         "robot_error": robot_error,
         "frame_changed": outcome.frame_changed,
         "inconsistent": outcome.inconsistent,
+        "outliers": batch.outliers[rows],
         "path_length": outcome.travelled,
         "rewards": {
             "uncertainty": outcome.uncertainty,

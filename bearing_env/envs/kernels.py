@@ -259,8 +259,9 @@ def write_observations(
         for k in range(n):
             at = bearings_at + _BEARING_FEATURES * k
             out[i, at] = 1.0
-            out[i, at + 1] = math.cos(latest_bearings[row, k])
-            out[i, at + 2] = math.sin(latest_bearings[row, k])
+            if not math.isnan(latest_bearings[row, k]):  # a missed reading reads (0, 0)
+                out[i, at + 1] = math.cos(latest_bearings[row, k])
+                out[i, at + 2] = math.sin(latest_bearings[row, k])
 
 
 @njit(**_JIT)

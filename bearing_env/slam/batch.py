@@ -40,6 +40,9 @@ FRAME_STATUSES: tuple[str, ...] = tuple(
             kernels.FRAME_L2_UNBOUNDED: "l2_unbounded",
             kernels.FRAME_L1_L2_OVERLAP: "l1_l2_overlap",
             kernels.FRAME_L1_L2_TOO_CLOSE: "l1_l2_too_close",
+            kernels.FRAME_L1_MISSING: "l1_missing",
+            kernels.FRAME_L2_MISSING: "l2_missing",
+            kernels.FRAME_REJECTED: "rejected",
         }.items()
     )
 )
@@ -54,12 +57,22 @@ LANDMARK_STATUSES: tuple[str, ...] = tuple(
             kernels.LANDMARK_UNBOUNDED: "unbounded",
             kernels.LANDMARK_INCONSISTENT: "inconsistent",
             kernels.LANDMARK_SKIPPED: "skipped",
+            kernels.LANDMARK_MISSING: "missing",
         }.items()
     )
 )
 LANDMARK_CODE = {name: code for code, name in enumerate(LANDMARK_STATUSES)}
 
 INCONSISTENCY_POLICIES = ("restart", "keep")
+
+#: How a landmark's regions from successive movements are combined: ``"intersect"``, the
+#: paper's intersection, or ``"relaxed"``, the q-relaxed intersection over a window.
+FUSIONS = ("intersect", "relaxed")
+
+#: The relaxed fusion's defaults: movements kept per map, and the most regions per
+#: landmark it may leave out of the window.
+DEFAULT_WINDOW = 8
+DEFAULT_MAX_OUTLIERS = 2
 
 #: Batches of at least this many maps are updated on all of numba's threads
 #: (``NUMBA_NUM_THREADS``; see :func:`bearing_env.slam.kernels.threads`).
@@ -105,6 +118,9 @@ class BatchedPolygonSLAM:
         transfer: str = "conservative",
         edge_samples: int = 3,
         on_inconsistency: str = "restart",
+        fusion: str = "intersect",
+        max_outliers: int = DEFAULT_MAX_OUTLIERS,
+        window: int = DEFAULT_WINDOW,
     ) -> None:
         self.num_maps = _int_at_least(num_maps, 1, "num_maps")
         self.n_landmarks = _int_at_least(n_landmarks, 3, "n_landmarks", "(L1, L2 and one more)")
@@ -128,6 +144,17 @@ class BatchedPolygonSLAM:
                 f"edge_samples must be <= {kernels.MAX_EDGE_SAMPLES}, got {edge_samples!r}"
             )
         self.on_inconsistency = on_inconsistency
+        if fusion not in FUSIONS:
+            raise ValueError(f"fusion must be one of {FUSIONS}, got {fusion!r}")
+        self.fusion = fusion
+        self.window = _int_at_least(window, 1, "window")
+        if self.window > kernels.MAX_WINDOW:
+            raise ValueError(f"window must be <= {kernels.MAX_WINDOW}, got {window!r}")
+        self.max_outliers = _int_at_least(max_outliers, 0, "max_outliers")
+        if self.max_outliers >= self.window:
+            raise ValueError(
+                f"max_outliers must be < window ({self.window}), got {max_outliers!r}"
+            )
         n, m, cap = self.num_maps, self.n_landmarks - 2, kernels.CAPACITY
         self.vertices = np.zeros((n, m, cap), dtype=np.complex128)
         self.counts = np.zeros((n, m), dtype=np.int64)
@@ -141,7 +168,34 @@ class BatchedPolygonSLAM:
         self.n_updates = np.empty(n, dtype=np.int64)
         self.n_frame_changes = np.empty(n, dtype=np.int64)
         self.n_inconsistent = np.empty(n, dtype=np.int64)
+        # The relaxed fusion's window and bases (empty window axis for "intersect").
+        w = self.window if fusion == "relaxed" else 0
+        self.window_vertices = np.zeros((n, w, m, cap), dtype=np.complex128)
+        self.window_counts = np.zeros((n, w, m), dtype=np.int64)
+        self.window_inlier = np.zeros((n, w, m), dtype=bool)
+        self.window_rejected = np.zeros((n, w), dtype=bool)
+        self.window_length = np.zeros(n, dtype=np.int64)
+        self.window_next = np.zeros(n, dtype=np.int64)
+        self.base_vertices = np.zeros((n, m, cap if w else 0), dtype=np.complex128)
+        self.base_counts = np.zeros((n, m), dtype=np.int64)
+        self.relaxation = np.zeros((n, m), dtype=np.int64)
+        self.n_dropped = np.zeros((n, m), dtype=np.int64)
+        self.outliers = np.zeros((n, m), dtype=np.int64)
         self.reset()
+
+    def empty_like(self, num_maps: int) -> BatchedPolygonSLAM:
+        """A new batch of ``num_maps`` empty maps with this batch's settings."""
+        return BatchedPolygonSLAM(
+            num_maps,
+            self.n_landmarks,
+            self.epsilon,
+            transfer=self.transfer,
+            edge_samples=self.edge_samples,
+            on_inconsistency=self.on_inconsistency,
+            fusion=self.fusion,
+            max_outliers=self.max_outliers,
+            window=self.window,
+        )
 
     @property
     def initialised(self) -> NDArray[np.bool_]:
@@ -166,6 +220,13 @@ class BatchedPolygonSLAM:
         self.n_updates[rows] = 0
         self.n_frame_changes[rows] = 0
         self.n_inconsistent[rows] = 0
+        self.window_counts[rows] = 0
+        self.window_length[rows] = 0
+        self.window_next[rows] = 0
+        self.base_counts[rows] = 0
+        self.relaxation[rows] = 0
+        self.n_dropped[rows] = 0
+        self.outliers[rows] = 0
 
     def update(
         self,
@@ -213,6 +274,7 @@ class BatchedPolygonSLAM:
             self.edge_samples,
             self.on_inconsistency == "keep",
             bool(robot),
+            self.max_outliers,
             *self._state_arrays(),
             frame,
             landmark,
@@ -303,6 +365,17 @@ STATE_ARRAYS = (
     "n_updates",
     "n_frame_changes",
     "n_inconsistent",
+    "window_vertices",
+    "window_counts",
+    "window_inlier",
+    "window_rejected",
+    "window_length",
+    "window_next",
+    "base_vertices",
+    "base_counts",
+    "relaxation",
+    "n_dropped",
+    "outliers",
 )
 
 
@@ -313,7 +386,7 @@ def check_bearings(bearings: ArrayLike, shape: tuple[int, ...], name: str) -> Fl
         and bearings.dtype == np.float64
         and bearings.shape == shape
         and bearings.flags.c_contiguous
-        and kernels.all_finite(bearings)
+        and kernels.none_infinite(bearings)
     ):
         return bearings  # the common case, checked without temporaries
     raw = np.asarray(bearings)
@@ -322,8 +395,10 @@ def check_bearings(bearings: ArrayLike, shape: tuple[int, ...], name: str) -> Fl
     arr = raw.astype(np.float64, copy=False)
     if arr.shape != shape:
         raise ValueError(f"{name} must have shape {shape}, got {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
+    if np.any(np.isinf(arr)):
+        raise ValueError(
+            f"{name} must be finite or NaN (a missed reading), got {arr.tolist()}"
+        )
     return np.ascontiguousarray(arr)
 
 

@@ -25,6 +25,7 @@ __all__ = [
     "convex_hull",
     "intersect",
     "offset_outward",
+    "relaxed_intersection",
     "wrap_angle",
 ]
 
@@ -77,6 +78,43 @@ def area_centroid(p: ArrayLike) -> tuple[float, complex]:
     a = _polygon(p)
     area, centroid = kernels.area_centroid(a, a.size)
     return float(area), complex(centroid)
+
+
+def relaxed_intersection(
+    polygons: list[ArrayLike], max_outliers: int
+) -> tuple[ComplexArray, int, NDArray[np.bool_]]:
+    """The convex hull of the q-relaxed intersection of convex polygons (CCW): the
+    points in all of them but at most ``q``, for the smallest ``q <= max_outliers`` that
+    makes that set non-empty (the relaxed fusion's rule, on one landmark's regions).
+
+    Returns ``(vertices, q, inliers)``: the hull (empty if no ``q`` up to the cap
+    works), ``q``, and for each polygon whether some non-empty intersection kept it.
+    """
+    k = len(polygons)
+    if not 1 <= k <= kernels.MAX_WINDOW:
+        raise ValueError(f"relaxed_intersection needs 1..{kernels.MAX_WINDOW} polygons, got {k}")
+    if isinstance(max_outliers, bool) or not isinstance(max_outliers, (int, np.integer)):
+        raise TypeError(f"max_outliers must be an int, got {max_outliers!r}")
+    if max_outliers < 0:
+        raise ValueError(f"max_outliers must be >= 0, got {max_outliers!r}")
+    window = np.zeros((1, k, 1, kernels.CAPACITY), dtype=np.complex128)
+    counts = np.zeros((1, k, 1), dtype=np.int64)
+    for i, polygon in enumerate(polygons):
+        vertices = _polygon(polygon)
+        if not 3 <= vertices.size <= kernels.CAPACITY:
+            raise ValueError(
+                f"polygon {i} must have 3..{kernels.CAPACITY} vertices, got {vertices.size}"
+            )
+        window[0, i, 0, : vertices.size] = vertices
+        counts[0, i, 0] = vertices.size
+    inlier = np.zeros((1, k, 1), dtype=bool)
+    scratch = [np.empty(kernels.MAX_CLOUD + 1, dtype=np.complex128) for _ in range(6)]
+    n, q = kernels.relaxed_region(
+        0, 0, np.arange(k, dtype=np.int64), k, False, int(max_outliers), window, counts,
+        inlier, np.zeros((1, 1, 0), dtype=np.complex128), np.zeros((1, 1), dtype=np.int64),
+        *scratch,
+    )
+    return scratch[0][:n].copy(), int(q), inlier[0, :, 0].copy()
 
 
 def _polygon(points: ArrayLike) -> ComplexArray:

@@ -11,7 +11,10 @@ from numpy.typing import ArrayLike, NDArray
 from bearing_env.slam import kernels
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
+    DEFAULT_MAX_OUTLIERS,
+    DEFAULT_WINDOW,
     FRAME_STATUSES,
+    FUSIONS,
     INCONSISTENCY_POLICIES,
     LANDMARK_STATUSES,
     STATE_ARRAYS,
@@ -19,20 +22,38 @@ from bearing_env.slam.batch import (
     check_bearings,
 )
 
-FRAME_OK, FRAME_L1_UNBOUNDED, FRAME_L2_UNBOUNDED, FRAME_L1_L2_OVERLAP, FRAME_L1_L2_TOO_CLOSE = (
-    FRAME_STATUSES
-)
-LANDMARK_UPDATED, LANDMARK_UNBOUNDED, LANDMARK_INCONSISTENT, LANDMARK_SKIPPED = LANDMARK_STATUSES
+(
+    FRAME_OK,
+    FRAME_L1_UNBOUNDED,
+    FRAME_L2_UNBOUNDED,
+    FRAME_L1_L2_OVERLAP,
+    FRAME_L1_L2_TOO_CLOSE,
+    FRAME_L1_MISSING,
+    FRAME_L2_MISSING,
+    FRAME_REJECTED,
+) = FRAME_STATUSES
+(
+    LANDMARK_UPDATED,
+    LANDMARK_UNBOUNDED,
+    LANDMARK_INCONSISTENT,
+    LANDMARK_SKIPPED,
+    LANDMARK_MISSING,
+) = LANDMARK_STATUSES
 _LANDMARK_NAMES = np.array(LANDMARK_STATUSES, dtype="<U12")
 
 __all__ = [
     "FRAME_L1_L2_OVERLAP",
     "FRAME_L1_L2_TOO_CLOSE",
+    "FRAME_L1_MISSING",
     "FRAME_L1_UNBOUNDED",
+    "FRAME_L2_MISSING",
     "FRAME_L2_UNBOUNDED",
     "FRAME_OK",
+    "FRAME_REJECTED",
+    "FUSIONS",
     "INCONSISTENCY_POLICIES",
     "LANDMARK_INCONSISTENT",
+    "LANDMARK_MISSING",
     "LANDMARK_SKIPPED",
     "LANDMARK_UNBOUNDED",
     "LANDMARK_UPDATED",
@@ -117,7 +138,22 @@ class PolygonSLAM:
         on_inconsistency: what a landmark's region becomes when a movement's region
             misses it (the observations contradict epsilon): ``"restart"`` replaces it by
             the movement's region (the newest evidence; the old intersection is known to
-            be wrong), ``"keep"`` leaves it unchanged. Either way it is counted.
+            be wrong), ``"keep"`` leaves it unchanged. Either way it is counted. With
+            ``fusion="relaxed"`` this applies when more than ``max_outliers`` of the
+            window's regions disagree.
+        fusion: ``"intersect"`` (the paper: the intersection of all of a landmark's
+            regions) or ``"relaxed"``: the q-relaxed intersection of the regions of the
+            last ``window`` movements (plus the intersection of the older regions it
+            kept), which leaves out up to ``max_outliers`` regions per landmark, and
+            whole movements that are outliers for most landmarks (a misread L1 or L2).
+            See :func:`bearing_env.slam.kernels.relaxed_movement`.
+        max_outliers: with ``fusion="relaxed"``, the most regions per landmark that the
+            window may leave out (0 <= max_outliers < window).
+        window: with ``fusion="relaxed"``, the movements kept per map, 1..32.
+
+    A bearing given as NaN is a missed reading: that landmark is skipped for the
+    movement (status ``"missing"``), and a missed L1 or L2 skips the movement
+    (``"l1_missing"``, ``"l2_missing"``).
     """
 
     def __init__(
@@ -127,6 +163,9 @@ class PolygonSLAM:
         transfer: str = "conservative",
         edge_samples: int = 3,
         on_inconsistency: str = "restart",
+        fusion: str = "intersect",
+        max_outliers: int = DEFAULT_MAX_OUTLIERS,
+        window: int = DEFAULT_WINDOW,
     ) -> None:
         self._batch = BatchedPolygonSLAM(
             1,
@@ -135,6 +174,9 @@ class PolygonSLAM:
             transfer=transfer,
             edge_samples=edge_samples,
             on_inconsistency=on_inconsistency,
+            fusion=fusion,
+            max_outliers=max_outliers,
+            window=window,
         )
         self._attach(self._batch, 0)
 
@@ -147,6 +189,9 @@ class PolygonSLAM:
         self.transfer = batch.transfer
         self.edge_samples = batch.edge_samples
         self.on_inconsistency = batch.on_inconsistency
+        self.fusion = batch.fusion
+        self.max_outliers = batch.max_outliers
+        self.window = batch.window
 
     @classmethod
     def view(cls, batch: BatchedPolygonSLAM, index: int) -> PolygonSLAM:
@@ -194,14 +239,7 @@ class PolygonSLAM:
         :meth:`BatchedPolygonSLAM.update`, each candidate on its own copy.
         """
         batch = self._batch
-        copies = BatchedPolygonSLAM(
-            count,
-            batch.n_landmarks,
-            batch.epsilon,
-            transfer=batch.transfer,
-            edge_samples=batch.edge_samples,
-            on_inconsistency=batch.on_inconsistency,
-        )
+        copies = batch.empty_like(count)
         for name in STATE_ARRAYS:
             getattr(copies, name)[:] = getattr(batch, name)[self._index]
         return copies
@@ -220,6 +258,12 @@ class PolygonSLAM:
     def n_inconsistent(self) -> int:
         """Landmark updates that met an inconsistency, over all movements."""
         return int(self._batch.n_inconsistent[self._index])
+
+    @property
+    def outliers(self) -> NDArray[np.int64]:
+        """(n-2,) per landmark, the regions its fused region leaves out (``"relaxed"``;
+        always 0 with ``"intersect"``)."""
+        return self._batch.outliers[self._index].copy()
 
     # -- the update --------------------------------------------------------------------------
 
