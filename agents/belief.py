@@ -52,6 +52,7 @@ MIN_PARALLAX_EPSILONS = 4.0
 _PROGRESS = ROBOT_FEATURES.index("progress")
 _FRAME_CHANGED = ROBOT_FEATURES.index("last_frame_changed")
 _BLOCKED = ROBOT_FEATURES.index("last_move_blocked")
+_BEARING_PRESENT = BEARING_FEATURES.index("present")
 _BEARING_COS = BEARING_FEATURES.index("cos")
 _BEARING_SIN = BEARING_FEATURES.index("sin")
 
@@ -66,18 +67,29 @@ class ObservationView:
     #: Latest bearings (n_landmarks,), radians, relative to the current heading.
     bearings: NDArray[np.float64]
 
+    @property
+    def n_landmarks(self) -> int:
+        """Landmarks in this episode (the bearing slots flagged present)."""
+        return int(self.bearings.size)
+
 
 class ObservationReader:
-    """Parses the env's observation vector (layout: ``BearingSLAMEnv`` docstring)."""
+    """Parses the env's observation vector (layout: ``BearingSLAMEnv`` docstring).
+
+    The landmark count is read from every observation (its bearing slots' ``present``
+    flags), not fixed when the reader is built: with ``n_landmarks=(lo, hi)`` it changes
+    from episode to episode, and the empty slots beyond it are not landmarks at bearing 0.
+    """
 
     def __init__(self, env: gym.Env) -> None:
         base = bearing_env_of(env)
-        self.n_landmarks = int(base.n_landmarks)
         self.bearing_block = observation_slices(int(base.max_landmarks))["bearings"]
 
     def read(self, observation: NDArray[np.float32]) -> ObservationView:
         obs = np.asarray(observation, dtype=np.float64)
-        bearings = obs[self.bearing_block].reshape(-1, len(BEARING_FEATURES))[: self.n_landmarks]
+        slots = obs[self.bearing_block].reshape(-1, len(BEARING_FEATURES))
+        # The env fills slots L1, L2, ... in order, so the present ones come first.
+        bearings = slots[: int(np.count_nonzero(slots[:, _BEARING_PRESENT] > 0.5))]
         return ObservationView(
             progress=float(obs[_PROGRESS]),
             frame_changed=bool(obs[_FRAME_CHANGED] > 0.5),

@@ -24,7 +24,9 @@ from bearing_env.agents import (
     make_policy,
     parse_policy_spec,
 )
-from bearing_env.agents.belief import scale_sample, triangulate_fr
+from bearing_env.agents.belief import ObservationReader, scale_sample, triangulate_fr
+from bearing_env.agents.env_access import MapReader
+from bearing_env.agents.vector import VectorPolicy
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.slam import world_to_fl
@@ -148,12 +150,27 @@ class PoisonedWorld:
 
 
 class PoisonedInfo(dict):
-    """An info dict whose every read is a failure (info holds ground truth)."""
+    """An info dict whose every read is a failure (info holds ground truth), but for the
+    robot's own map (``info["robot_map"]``), which it holds when built from a real info."""
+
+    def __init__(self, info: dict[str, Any] | None = None) -> None:
+        super().__init__()
+        self._robot_map = None if info is None else info["robot_map"]
 
     def _fail(self, *args: Any, **kwargs: Any) -> Any:
-        raise GroundTruthRead("the policy read info")
+        raise GroundTruthRead("the policy read info beyond the robot's map")
 
-    __getitem__ = get = keys = items = values = __contains__ = __iter__ = _fail  # type: ignore[assignment]
+    def __getitem__(self, key: str) -> Any:
+        if key == "robot_map" and self._robot_map is not None:
+            return self._robot_map
+        raise GroundTruthRead(f"the policy read info[{key!r}]")
+
+    def __contains__(self, key: object) -> bool:
+        if key == "robot_map" and self._robot_map is not None:
+            return True
+        raise GroundTruthRead(f"the policy asked for info[{key!r}]")
+
+    get = keys = items = values = __iter__ = _fail  # type: ignore[assignment]
 
 
 def _corrupted_world(world: Any, rng: np.random.Generator) -> Any:
@@ -179,7 +196,7 @@ def play_with_truth_swapped(
         true_world = base._world
         base._world = replacement(true_world)
         try:
-            action = policy.act(observation, PoisonedInfo() if poison_info else info)
+            action = policy.act(observation, PoisonedInfo(info) if poison_info else info)
         finally:
             base._world = true_world
         actions.append(copy.deepcopy(action))
@@ -222,6 +239,83 @@ def test_the_oracle_does_read_the_truth() -> None:
     assert not same_actions(reference, corrupted)
     with pytest.raises(GroundTruthRead):
         play_with_truth_swapped(env, GreedyOracle(env), 1, lambda _: PoisonedWorld(), False)
+
+
+def test_a_poisoned_info_does_fail_on_ground_truth() -> None:
+    # The whitelist above is a real test: reading any other key of it fails.
+    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    _, info = env.reset(seed=0)
+    poisoned = PoisonedInfo(info)
+    assert poisoned["robot_map"] is info["robot_map"]
+    for key in ("total_area", "landmark_error", "robot_error"):
+        with pytest.raises(GroundTruthRead):
+            poisoned[key]
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_the_robot_map_in_info_is_the_robots_map_and_holds_no_truth(env_id: str) -> None:
+    env = gym.make(env_id, scenario="khepera", max_moves=10, max_episode_steps=10)
+    base = env.unwrapped
+    policy = GreedyOneStep(env)
+    reader = MapReader(env)
+    observation, info = env.reset(seed=3)
+    policy.reset(seed=3)
+    terminated = truncated = False
+    while not (terminated or truncated):
+        live = base.slam
+        rebuilt = reader.read(info, base.n_landmarks)
+        # The same map, bit for bit, as the robot's own...
+        for name in ("areas", "estimates", "robot_estimate", "robot_area", "robot_heading"):
+            assert np.array_equal(getattr(rebuilt, name), getattr(live, name), equal_nan=True)
+        for mine, theirs in zip(rebuilt.polygons, live.polygons, strict=True):
+            assert (mine is None and theirs is None) or np.array_equal(mine, theirs)
+        assert np.array_equal(rebuilt.robot_polygon, live.robot_polygon)  # type: ignore[arg-type]
+        assert (rebuilt.n_updates, rebuilt.n_frame_changes) == (
+            live.n_updates,
+            live.n_frame_changes,
+        )
+        # ...and no array of it holds a true position (FL landmarks or robot).
+        world = base.world
+        l1, l2 = world.landmarks[0], world.landmarks[1]
+        truths = world_to_fl(np.vstack([world.landmarks[2:], world.position[None]]), l1, l2)
+        for name, values in info["robot_map"].items():
+            points = np.asarray(values)
+            if points.shape[-1:] == (2,):  # FL points as (x, y)
+                for truth in truths:
+                    hits = np.all(np.abs(points.reshape(-1, 2) - truth) < 1e-9, axis=1)
+                    assert not np.any(hits), name
+        action = policy.act(observation, info)
+        observation, _, terminated, truncated, info = env.step(action)
+    # A copy of the env (pickled, as a remote worker would get it) gives the same map data.
+    clone = pickle.loads(pickle.dumps(env))
+    assert np.array_equal(
+        clone.unwrapped.slam.batch.vertices[0], base.slam.batch.vertices[0], equal_nan=True
+    )
+
+
+@pytest.mark.parametrize("seed", [1, 3, 4])
+def test_no_phantom_landmarks_when_the_count_varies(seed: int) -> None:
+    # One reader, built once, for episodes of 3 to 8 landmarks: the count is read from
+    # each observation's present flags (it used to be fixed at build time, which gave
+    # phantom landmarks at bearing 0 in the empty slots).
+    env = gym.make("BearingSLAM-v0", n_landmarks=(3, 8))
+    reader = ObservationReader(env)
+    counts = set()
+    for episode in range(6):
+        observation, _ = env.reset(seed=seed + 7 * episode)
+        view = reader.read(observation)
+        n = env.unwrapped.n_landmarks
+        counts.add(n)
+        assert view.n_landmarks == n
+        truth = env.unwrapped.world.true_bearings()
+        gap = np.abs(np.angle(np.exp(1j * (view.bearings - truth))))
+        assert np.all(gap <= env.unwrapped.epsilon + 1e-6)
+    assert len(counts) > 1  # the count did vary
+    # The policies built once run on every count (their map is sized by the observation).
+    for policy_class in HEURISTICS:
+        policy = policy_class(env)
+        for episode in range(3):
+            play(env, policy, seed + 7 * episode)
 
 
 # --------------------------------------------------------------------------------------
@@ -454,3 +548,47 @@ def test_sb3_policy_load_errors(tiny_ppo: Path, tmp_path: Path) -> None:
     with pytest.raises(ModelLoadError, match="expects observations"):
         SB3Policy(wide, tiny_ppo)
     assert issubclass(ModelLoadError, ValueError)
+
+
+# --------------------------------------------------------------------------------------
+# Vector envs: a batched act
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("policy_class", HEURISTICS, ids=lambda c: c.__name__)
+def test_vector_policy_acts_like_one_policy_per_sub_env(env_id: str, policy_class: type) -> None:
+    # Sub-env i of the vector env, seeded seed + i, with its own policy, takes the actions
+    # the same policy takes on the single env seeded seed + i.
+    kwargs = {"scenario": "khepera", "max_moves": 5}
+    vector_env = gym.make_vec(env_id, num_envs=3, **kwargs)
+    policy = VectorPolicy(vector_env, policy_class)
+    observations, infos = vector_env.reset(seed=20)
+    policy.reset(seed=20)
+    actions: list[list[Any]] = [[], [], []]
+    for _ in range(5):
+        batch = policy.act(observations, infos)
+        assert vector_env.action_space.contains(batch)
+        for row in range(3):
+            actions[row].append(batch[row])
+        observations, _, _, _, infos = vector_env.step(batch)
+    single = gym.make(env_id, max_episode_steps=5, **kwargs)
+    for row in range(3):
+        expected, _, _ = play(single, policy_class(single), seed=20 + row)
+        assert same_actions(actions[row][: len(expected)], expected)
+
+
+def test_vector_policy_runs_on_varying_counts_and_sync_vector_envs() -> None:
+    for vector_env in (
+        gym.make_vec("BearingSLAM-v0", num_envs=2, n_landmarks=(3, 8), max_moves=4),
+        gym.make_vec(
+            "BearingSLAM-v0", num_envs=2, vectorization_mode="sync", scenario="khepera"
+        ),
+    ):
+        policy = VectorPolicy(vector_env, GreedyOneStep)
+        observations, infos = vector_env.reset(seed=1)
+        policy.reset(seed=1)
+        for _ in range(9):  # through an autoreset
+            observations, _, _, _, infos = vector_env.step(policy.act(observations, infos))
+    with pytest.raises(TypeError, match="VectorEnv"):
+        VectorPolicy(gym.make("BearingSLAM-v0"), GreedyOneStep)  # type: ignore[arg-type]

@@ -44,6 +44,7 @@ INFO_KEYS = {
     "frame_changed",
     "inconsistent",
     "path_length",
+    "robot_map",
     "rewards",
 }
 
@@ -258,6 +259,7 @@ def test_info_keys_and_shapes() -> None:
         assert isinstance(info["inconsistent"], int)
         assert 0.0 <= info["path_length"] <= env.move_length[1]
         assert reward == pytest.approx(sum(info["rewards"].values()))
+        assert info["robot_map"]["vertices"].shape[:-2] == info["robot_map"]["counts"].shape
         # Not initialised <=> infinite area <=> infinite error.
         assert np.array_equal(np.isinf(info["landmark_area"]), np.isinf(info["landmark_error"]))
 

@@ -227,7 +227,20 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     ## Info
 
-    Ground truth, for evaluation only (arrays are over landmarks i >= 3):
+    `robot_map` is the robot's own map, as data (no ground truth; what policies may read:
+    see `bearing_env.agents.env_access.MapReader`): a dict of its state arrays
+    (`bearing_env.slam.batch.STATE_ARRAYS`: `vertices` (M - 2, CAPACITY, 2), the FL
+    region vertices as (x, y), of which the first `counts` are used, `areas`,
+    `centroids` (M - 2, 2), the robot's
+    `robot_vertices`, `robot_counts`, `robot_area`, `robot_centroid`, `robot_heading`, and
+    the counters `n_updates`, `n_frame_changes`, `n_inconsistent`). The per-landmark
+    arrays have `M - 2` slots whatever the episode's landmark count (empty slots: count
+    0), so infos batch on the vector env; the count is the observation's present slots.
+    Unused vertex slots are 0 and unknown values (a centroid without a region, the
+    robot's centroid or heading before it has one) are inf, so equal maps give equal
+    infos.
+
+    The rest is ground truth, for evaluation only (arrays are over landmarks i >= 3):
     `landmark_area` (inf if not initialised), `landmark_error` (centroid to true FL
     position; inf if not initialised), `landmark_contains_truth` (bool), `total_area`
     (sum of `landmark_area`), `robot_error` (robot region centroid to the robot's true FL

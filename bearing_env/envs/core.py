@@ -33,7 +33,7 @@ from bearing_env.envs import kernels
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig
 from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
 from bearing_env.slam import PolygonSLAM
-from bearing_env.slam.batch import CONTAINMENT_TOLERANCE, BatchedPolygonSLAM
+from bearing_env.slam.batch import CONTAINMENT_TOLERANCE, STATE_ARRAYS, BatchedPolygonSLAM
 from bearing_env.slam.geometry import wrap_angle
 from bearing_env.world import (
     Arena,
@@ -630,12 +630,62 @@ def infos(
         "frame_changed": outcome.frame_changed,
         "inconsistent": outcome.inconsistent,
         "path_length": outcome.travelled,
+        "robot_map": robot_map_info(batch, rows, config.max_landmarks - 2),
         "rewards": {
             "uncertainty": outcome.uncertainty,
             "path_cost": outcome.path_cost,
             "move_cost": outcome.move_cost,
         },
     }
+
+
+#: Fill of the empty landmark slots of ``info["robot_map"]`` (default 0: count 0 is a
+#: landmark without a region), as the map itself holds an uninitialised landmark.
+ROBOT_MAP_PADDING: dict[str, Any] = {"areas": np.inf, "centroids": complex(np.inf, np.inf)}
+#: The arrays of ``info["robot_map"]`` whose unknown values (NaN in the map: the centroid
+#: of a landmark without a region, the robot's centroid and heading before it has them)
+#: are written as inf, so that equal maps give equal infos (NaN != NaN).
+ROBOT_MAP_UNKNOWN_AS_INF: tuple[str, ...] = ("centroids", "robot_centroid", "robot_heading")
+#: Vertex arrays of the map and the arrays counting their used vertices.
+_VERTEX_COUNTS = {"vertices": "counts", "robot_vertices": "robot_counts"}
+
+
+def robot_map_info(batch: BatchedPolygonSLAM, rows: IntArray, slots: int) -> dict[str, Any]:
+    """The robot's own map state of the rows, as data (``info["robot_map"]``).
+
+    One array per state array of the map (``bearing_env.slam.batch.STATE_ARRAYS``),
+    restricted to the rows; complex FL points are (x, y) pairs on a last axis of 2. It has
+    a canonical form so that equal maps give equal infos:
+    vertex slots beyond a region's count are 0, and unknown values are inf (see
+    :data:`ROBOT_MAP_UNKNOWN_AS_INF`). The per-landmark arrays (the names not starting
+    with ``robot_`` or ``n_``) are padded to ``slots`` landmark slots (``max_landmarks -
+    2``), so that every episode's info has the same shapes whatever its landmark count.
+    It is what the robot knows, never ground truth.
+    """
+    mapped = batch.n_landmarks - 2
+    out: dict[str, Any] = {}
+    for name in STATE_ARRAYS:
+        values = getattr(batch, name)[rows]
+        if name in _VERTEX_COUNTS:
+            used = getattr(batch, _VERTEX_COUNTS[name])[rows]
+            values[np.arange(values.shape[-1]) >= used[..., None]] = 0
+        elif name in ROBOT_MAP_UNKNOWN_AS_INF:
+            unknown = np.isnan(values)
+            values[unknown] = complex(np.inf, np.inf) if values.dtype.kind == "c" else np.inf
+        if not name.startswith(("robot_", "n_")) and slots > mapped:
+            padded = np.full(
+                (rows.size, slots, *values.shape[2:]),
+                ROBOT_MAP_PADDING.get(name, 0),
+                dtype=values.dtype,
+            )
+            padded[:, :mapped] = values
+            values = padded
+        if values.dtype.kind == "c":
+            # FL points as (x, y) pairs on a last axis: Gymnasium batches real arrays and
+            # scalars only (a complex scalar would become an object array).
+            values = np.stack([values.real, values.imag], axis=-1)
+        out[name] = values
+    return out
 
 
 def row_info(batched: dict[str, Any], row: int) -> dict[str, Any]:
