@@ -34,13 +34,16 @@ has a relative error of about epsilon / parallax.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env.envs.bearing_slam import BEARING_FEATURES, ROBOT_FEATURES, observation_slices
+from bearing_env.envs.core import ENTITY_FEATURES
 from bearing_env.slam import PolygonSLAM
 
 from .base import Movement, wrap_angle
@@ -85,16 +88,27 @@ class ObservationReader:
         base = bearing_env_of(env)
         self.bearing_block = observation_slices(int(base.max_landmarks))["bearings"]
 
-    def read(self, observation: NDArray[np.float32]) -> ObservationView:
-        obs = np.asarray(observation, dtype=np.float64)
-        slots = obs[self.bearing_block].reshape(-1, len(BEARING_FEATURES))
+    def read(self, observation: NDArray[np.float32] | Mapping[str, Any]) -> ObservationView:
+        """The view of a flat observation, or of an entity one (``observation="entities"``)."""
+        if isinstance(observation, Mapping):
+            robot = np.asarray(observation["robot"], dtype=np.float64)
+            table = np.asarray(observation["landmarks"], dtype=np.float64)
+            table = table.reshape(-1, len(ENTITY_FEATURES))
+            present, cos, sin = (
+                ENTITY_FEATURES.index(name) for name in ("present", "bearing_cos", "bearing_sin")
+            )
+        else:
+            obs = np.asarray(observation, dtype=np.float64)
+            robot = obs
+            table = obs[self.bearing_block].reshape(-1, len(BEARING_FEATURES))
+            present, cos, sin = _BEARING_PRESENT, _BEARING_COS, _BEARING_SIN
         # The env fills slots L1, L2, ... in order, so the present ones come first.
-        bearings = slots[: int(np.count_nonzero(slots[:, _BEARING_PRESENT] > 0.5))]
+        bearings = table[: int(np.count_nonzero(table[:, present] > 0.5))]
         return ObservationView(
-            progress=float(obs[_PROGRESS]),
-            frame_changed=bool(obs[_FRAME_CHANGED] > 0.5),
-            blocked=bool(obs[_BLOCKED] > 0.5),
-            bearings=np.arctan2(bearings[:, _BEARING_SIN], bearings[:, _BEARING_COS]),
+            progress=float(robot[_PROGRESS]),
+            frame_changed=bool(robot[_FRAME_CHANGED] > 0.5),
+            blocked=bool(robot[_BLOCKED] > 0.5),
+            bearings=np.arctan2(bearings[:, sin], bearings[:, cos]),
         )
 
 

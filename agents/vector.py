@@ -12,7 +12,7 @@ observation and ``info["robot_map"]`` (privileged ones also read their sub-env's
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, cast
 
 import gymnasium as gym
@@ -42,6 +42,12 @@ def info_row(infos: dict[str, Any], row: int) -> dict[str, Any]:
             continue
         info[key] = info_row(value, row) if isinstance(value, dict) else value[row]
     return info
+
+
+def _observation_row(observations: Any, row: int) -> Any:
+    if isinstance(observations, Mapping):
+        return {key: value[row] for key, value in observations.items()}
+    return observations[row]
 
 
 def sub_env_template(vector_env: gym.vector.VectorEnv, row: int) -> BearingSLAMEnv:
@@ -94,14 +100,17 @@ class VectorPolicy:
         for policy, row_seed in zip(self.policies, seeds, strict=True):
             policy.reset(seed=row_seed)
 
-    def act(self, observations: NDArray[np.float32], infos: dict[str, Any]) -> NDArray[Any]:
-        """The actions (num_envs, ...) for a vector env's observations and infos."""
-        if len(observations) != self.num_envs:
-            raise ValueError(
-                f"expected observations for {self.num_envs} sub-envs, got {len(observations)}"
-            )
+    def act(
+        self, observations: NDArray[np.float32] | Mapping[str, Any], infos: dict[str, Any]
+    ) -> NDArray[Any]:
+        """The actions (num_envs, ...) for a vector env's observations (flat, or entity
+        dicts of batched arrays) and infos."""
+        first = next(iter(observations.values())) if isinstance(observations, Mapping) else None
+        count = len(first) if first is not None else len(observations)
+        if count != self.num_envs:
+            raise ValueError(f"expected observations for {self.num_envs} sub-envs, got {count}")
         actions = [
-            policy.act(observations[row], info_row(infos, row))
+            policy.act(_observation_row(observations, row), info_row(infos, row))
             for row, policy in enumerate(self.policies)
         ]
         return np.stack([np.asarray(action) for action in actions])

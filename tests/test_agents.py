@@ -592,3 +592,21 @@ def test_vector_policy_runs_on_varying_counts_and_sync_vector_envs() -> None:
             observations, _, _, _, infos = vector_env.step(policy.act(observations, infos))
     with pytest.raises(TypeError, match="VectorEnv"):
         VectorPolicy(gym.make("BearingSLAM-v0"), GreedyOneStep)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("policy_class", HEURISTICS, ids=lambda c: c.__name__)
+def test_policies_act_alike_on_the_entity_observation(env_id: str, policy_class: type) -> None:
+    kwargs = {"scenario": "khepera", "max_moves": 6, "max_episode_steps": 6}
+    flat = gym.make(env_id, **kwargs)
+    entities = gym.make(env_id, observation="entities", **kwargs)
+    reference, _, _ = play(flat, policy_class(flat), seed=9)
+    actions, _, _ = play(entities, policy_class(entities), seed=9)
+    assert same_actions(reference, actions)
+    vector_env = gym.make_vec(env_id, num_envs=2, observation="entities", scenario="khepera")
+    policy = VectorPolicy(vector_env, policy_class)
+    observations, infos = vector_env.reset(seed=9)
+    policy.reset(seed=9)
+    batch = policy.act(observations, infos)
+    assert vector_env.action_space.contains(batch)
+    assert np.array_equal(np.asarray(batch[0]), np.asarray(reference[0]))

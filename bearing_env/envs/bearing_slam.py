@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any, Generic, SupportsFloat, TypeVar
+from typing import Any, Generic, SupportsFloat, TypeVar, cast
 
 import gymnasium as gym
 import numpy as np
@@ -196,6 +196,13 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     are the reading at the current position (at reset: the initial reading), relative to
     the current heading. `observation_slices(M)` gives the three blocks as slices.
 
+    With `observation="entities"` the observation is a `Dict` of the same numbers:
+    `"robot"` (the 9 elements above) and `"landmarks"`, a table of one row per landmark
+    slot L1 .. LM, flattened row by row (a Box of `M * 8`; reshape to `(M, 8)`), with the
+    columns `core.ENTITY_FEATURES`: present, is-frame (L1 and L2, at (0, 0) and (1, 0)),
+    not initialised, estimate x, y, log-area (`log(1e-10)` for the exact L1 and L2) and
+    the latest bearing's cos and sin. Absent rows are zeros.
+
     ## Rewards
 
     With `reward="log_area"` (default), the reward is the decrease of the potential
@@ -279,6 +286,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     - `area_cap`: the area counted for an uninitialised landmark, in `(1e-10, 1e6]`;
       default 10.
     - `max_landmarks`: observation slots (at most 1024); default `max(8, n_landmarks)`.
+    - `observation`: `"flat"` (default, the Box above) or `"entities"` (the Dict above).
     - `render_mode`: `None`, `"human"` or `"rgb_array"`.
     - `config`: an `EnvConfig` (`bearing_env.envs.config`) holding all the settings
       above but `render_mode`, instead of the keywords (`EnvConfig.create(...)` takes
@@ -287,7 +295,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     Every setting is also an attribute (`env.area_cap`, `env.path_cost`, ...; `reward`
     is `env.reward_kind`); assigning one replaces `env.config` with a validated copy.
-    `max_landmarks` is read-only (it fixes the observation space). A change of
+    `max_landmarks` and `observation_kind` (the `observation` setting) are read-only
+    (they fix the observation space). A change of
     `epsilon_deg` or `transfer` gives the env a new, empty map.
 
     ## Version History
@@ -312,6 +321,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     move_cost: Setting[float] = Setting("move_cost")
     area_cap: Setting[float] = Setting("area_cap")
     max_landmarks: Setting[int] = Setting("max_landmarks", read_only=FIXES_THE_SPACES)
+    observation_kind: Setting[str] = Setting("observation", read_only=FIXES_THE_SPACES)
 
     def __init__(
         self,
@@ -332,6 +342,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         max_landmarks: int | None = None,
         render_mode: str | None = None,
         config: EnvConfig | None = None,
+        observation: str = "flat",
     ) -> None:
         super().__init__()
         settings = {
@@ -350,6 +361,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             "move_cost": move_cost,
             "area_cap": area_cap,
             "max_landmarks": max_landmarks,
+            "observation": observation,
         }
         self._setup(settings_from(config, settings, _CONTINUOUS_DEFAULTS), render_mode)
 
@@ -363,7 +375,13 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         self._config = config
         self.render_mode = render_mode
         self.action_space = self._make_action_space()
-        self.observation_space = observation_space(config)
+        # Any: the entity kind's Dict space is not the Box the class's type parameter names.
+        self.observation_space = cast(
+            Any,
+            entity_observation_space(config)
+            if config.observation == "entities"
+            else observation_space(config),
+        )
         #: The batch of one this env is; its row index array, for the core's functions.
         self._rows = np.array([0])
         self._state = BatchState.empty(1, config.max_landmarks)
@@ -439,7 +457,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         infos = core.infos(self._state, rows, config, self._maps, core.reset_outcome(1))
         if self.render_mode == "human":
             self.render()
-        return observation, core.row_info(infos, 0)
+        return self._observation(observation), core.row_info(infos, 0)
 
     def step(
         self, action: NDArray[np.float32] | ArrayLike
@@ -461,12 +479,18 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         if self.render_mode == "human":
             self.render()
         return (
-            observation,
+            self._observation(observation),
             float(outcome.rewards[0]),
             bool(outcome.terminated[0]),
             bool(outcome.truncated[0]),
             info,
         )
+
+    def _observation(self, flat: NDArray[np.float32]) -> Any:
+        """The observation of the env's kind from the flat vector."""
+        if self.config.observation == "entities":
+            return core.entity_observations(flat, self.config.max_landmarks)
+        return flat
 
     def render(self) -> NDArray[np.uint8] | None:
         if self.render_mode is None:
@@ -546,6 +570,28 @@ def observation_space(config: EnvConfig) -> spaces.Box[np.float32]:
         np.nextafter(low.astype(np.float32), np.float32(-np.inf)),
         np.nextafter(high.astype(np.float32), np.float32(np.inf)),
         dtype=np.float32,
+    )
+
+
+def entity_observation_space(config: EnvConfig) -> spaces.Dict:
+    """The observation space of ``observation="entities"``: the flat space's bounds,
+    rearranged as :func:`~bearing_env.envs.core.entity_observations` rearranges the values
+    (each table column's bounds are its extremes over the slots)."""
+    flat = observation_space(config)
+    low = core.entity_observations(flat.low, config.max_landmarks)
+    high = core.entity_observations(flat.high, config.max_landmarks)
+    rows = (config.max_landmarks, len(core.ENTITY_FEATURES))
+    table_low = np.minimum(low["landmarks"], high["landmarks"]).reshape(rows).min(axis=0)
+    table_high = np.maximum(low["landmarks"], high["landmarks"]).reshape(rows).max(axis=0)
+    return spaces.Dict(
+        {
+            "robot": spaces.Box(low["robot"], high["robot"], dtype=np.float32),
+            "landmarks": spaces.Box(
+                np.tile(table_low, config.max_landmarks),
+                np.tile(table_high, config.max_landmarks),
+                dtype=np.float32,
+            ),
+        }
     )
 
 

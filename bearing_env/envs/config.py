@@ -58,6 +58,9 @@ DEFAULT_N_TURNS = 8
 DEFAULT_N_MOVE_LENGTHS = 3
 
 REWARDS: tuple[str, ...] = ("log_area", "area")
+#: Observation kinds: the flat Box (default) or a Dict of a robot block and a landmark
+#: table (``bearing_env.envs.core.entity_observations``).
+OBSERVATIONS: tuple[str, ...] = ("flat", "entities")
 
 
 def is_number(value: Any) -> bool:
@@ -138,6 +141,7 @@ class EnvConfig:
     max_landmarks: int
     n_turns: int = DEFAULT_N_TURNS
     n_move_lengths: int = DEFAULT_N_MOVE_LENGTHS
+    observation: str = "flat"
 
     # ------------------------------------------------------------------------------------
     # Construction
@@ -163,6 +167,7 @@ class EnvConfig:
         max_landmarks: int | None = None,
         n_turns: int = DEFAULT_N_TURNS,
         n_move_lengths: int | None = None,
+        observation: str = "flat",
     ) -> EnvConfig:
         """A validated config from the envs' keyword arguments, with the scenario's
         defaults for what is left out."""
@@ -199,6 +204,7 @@ class EnvConfig:
             max_landmarks=max_landmarks,
             n_turns=n_turns,
             n_move_lengths=n_move_lengths,
+            observation=observation,
         )
 
     def __post_init__(self) -> None:
@@ -252,6 +258,7 @@ class EnvConfig:
         normalise("max_landmarks", int_at_most(max_landmarks, MAX_N_LANDMARKS, "max_landmarks"))
         normalise("n_turns", int_at_least(self.n_turns, 1, "n_turns"))
         normalise("n_move_lengths", int_at_least(self.n_move_lengths, 1, "n_move_lengths"))
+        choice(self.observation, OBSERVATIONS, "observation")
 
     def replace(self, **changes: Any) -> EnvConfig:
         """A copy with some fields changed (validated)."""

@@ -82,6 +82,52 @@ def observation_slices(max_landmarks: int) -> dict[str, slice]:
     }
 
 
+#: The columns of the entity observation's landmark table, one row per landmark slot
+#: (L1, L2, L3, ...): present, is-frame (L1 and L2, fixed at (0, 0) and (1, 0) in FL),
+#: not initialised yet, the estimate in FL, the log-area, and the latest bearing.
+ENTITY_FEATURES: tuple[str, ...] = (
+    "present",
+    "is_frame",
+    "uninitialised",
+    "x",
+    "y",
+    "log_area",
+    "bearing_cos",
+    "bearing_sin",
+)
+
+
+def entity_observations(flat: NDArray[np.float32], max_landmarks: int) -> dict[str, Any]:
+    """The entity view of flat observations (..., observation_size): the same numbers,
+    rearranged. ``"robot"`` (..., len(ROBOT_FEATURES)) is the robot block;
+    ``"landmarks"`` (..., max_landmarks * len(ENTITY_FEATURES)) is the landmark table, a
+    row per slot, flattened row by row (a 1-D Box per observation, as SB3's checker
+    wants: reshape to (max_landmarks, len(ENTITY_FEATURES))). L1 and L2 are the frame:
+    estimate (0, 0) and (1, 0), exact (log-area ``log(AREA_FLOOR)``). Rows of absent
+    landmarks are all zeros.
+    """
+    flat = np.asarray(flat, dtype=np.float32)
+    blocks = observation_slices(max_landmarks)
+    lead = flat.shape[:-1]
+    mapped = flat[..., blocks["landmarks"]].reshape(*lead, max_landmarks - 2, -1)
+    bearings = flat[..., blocks["bearings"]].reshape(*lead, max_landmarks, -1)
+    table = np.zeros((*lead, max_landmarks, len(ENTITY_FEATURES)), dtype=np.float32)
+    column = {name: index for index, name in enumerate(ENTITY_FEATURES)}
+    landmark = {name: index for index, name in enumerate(LANDMARK_FEATURES)}
+    bearing = {name: index for index, name in enumerate(BEARING_FEATURES)}
+    table[..., column["present"]] = bearings[..., bearing["present"]]
+    frame = table[..., :2, :]
+    frame[..., column["is_frame"]] = frame[..., column["present"]]
+    frame[..., 1, column["x"]] = frame[..., 1, column["present"]]
+    exact = np.float32(math.log(AREA_FLOOR))
+    frame[..., column["log_area"]] = exact * frame[..., column["present"]]
+    for name in ("uninitialised", "x", "y", "log_area"):
+        table[..., 2:, column[name]] = mapped[..., landmark[name]]
+    table[..., column["bearing_cos"]] = bearings[..., bearing["cos"]]
+    table[..., column["bearing_sin"]] = bearings[..., bearing["sin"]]
+    return {"robot": flat[..., blocks["robot"]].copy(), "landmarks": table.reshape(*lead, -1)}
+
+
 # ----------------------------------------------------------------------------------------
 # State
 # ----------------------------------------------------------------------------------------
@@ -219,6 +265,11 @@ def check_config_switch(old: EnvConfig, new: EnvConfig, action_grid_fixed: bool)
     if new.max_landmarks != old.max_landmarks:
         raise ValueError(
             f"max_landmarks cannot change ({old.max_landmarks} -> {new.max_landmarks}): "
+            "it fixes the observation space; make a new env"
+        )
+    if new.observation != old.observation:
+        raise ValueError(
+            f"observation cannot change ({old.observation!r} -> {new.observation!r}): "
             "it fixes the observation space; make a new env"
         )
     if action_grid_fixed and (new.n_turns, new.n_move_lengths) != (
