@@ -26,15 +26,18 @@ from bearing_env.agents import (
 )
 from bearing_env.agents.belief import ObservationReader, scale_sample, triangulate_fr
 from bearing_env.agents.env_access import MapReader
+from bearing_env.agents.lookahead import Lookahead, LookaheadOracle, sample_in_polygon
 from bearing_env.agents.vector import VectorPolicy
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.slam import world_to_fl
 
 ENV_IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
-HEURISTICS = (RandomPolygonal, Parallax, GreedyOneStep, GreedyOracle)
+HEURISTICS = (RandomPolygonal, Parallax, GreedyOneStep, GreedyOracle, Lookahead, LookaheadOracle)
 #: Policies that must act on the robot's knowledge only.
-ROBOT_POLICIES = (RandomPolygonal, Parallax, GreedyOneStep)
+ROBOT_POLICIES = (RandomPolygonal, Parallax, GreedyOneStep, Lookahead)
+#: The privileged upper references (they read ground truth).
+ORACLES = (GreedyOracle, LookaheadOracle)
 
 
 def play(env: gym.Env, policy: Any, seed: int) -> tuple[list[Any], dict[str, Any], int]:
@@ -227,18 +230,19 @@ def test_corrupting_the_truth_does_not_change_robot_policies(policy_class: type)
         assert same_actions(reference, corrupted)
 
 
-def test_the_oracle_does_read_the_truth() -> None:
-    # The swap above is a real test: the privileged oracle's choices do change with it.
+@pytest.mark.parametrize("oracle_class", ORACLES, ids=lambda c: c.__name__)
+def test_the_oracle_does_read_the_truth(oracle_class: type) -> None:
+    # The swap above is a real test: the privileged oracles' choices do change with it.
     env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=6, max_episode_steps=6)
-    assert GreedyOracle.privileged and not GreedyOneStep.privileged
-    reference, _, _ = play(env, GreedyOracle(env), seed=1)
+    assert oracle_class.privileged and not GreedyOneStep.privileged and not Lookahead.privileged
+    reference, _, _ = play(env, oracle_class(env), seed=1)
     rng = np.random.default_rng(0)
     corrupted = play_with_truth_swapped(
-        env, GreedyOracle(env), 1, lambda w: _corrupted_world(w, rng), poison_info=False
+        env, oracle_class(env), 1, lambda w: _corrupted_world(w, rng), poison_info=False
     )
     assert not same_actions(reference, corrupted)
     with pytest.raises(GroundTruthRead):
-        play_with_truth_swapped(env, GreedyOracle(env), 1, lambda _: PoisonedWorld(), False)
+        play_with_truth_swapped(env, oracle_class(env), 1, lambda _: PoisonedWorld(), False)
 
 
 def test_a_poisoned_info_does_fail_on_ground_truth() -> None:
@@ -581,9 +585,7 @@ def test_vector_policy_acts_like_one_policy_per_sub_env(env_id: str, policy_clas
 def test_vector_policy_runs_on_varying_counts_and_sync_vector_envs() -> None:
     for vector_env in (
         gym.make_vec("BearingSLAM-v0", num_envs=2, n_landmarks=(3, 8), max_moves=4),
-        gym.make_vec(
-            "BearingSLAM-v0", num_envs=2, vectorization_mode="sync", scenario="khepera"
-        ),
+        gym.make_vec("BearingSLAM-v0", num_envs=2, vectorization_mode="sync", scenario="khepera"),
     ):
         policy = VectorPolicy(vector_env, GreedyOneStep)
         observations, infos = vector_env.reset(seed=1)
@@ -610,3 +612,52 @@ def test_policies_act_alike_on_the_entity_observation(env_id: str, policy_class:
     batch = policy.act(observations, infos)
     assert vector_env.action_space.contains(batch)
     assert np.array_equal(np.asarray(batch[0]), np.asarray(reference[0]))
+
+
+# --------------------------------------------------------------------------------------
+# Lookahead
+# --------------------------------------------------------------------------------------
+
+
+def test_lookahead_of_depth_one_in_one_world_is_the_greedy_planner() -> None:
+    # One move ahead, scored at the estimates only, over GreedyOneStep's candidates: the
+    # same decisions (the search is a generalisation, not a different rule).
+    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=10, max_episode_steps=10)
+    for seed in (2, 5):
+        greedy, _, _ = play(env, GreedyOneStep(env), seed)
+        one_step, _, _ = play(env, Lookahead(env, depth=1, hypotheses=1, n_turns=8), seed)
+        assert same_actions(greedy, one_step)
+
+
+def test_lookahead_options_and_planning_times() -> None:
+    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=5, max_episode_steps=5)
+    policy = Lookahead(env, depth=3, width=4, n_turns=12, lengths=2, hypotheses=3)
+    assert len(policy.candidates) == 24
+    _, _, moves = play(env, policy, seed=4)
+    # Every move after the bootstrap is planned, and timed.
+    assert 1 <= len(policy.planning_times) <= moves
+    assert all(t > 0.0 for t in policy.planning_times)
+    for bad in ({"depth": 0}, {"width": -1}, {"hypotheses": 1.5}, {"depth": True}):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            Lookahead(env, **bad)
+    spec = make_policy("lookahead:depth=3,hypotheses=2", env)
+    assert isinstance(spec, Lookahead) and (spec.depth, spec.hypotheses) == (3, 2)
+    assert isinstance(make_policy("lookahead_oracle", env), LookaheadOracle)
+
+
+def test_hypotheses_change_the_plans_and_follow_the_seed() -> None:
+    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=8, max_episode_steps=8)
+    single, _, _ = play(env, Lookahead(env, hypotheses=1), seed=6)
+    first, _, _ = play(env, Lookahead(env, hypotheses=4), seed=6)
+    again, _, _ = play(env, Lookahead(env, hypotheses=4), seed=6)
+    assert same_actions(first, again)
+    assert not same_actions(first, single)
+
+
+def test_samples_fall_inside_the_polygon_uniformly() -> None:
+    square = np.array([0, 2, 2 + 1j, 1j], dtype=np.complex128)  # 2 x 1, CCW
+    points = sample_in_polygon(square, 4000, np.random.default_rng(0))
+    assert np.all((points.real >= 0) & (points.real <= 2) & (points.imag >= 0) & (points.imag <= 1))
+    assert abs(points.mean() - (1 + 0.5j)) < 0.03
+    assert abs(np.mean(points.real < 1.0) - 0.5) < 0.03  # uniform, not per-triangle
+    assert sample_in_polygon(square[:1], 3, np.random.default_rng(0)).tolist() == [0j] * 3
