@@ -10,6 +10,9 @@ vector envs and on remote copies. All work on both registered ids:
 - :class:`Parallax`: move across the line of sight of the most uncertain landmark;
 - :class:`GreedyOneStep`: one-step look-ahead on the robot's own map (no ground truth);
 - :class:`GreedyOracle`: the same on the true map (privileged upper reference);
+- :class:`Lookahead`: receding-horizon beam search on the robot's own map, each plan
+  scored over worlds drawn inside the uncertainty regions;
+- :class:`LookaheadOracle`: the same search on the true map (privileged upper reference);
 - :class:`VectorPolicy`: one policy per sub-env of a vector env, with a batched ``act``;
 - :class:`SB3Policy`: a saved stable-baselines3 model; ``SB3Policy.pretrained(name, env)``
   loads one shipped under ``agents/pretrained/`` (:func:`pretrained_names` lists them).
@@ -19,6 +22,7 @@ vector envs and on remote copies. All work on both registered ids:
 
 from .base import ActionCodec, Movement, Policy
 from .heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
+from .lookahead import Lookahead, LookaheadOracle
 from .registry import POLICY_CLASSES, PolicySpec, make_policy, parse_policy_spec
 from .sb3 import ModelLoadError, SB3Policy, pretrained_names, pretrained_record
 from .vector import VectorPolicy
@@ -28,6 +32,8 @@ __all__ = [
     "ActionCodec",
     "GreedyOneStep",
     "GreedyOracle",
+    "Lookahead",
+    "LookaheadOracle",
     "ModelLoadError",
     "Movement",
     "Parallax",
