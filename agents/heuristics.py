@@ -60,6 +60,10 @@ class MovementPolicy:
         self.reader = ObservationReader(env)
         self.maps = MapReader(env)
         self.rng = policy_rng(None)
+        #: Where a privileged policy reads the truth: the env's world (a vector env's
+        #: row, under :class:`~bearing_env.agents.vector.VectorPolicy`). Robot policies
+        #: never call it.
+        self.world_source: Callable[[], WorldView] = partial(world_of, env)
 
     def reset(self, seed: int | None = None) -> None:
         self.rng = policy_rng(seed)
@@ -354,14 +358,6 @@ class GreedyOracle(GreedyOneStep):
 
     name = "greedy_oracle"
     privileged = True
-
-    def __init__(
-        self, env: gym.Env, n_turns: int = 8, lengths: int | tuple[float, ...] = 2
-    ) -> None:
-        super().__init__(env, n_turns, lengths)
-        #: Where the truth comes from: the env's world (a vector env's row, under
-        #: :class:`~bearing_env.agents.vector.VectorPolicy`).
-        self.world_source: Callable[[], WorldView] = partial(world_of, env)
 
     def _choose(self, view: ObservationView, slam: PolygonSLAM) -> Movement:
         world = self.world_source()

@@ -32,19 +32,16 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import partial
 
 import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
-from bearing_env.envs.core import WorldView
-from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM, world_to_fl
-from bearing_env.slam.batch import STATE_ARRAYS
+from bearing_env.slam import PolygonSLAM, world_to_fl
 
 from .base import Movement
 from .belief import ObservationView
-from .env_access import bearing_env_of, world_of
+from .env_access import bearing_env_of
 from .heuristics import GreedyOneStep, bootstrap_movement
 from .planning import bearings_from, uncertainty_potential
 
@@ -80,21 +77,6 @@ def sample_in_polygon(
     flip = u + v > 1.0
     u, v = np.where(flip, 1.0 - u, u), np.where(flip, 1.0 - v, v)
     return np.asarray(a + u * (b[triangle] - a) + v * (c[triangle] - a))
-
-
-def copy_maps(source: BatchedPolygonSLAM, rows: NDArray[np.int64]) -> BatchedPolygonSLAM:
-    """A new batch whose map ``i`` is a copy of ``source``'s map ``rows[i]``."""
-    copies = BatchedPolygonSLAM(
-        rows.size,
-        source.n_landmarks,
-        source.epsilon,
-        transfer=source.transfer,
-        edge_samples=source.edge_samples,
-        on_inconsistency=source.on_inconsistency,
-    )
-    for name in STATE_ARRAYS:
-        getattr(copies, name)[:] = getattr(source, name)[rows]
-    return copies
 
 
 #: Distances (nodes, K, H) in FL units travelled by each candidate from each node's
@@ -144,7 +126,7 @@ def beam_search(
         b2 = np.where(moving, b2, b1)
         rows = (np.arange(n_nodes)[:, None, None] * n_worlds + np.arange(n_worlds)[None, None, :])
         rows = np.broadcast_to(rows, step.shape).reshape(-1)
-        trials = copy_maps(maps, rows.astype(np.int64))
+        trials = maps.take(rows.astype(np.int64))
         n = slam.n_landmarks
         trials.update(
             np.ascontiguousarray(b1.reshape(-1, n)),
@@ -162,7 +144,7 @@ def beam_search(
         keep = order[: min(width, order.size)]
         node_index, k_index = np.unravel_index(keep, scores.shape)
         chosen = (node_index * n_k + k_index)[:, None] * n_worlds + np.arange(n_worlds)[None, :]
-        maps = copy_maps(trials, chosen.reshape(-1).astype(np.int64))
+        maps = trials.take(chosen.reshape(-1).astype(np.int64))
         positions = ends[node_index, k_index]
         headings = new_headings[node_index, k_index]
         firsts = node_firsts[node_index, k_index]
@@ -285,19 +267,6 @@ class LookaheadOracle(Lookahead):
 
     name = "lookahead_oracle"
     privileged = True
-
-    def __init__(
-        self,
-        env: gym.Env,
-        depth: int = 2,
-        width: int = 8,
-        n_turns: int = 24,
-        lengths: int | tuple[float, ...] = 2,
-        hypotheses: int = 1,
-    ) -> None:
-        super().__init__(env, depth, width, n_turns, lengths, hypotheses=1)
-        #: Where the truth comes from (a vector env's row under VectorPolicy).
-        self.world_source: Callable[[], WorldView] = partial(world_of, env)
 
     def _choose(self, view: ObservationView, slam: PolygonSLAM) -> Movement:
         world = self.world_source()

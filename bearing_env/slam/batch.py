@@ -255,6 +255,22 @@ class BatchedPolygonSLAM:
         """The vertices (CCW) of a map's robot region; empty before any frame change."""
         return self.robot_vertices[map_index, : self.robot_counts[map_index]].copy()
 
+    def take(self, maps: ArrayLike) -> BatchedPolygonSLAM:
+        """A new batch whose map ``i`` is a copy of map ``maps[i]`` (indices may repeat):
+        for planning, many candidates from each of a few maps."""
+        rows = self._check_maps(maps, distinct=False)
+        copies = BatchedPolygonSLAM(
+            rows.size,
+            self.n_landmarks,
+            self.epsilon,
+            transfer=self.transfer,
+            edge_samples=self.edge_samples,
+            on_inconsistency=self.on_inconsistency,
+        )
+        for name in STATE_ARRAYS:
+            getattr(copies, name)[:] = getattr(self, name)[rows]
+        return copies
+
     def _state_arrays(self) -> tuple[NDArray[Any], ...]:
         """The state in the kernels' argument order (see :data:`STATE_ARRAYS`)."""
         d = self.__dict__

@@ -14,7 +14,6 @@ from bearing_env.slam.batch import (
     FRAME_STATUSES,
     INCONSISTENCY_POLICIES,
     LANDMARK_STATUSES,
-    STATE_ARRAYS,
     BatchedPolygonSLAM,
     check_bearings,
 )
@@ -193,18 +192,7 @@ class PolygonSLAM:
         For planning: score many candidate movements with one batched
         :meth:`BatchedPolygonSLAM.update`, each candidate on its own copy.
         """
-        batch = self._batch
-        copies = BatchedPolygonSLAM(
-            count,
-            batch.n_landmarks,
-            batch.epsilon,
-            transfer=batch.transfer,
-            edge_samples=batch.edge_samples,
-            on_inconsistency=batch.on_inconsistency,
-        )
-        for name in STATE_ARRAYS:
-            getattr(copies, name)[:] = getattr(batch, name)[self._index]
-        return copies
+        return self._batch.take(np.full(count, self._index, dtype=np.int64))
 
     @property
     def n_updates(self) -> int:
