@@ -10,15 +10,11 @@ import pytest
 import torch
 from bearing_env.agents import SB3Policy
 from bearing_env.agents.extractors import LandmarkSetExtractor, LandmarkSetPolicy
-from bearing_env.train.train import (
-    TrainSettings,
-    parse_hyperparameters,
-    read_hyperparameters,
-    train,
-)
+from bearing_env.train.train import parse_hyperparameters, read_hyperparameters, train
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.envs.core import ENTITY_FEATURES
+from tests.test_train import TINY_TIMESTEPS, tiny_settings
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 CONF_FILE = REPO_ROOT / "train" / "hyperparams" / "ppo_entities.yml"
@@ -77,10 +73,10 @@ def test_the_entities_config_names_the_policy_class() -> None:
 
 
 def test_a_tiny_run_trains_and_its_model_plays_other_landmark_counts(tmp_path: Path) -> None:
-    settings = TrainSettings(
-        algo="ppo",
+    settings = tiny_settings(
+        "ppo",
+        tmp_path / "run",
         env_id="BearingSLAM-v0",
-        output=tmp_path / "run",
         conf_file=CONF_FILE,
         hyperparam_overrides={
             "n_steps": 64,
@@ -88,18 +84,9 @@ def test_a_tiny_run_trains_and_its_model_plays_other_landmark_counts(tmp_path: P
             "n_epochs": 2,
             "policy_kwargs": "dict(features_extractor_kwargs=dict(hidden=16, features_dim=16))",
         },
-        timesteps=256,
-        seed=3,
-        n_envs=2,
-        eval_freq=128,
-        eval_episodes=2,
-        checkpoint_freq=128,
-        progress_bar=False,
-        tensorboard=False,
-        verbose=0,
     )
     result = train(settings)
-    assert result.num_timesteps == 256
+    assert result.num_timesteps == TINY_TIMESTEPS
     assert isinstance(result.model.policy.features_extractor, LandmarkSetExtractor)
     for count in (3, 16):
         env = gym.make(
