@@ -42,7 +42,7 @@ from bearing_env.slam import PolygonSLAM, world_to_fl
 from .base import Movement
 from .belief import ObservationView
 from .env_access import bearing_env_of
-from .heuristics import GreedyOneStep, bootstrap_movement
+from .heuristics import GreedyOneStep, _allowed_turns, bootstrap_movement
 from .planning import bearings_from, uncertainty_potential
 
 FloatArray = NDArray[np.float64]
@@ -223,7 +223,7 @@ class Lookahead(GreedyOneStep):
     ) -> Movement:
         turns = np.array([c.turn for c in self.candidates])
         lengths = np.array([c.length for c in self.candidates])
-        allowed = np.isin(np.arange(len(self.candidates)), self._allowed_indices(view))
+        allowed = _allowed_turns(turns, view)
         first, score = beam_search(
             slam, worlds, heading, turns, lengths, allowed, mover, self.depth, self.width,
             self.area_cap,
@@ -231,10 +231,6 @@ class Lookahead(GreedyOneStep):
         if first < 0 or score >= uncertainty_potential(slam.areas, self.area_cap):
             return bootstrap_movement(self.codec, view)
         return self.candidates[first]
-
-    def _allowed_indices(self, view: ObservationView) -> list[int]:
-        allowed = {id(c) for c in self._allowed(view)}
-        return [index for index, c in enumerate(self.candidates) if id(c) in allowed]
 
     def _worlds(self, slam: PolygonSLAM, position: complex) -> Worlds:
         n_draws = self.hypotheses - 1
