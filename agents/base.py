@@ -2,8 +2,9 @@
 
 A policy is built from the env it acts in, ``Policy(env, **options)``, and then driven
 with ``reset(seed)`` at the start of every episode and ``act(observation, info)`` at
-every step. ``info`` is passed because some policies (trained agents, wrappers) may want
-it, but it holds ground truth: the heuristics here never read it.
+every step. ``info`` holds the robot's own map (``info["robot_map"]``, what the map-based
+policies read: see :mod:`bearing_env.agents.env_access`) and ground truth for evaluation,
+which robot policies never read.
 
 Policies choose a *movement* as a turn (radians, counter-clockwise, relative to the
 current heading) and a length (metres); :class:`ActionCodec` turns that into the env's

@@ -34,13 +34,16 @@ has a relative error of about epsilon / parallax.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env.envs.bearing_slam import BEARING_FEATURES, ROBOT_FEATURES, observation_slices
+from bearing_env.envs.core import ENTITY_FEATURES
 from bearing_env.slam import PolygonSLAM
 
 from .base import Movement, wrap_angle
@@ -52,6 +55,7 @@ MIN_PARALLAX_EPSILONS = 4.0
 _PROGRESS = ROBOT_FEATURES.index("progress")
 _FRAME_CHANGED = ROBOT_FEATURES.index("last_frame_changed")
 _BLOCKED = ROBOT_FEATURES.index("last_move_blocked")
+_BEARING_PRESENT = BEARING_FEATURES.index("present")
 _BEARING_COS = BEARING_FEATURES.index("cos")
 _BEARING_SIN = BEARING_FEATURES.index("sin")
 
@@ -66,23 +70,45 @@ class ObservationView:
     #: Latest bearings (n_landmarks,), radians, relative to the current heading.
     bearings: NDArray[np.float64]
 
+    @property
+    def n_landmarks(self) -> int:
+        """Landmarks in this episode (the bearing slots flagged present)."""
+        return int(self.bearings.size)
+
 
 class ObservationReader:
-    """Parses the env's observation vector (layout: ``BearingSLAMEnv`` docstring)."""
+    """Parses the env's observation vector (layout: ``BearingSLAMEnv`` docstring).
+
+    The landmark count is read from every observation (its bearing slots' ``present``
+    flags), not fixed when the reader is built: with ``n_landmarks=(lo, hi)`` it changes
+    from episode to episode, and the empty slots beyond it are not landmarks at bearing 0.
+    """
 
     def __init__(self, env: gym.Env) -> None:
         base = bearing_env_of(env)
-        self.n_landmarks = int(base.n_landmarks)
         self.bearing_block = observation_slices(int(base.max_landmarks))["bearings"]
 
-    def read(self, observation: NDArray[np.float32]) -> ObservationView:
-        obs = np.asarray(observation, dtype=np.float64)
-        bearings = obs[self.bearing_block].reshape(-1, len(BEARING_FEATURES))[: self.n_landmarks]
+    def read(self, observation: NDArray[np.float32] | Mapping[str, Any]) -> ObservationView:
+        """The view of a flat observation, or of an entity one (``observation="entities"``)."""
+        if isinstance(observation, Mapping):
+            robot = np.asarray(observation["robot"], dtype=np.float64)
+            table = np.asarray(observation["landmarks"], dtype=np.float64)
+            table = table.reshape(-1, len(ENTITY_FEATURES))
+            present, cos, sin = (
+                ENTITY_FEATURES.index(name) for name in ("present", "bearing_cos", "bearing_sin")
+            )
+        else:
+            obs = np.asarray(observation, dtype=np.float64)
+            robot = obs
+            table = obs[self.bearing_block].reshape(-1, len(BEARING_FEATURES))
+            present, cos, sin = _BEARING_PRESENT, _BEARING_COS, _BEARING_SIN
+        # The env fills slots L1, L2, ... in order, so the present ones come first.
+        bearings = table[: int(np.count_nonzero(table[:, present] > 0.5))]
         return ObservationView(
-            progress=float(obs[_PROGRESS]),
-            frame_changed=bool(obs[_FRAME_CHANGED] > 0.5),
-            blocked=bool(obs[_BLOCKED] > 0.5),
-            bearings=np.arctan2(bearings[:, _BEARING_SIN], bearings[:, _BEARING_COS]),
+            progress=float(robot[_PROGRESS]),
+            frame_changed=bool(robot[_FRAME_CHANGED] > 0.5),
+            blocked=bool(robot[_BLOCKED] > 0.5),
+            bearings=np.arctan2(bearings[:, sin], bearings[:, cos]),
         )
 
 

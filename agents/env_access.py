@@ -1,21 +1,32 @@
 """The one place where policies reach into the env, split by what the robot may know.
 
-The env exposes the robot's map as ``env.unwrapped.slam`` and the ground truth as
-``env.unwrapped.world``; this module keeps the two apart for policies.
+The robot's own map (landmark regions and estimates in FL, its own region and heading
+estimate) reaches policies as data: every info carries it as ``info["robot_map"]`` (the
+map's state arrays; see the env's Info section), and :class:`MapReader` rebuilds a
+:class:`~bearing_env.slam.PolygonSLAM` from it. That works wherever an info goes: on the
+vector envs (one row of the batched infos), across processes and on pickled copies, with
+no reference to the live env. The rest of an info is ground truth (areas, errors):
+robot policies read ``info["robot_map"]`` only.
 
-- :func:`slam_of` is the robot's own knowledge: its map (landmark regions and estimates
-  in FL, its own region and heading estimate). Any policy may read it.
 - :func:`world_of` is ground truth (true landmark positions, the robot's true pose). Only
   policies labelled *privileged* (:class:`agents.GreedyOracle`) may read it.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any
+
 import gymnasium as gym
+import numpy as np
 
 from bearing_env.envs.bearing_slam import BearingSLAMEnv
-from bearing_env.envs.core import WorldView
+from bearing_env.envs.core import ROBOT_MAP_UNKNOWN_AS_INF, WorldView
 from bearing_env.slam import PolygonSLAM
+from bearing_env.slam.batch import LANDMARK_AXES, STATE_ARRAYS
+
+#: The one key of an info that robot policies read: the robot's own map.
+ROBOT_MAP_KEY = "robot_map"
 
 
 def bearing_env_of(env: gym.Env) -> BearingSLAMEnv:
@@ -29,11 +40,6 @@ def bearing_env_of(env: gym.Env) -> BearingSLAMEnv:
     return base
 
 
-def slam_of(env: gym.Env) -> PolygonSLAM:
-    """The robot's map (what the robot knows)."""
-    return bearing_env_of(env).slam
-
-
 def world_of(env: gym.Env) -> WorldView:
     """Ground truth (a read-only live view): privileged policies only. RuntimeError
     before the first reset."""
@@ -41,3 +47,42 @@ def world_of(env: gym.Env) -> WorldView:
     if world is None:
         raise RuntimeError("the env has no world yet: call env.reset() first")
     return world
+
+
+class MapReader:
+    """Rebuilds the robot's map from ``info["robot_map"]`` (see the module doc).
+
+    Built from the env (any wrapper stack) only to read the map's settings (epsilon,
+    transfer, fusion, ...); :meth:`read` then needs nothing but the info and the landmark
+    count (the observation's present bearing slots).
+    """
+
+    def __init__(self, env: gym.Env) -> None:
+        base = bearing_env_of(env)
+        #: The world model's keyword settings (epsilon, transfer, fusion, ...).
+        self.map_settings = dict(base.config.map_settings)
+
+    def read(self, info: Mapping[str, Any], n_landmarks: int) -> PolygonSLAM:
+        """The map of an info (an independent copy: the policy may update it)."""
+        if ROBOT_MAP_KEY not in info:
+            raise KeyError(
+                f"the info has no {ROBOT_MAP_KEY!r} (keys: {sorted(info)}): pass the info "
+                "the env returned with this observation"
+            )
+        state = info[ROBOT_MAP_KEY]
+        slam = PolygonSLAM(int(n_landmarks), **self.map_settings)
+        batch, mapped = slam.batch, int(n_landmarks) - 2
+        for name in STATE_ARRAYS:
+            target = getattr(batch, name)
+            values = np.array(state[name])
+            if name in LANDMARK_AXES:  # the info's arrays have no map axis
+                values = np.take(values, np.arange(mapped), axis=LANDMARK_AXES[name] - 1)
+            if target.dtype.kind == "c":  # (x, y) pairs back to complex
+                points = np.asarray(values[..., 0], dtype=np.complex128)
+                points.imag = values[..., 1]
+                values = points
+            if name in ROBOT_MAP_UNKNOWN_AS_INF:
+                unknown = complex(np.nan, np.nan) if values.dtype.kind == "c" else np.nan
+                values[np.isinf(values)] = unknown  # back to the map's "unknown"
+            target[0] = values
+        return slam

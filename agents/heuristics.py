@@ -4,12 +4,15 @@ and the one-step greedy planners (on the robot's map, and on the true map)."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
+from bearing_env.envs.core import WorldView
 from bearing_env.slam import PolygonSLAM, world_to_fl
 
 from .base import Action, ActionCodec, Movement, policy_rng, wrap_angle
@@ -20,7 +23,7 @@ from .belief import (
     RobotBelief,
     spread_turn,
 )
-from .env_access import bearing_env_of, slam_of, world_of
+from .env_access import MapReader, bearing_env_of, world_of
 from .planning import (
     SimulatedMove,
     landmark_positions_fl,
@@ -39,7 +42,13 @@ INWARD_AFTER_BLOCK = math.pi / 3
 
 
 class MovementPolicy:
-    """Shared plumbing: the action codec, the observation reader and the policy's rng."""
+    """Shared plumbing: the action codec, the observation and map readers and the rng.
+
+    Subclasses act on the observation and on ``info["robot_map"]`` (the robot's own map,
+    see :mod:`bearing_env.agents.env_access`), never on the live env: they run the same on
+    a vector env's rows (:class:`bearing_env.agents.vector.VectorPolicy`) and on remote or
+    pickled copies of the env.
+    """
 
     name = "movement_policy"
     #: True for policies that read ground truth (an upper reference, not a robot policy).
@@ -49,7 +58,12 @@ class MovementPolicy:
         self.env = env
         self.codec = ActionCodec(env)
         self.reader = ObservationReader(env)
+        self.maps = MapReader(env)
         self.rng = policy_rng(None)
+        #: Where a privileged policy reads the truth: the env's world (a vector env's
+        #: row, under :class:`~bearing_env.agents.vector.VectorPolicy`). Robot policies
+        #: never call it.
+        self.world_source: Callable[[], WorldView] = partial(world_of, env)
 
     def reset(self, seed: int | None = None) -> None:
         self.rng = policy_rng(seed)
@@ -206,7 +220,7 @@ class Parallax(MovementPolicy):
     def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
         view = self.reader.read(observation)
         self.belief.observe(view)
-        slam = slam_of(self.env)
+        slam = self.maps.read(info, view.n_landmarks)
         pose = self.belief.pose(slam)
         if pose is None:
             movement = bootstrap_movement(self.codec, view)
@@ -262,7 +276,8 @@ class GreedyOneStep(MovementPolicy):
     see :mod:`bearing_env.agents.belief`) and takes the move whose predicted sum of capped log areas
     is lowest, i.e. the largest expected decrease of the env's default potential.
     Landmarks not yet initialised count at the env's ``area_cap`` and cannot be simulated
-    (no predicted progress). It never reads ground truth: no ``info``, no world.
+    (no predicted progress). It never reads ground truth: of ``info`` only the robot's
+    own map (``info["robot_map"]``), no world.
 
     Before the first movement that changes frames (no map, no pose, or no FL scale yet)
     it makes the bootstrap move (longest length, every landmark away from the line of
@@ -303,12 +318,11 @@ class GreedyOneStep(MovementPolicy):
     def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
         view = self.reader.read(observation)
         self.belief.observe(view)
-        movement = self._choose(view)
+        movement = self._choose(view, self.maps.read(info, view.n_landmarks))
         self.belief.commanded(movement, view)
         return movement.action
 
-    def _choose(self, view: ObservationView) -> Movement:
-        slam = slam_of(self.env)
+    def _choose(self, view: ObservationView, slam: PolygonSLAM) -> Movement:
         pose = self.belief.pose(slam)
         if pose is None or pose.metres_per_unit is None:
             return bootstrap_movement(self.codec, view)
@@ -345,8 +359,8 @@ class GreedyOracle(GreedyOneStep):
     name = "greedy_oracle"
     privileged = True
 
-    def _choose(self, view: ObservationView) -> Movement:
-        world = world_of(self.env)
+    def _choose(self, view: ObservationView, slam: PolygonSLAM) -> Movement:
+        world = self.world_source()
         l1, l2 = world.landmarks[0], world.landmarks[1]
         baseline = complex(*(l2 - l1))
         metres_per_unit = abs(baseline)
@@ -361,7 +375,6 @@ class GreedyOracle(GreedyOneStep):
             if travelled < world.min_baseline:
                 travelled = 0.0
             moves.append(SimulatedMove(heading_fl + candidate.turn, travelled / metres_per_unit))
-        slam = slam_of(self.env)
         potentials = simulate_potentials(
             slam,
             complex(position[0], position[1]),

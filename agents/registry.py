@@ -5,6 +5,7 @@ A *policy spec* is a string ``NAME[:KEY=VALUE[,KEY=VALUE...]]``:
     random                          RandomPolygonal with its defaults
     random:length=0.25              fixed 25 cm moves
     greedy:n_turns=16,lengths=1     GreedyOneStep with 16 turns at the longest length
+    lookahead:depth=3,hypotheses=6  Lookahead, a deeper search over more worlds
     sb3:path=runs/ppo/best_model.zip
     sb3:runs/ppo/best_model.zip     (sb3 only: a bare value is the path)
     pretrained:ppo_khepera          a model shipped under agents/pretrained/, by name
@@ -24,6 +25,7 @@ import gymnasium as gym
 
 from .base import Policy
 from .heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
+from .lookahead import Lookahead, LookaheadOracle
 from .sb3 import SB3Policy
 
 
@@ -41,6 +43,8 @@ POLICY_CLASSES: dict[str, Any] = {
     "greedy_one_step": GreedyOneStep,
     "oracle": GreedyOracle,
     "greedy_oracle": GreedyOracle,
+    "lookahead": Lookahead,
+    "lookahead_oracle": LookaheadOracle,
     "sb3": SB3Policy,
     "pretrained": pretrained_policy,
 }

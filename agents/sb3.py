@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import pickle
 import zipfile
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -122,7 +123,7 @@ def infer_algorithm(model_path: Path) -> str:
         return _ALGORITHM_BY_POLICY_MODULE[module]
     if module.startswith("sb3_contrib.common.recurrent"):
         return "RecurrentPPO"
-    if module == "stable_baselines3.common.policies":
+    if module in ("stable_baselines3.common.policies", "bearing_env.agents.extractors"):
         # Actor-critic: PPO and A2C share the policy; PPO alone saves n_epochs.
         return "PPO" if "n_epochs" in data else "A2C"
     raise ModelLoadError(
@@ -246,10 +247,16 @@ class SB3Policy:
 
             torch.manual_seed(int(seed))
 
-    def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
-        obs = np.asarray(observation, dtype=np.float32)
+    def act(
+        self, observation: NDArray[np.float32] | Mapping[str, Any], info: dict[str, Any]
+    ) -> Action:
+        obs: Any
+        if isinstance(observation, Mapping):  # the entity observation
+            obs = {key: np.asarray(value, dtype=np.float32) for key, value in observation.items()}
+        else:
+            obs = np.asarray(observation, dtype=np.float32)
         if self.obs_normalizer is not None:
-            obs = np.asarray(self.obs_normalizer.normalize_obs(obs), dtype=np.float32)
+            obs = self.obs_normalizer.normalize_obs(obs)
         action, _ = self.model.predict(obs, deterministic=self.deterministic)
         if self.discrete:
             return int(np.asarray(action).reshape(-1)[0])

@@ -24,15 +24,20 @@ from bearing_env.agents import (
     make_policy,
     parse_policy_spec,
 )
-from bearing_env.agents.belief import scale_sample, triangulate_fr
+from bearing_env.agents.belief import ObservationReader, scale_sample, triangulate_fr
+from bearing_env.agents.env_access import MapReader
+from bearing_env.agents.lookahead import Lookahead, LookaheadOracle, sample_in_polygon
+from bearing_env.agents.vector import VectorPolicy
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.slam import world_to_fl
 
 ENV_IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
-HEURISTICS = (RandomPolygonal, Parallax, GreedyOneStep, GreedyOracle)
+HEURISTICS = (RandomPolygonal, Parallax, GreedyOneStep, GreedyOracle, Lookahead, LookaheadOracle)
 #: Policies that must act on the robot's knowledge only.
-ROBOT_POLICIES = (RandomPolygonal, Parallax, GreedyOneStep)
+ROBOT_POLICIES = (RandomPolygonal, Parallax, GreedyOneStep, Lookahead)
+#: The privileged upper references (they read ground truth).
+ORACLES = (GreedyOracle, LookaheadOracle)
 
 
 def play(env: gym.Env, policy: Any, seed: int) -> tuple[list[Any], dict[str, Any], int]:
@@ -148,12 +153,27 @@ class PoisonedWorld:
 
 
 class PoisonedInfo(dict):
-    """An info dict whose every read is a failure (info holds ground truth)."""
+    """An info dict whose every read is a failure (info holds ground truth), but for the
+    robot's own map (``info["robot_map"]``), which it holds when built from a real info."""
+
+    def __init__(self, info: dict[str, Any] | None = None) -> None:
+        super().__init__()
+        self._robot_map = None if info is None else info["robot_map"]
 
     def _fail(self, *args: Any, **kwargs: Any) -> Any:
-        raise GroundTruthRead("the policy read info")
+        raise GroundTruthRead("the policy read info beyond the robot's map")
 
-    __getitem__ = get = keys = items = values = __contains__ = __iter__ = _fail  # type: ignore[assignment]
+    def __getitem__(self, key: str) -> Any:
+        if key == "robot_map" and self._robot_map is not None:
+            return self._robot_map
+        raise GroundTruthRead(f"the policy read info[{key!r}]")
+
+    def __contains__(self, key: object) -> bool:
+        if key == "robot_map" and self._robot_map is not None:
+            return True
+        raise GroundTruthRead(f"the policy asked for info[{key!r}]")
+
+    get = keys = items = values = __iter__ = _fail  # type: ignore[assignment]
 
 
 def _corrupted_world(world: Any, rng: np.random.Generator) -> Any:
@@ -179,7 +199,7 @@ def play_with_truth_swapped(
         true_world = base._world
         base._world = replacement(true_world)
         try:
-            action = policy.act(observation, PoisonedInfo() if poison_info else info)
+            action = policy.act(observation, PoisonedInfo(info) if poison_info else info)
         finally:
             base._world = true_world
         actions.append(copy.deepcopy(action))
@@ -210,18 +230,104 @@ def test_corrupting_the_truth_does_not_change_robot_policies(policy_class: type)
         assert same_actions(reference, corrupted)
 
 
-def test_the_oracle_does_read_the_truth() -> None:
-    # The swap above is a real test: the privileged oracle's choices do change with it.
+@pytest.mark.parametrize("oracle_class", ORACLES, ids=lambda c: c.__name__)
+def test_the_oracle_does_read_the_truth(oracle_class: type) -> None:
+    # The swap above is a real test: the privileged oracles' choices do change with it.
     env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=6, max_episode_steps=6)
-    assert GreedyOracle.privileged and not GreedyOneStep.privileged
-    reference, _, _ = play(env, GreedyOracle(env), seed=1)
+    assert oracle_class.privileged and not GreedyOneStep.privileged and not Lookahead.privileged
+    reference, _, _ = play(env, oracle_class(env), seed=1)
     rng = np.random.default_rng(0)
     corrupted = play_with_truth_swapped(
-        env, GreedyOracle(env), 1, lambda w: _corrupted_world(w, rng), poison_info=False
+        env, oracle_class(env), 1, lambda w: _corrupted_world(w, rng), poison_info=False
     )
     assert not same_actions(reference, corrupted)
     with pytest.raises(GroundTruthRead):
-        play_with_truth_swapped(env, GreedyOracle(env), 1, lambda _: PoisonedWorld(), False)
+        play_with_truth_swapped(env, oracle_class(env), 1, lambda _: PoisonedWorld(), False)
+
+
+def test_a_poisoned_info_does_fail_on_ground_truth() -> None:
+    # The whitelist above is a real test: reading any other key of it fails.
+    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    _, info = env.reset(seed=0)
+    poisoned = PoisonedInfo(info)
+    assert poisoned["robot_map"] is info["robot_map"]
+    for key in ("total_area", "landmark_error", "robot_error"):
+        with pytest.raises(GroundTruthRead):
+            poisoned[key]
+
+
+@pytest.mark.parametrize(
+    "map_kwargs",
+    [{}, {"fusion": "relaxed", "noise": {"kind": "uniform", "outlier_rate": 0.1}}],
+    ids=["intersect", "relaxed"],
+)
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_the_robot_map_in_info_is_the_robots_map_and_holds_no_truth(
+    env_id: str, map_kwargs: dict[str, Any]
+) -> None:
+    env = gym.make(env_id, scenario="khepera", max_moves=10, max_episode_steps=10, **map_kwargs)
+    base = env.unwrapped
+    policy = GreedyOneStep(env)
+    reader = MapReader(env)
+    observation, info = env.reset(seed=3)
+    policy.reset(seed=3)
+    terminated = truncated = False
+    while not (terminated or truncated):
+        live = base.slam
+        rebuilt = reader.read(info, base.n_landmarks)
+        # The same map, bit for bit, as the robot's own...
+        for name in ("areas", "estimates", "robot_estimate", "robot_area", "robot_heading"):
+            assert np.array_equal(getattr(rebuilt, name), getattr(live, name), equal_nan=True)
+        for mine, theirs in zip(rebuilt.polygons, live.polygons, strict=True):
+            assert (mine is None and theirs is None) or np.array_equal(mine, theirs)
+        assert np.array_equal(rebuilt.robot_polygon, live.robot_polygon)  # type: ignore[arg-type]
+        assert (rebuilt.n_updates, rebuilt.n_frame_changes) == (
+            live.n_updates,
+            live.n_frame_changes,
+        )
+        assert np.array_equal(rebuilt.outliers, live.outliers)
+        # ...and no array of it holds a true position (FL landmarks or robot).
+        world = base.world
+        l1, l2 = world.landmarks[0], world.landmarks[1]
+        truths = world_to_fl(np.vstack([world.landmarks[2:], world.position[None]]), l1, l2)
+        for name, values in info["robot_map"].items():
+            points = np.asarray(values)
+            if points.shape[-1:] == (2,):  # FL points as (x, y)
+                for truth in truths:
+                    hits = np.all(np.abs(points.reshape(-1, 2) - truth) < 1e-9, axis=1)
+                    assert not np.any(hits), name
+        action = policy.act(observation, info)
+        observation, _, terminated, truncated, info = env.step(action)
+    # A copy of the env (pickled, as a remote worker would get it) gives the same map data.
+    clone = pickle.loads(pickle.dumps(env))
+    assert np.array_equal(
+        clone.unwrapped.slam.batch.vertices[0], base.slam.batch.vertices[0], equal_nan=True
+    )
+
+
+@pytest.mark.parametrize("seed", [1, 3, 4])
+def test_no_phantom_landmarks_when_the_count_varies(seed: int) -> None:
+    # One reader, built once, for episodes of 3 to 8 landmarks: the count is read from
+    # each observation's present flags (it used to be fixed at build time, which gave
+    # phantom landmarks at bearing 0 in the empty slots).
+    env = gym.make("BearingSLAM-v0", n_landmarks=(3, 8))
+    reader = ObservationReader(env)
+    counts = set()
+    for episode in range(6):
+        observation, _ = env.reset(seed=seed + 7 * episode)
+        view = reader.read(observation)
+        n = env.unwrapped.n_landmarks
+        counts.add(n)
+        assert view.n_landmarks == n
+        truth = env.unwrapped.world.true_bearings()
+        gap = np.abs(np.angle(np.exp(1j * (view.bearings - truth))))
+        assert np.all(gap <= env.unwrapped.epsilon + 1e-6)
+    assert len(counts) > 1  # the count did vary
+    # The policies built once run on every count (their map is sized by the observation).
+    for policy_class in HEURISTICS:
+        policy = policy_class(env)
+        for episode in range(3):
+            play(env, policy, seed + 7 * episode)
 
 
 # --------------------------------------------------------------------------------------
@@ -454,3 +560,112 @@ def test_sb3_policy_load_errors(tiny_ppo: Path, tmp_path: Path) -> None:
     with pytest.raises(ModelLoadError, match="expects observations"):
         SB3Policy(wide, tiny_ppo)
     assert issubclass(ModelLoadError, ValueError)
+
+
+# --------------------------------------------------------------------------------------
+# Vector envs: a batched act
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("policy_class", HEURISTICS, ids=lambda c: c.__name__)
+def test_vector_policy_acts_like_one_policy_per_sub_env(env_id: str, policy_class: type) -> None:
+    # Sub-env i of the vector env, seeded seed + i, with its own policy, takes the actions
+    # the same policy takes on the single env seeded seed + i.
+    kwargs = {"scenario": "khepera", "max_moves": 5}
+    vector_env = gym.make_vec(env_id, num_envs=3, **kwargs)
+    policy = VectorPolicy(vector_env, policy_class)
+    observations, infos = vector_env.reset(seed=20)
+    policy.reset(seed=20)
+    actions: list[list[Any]] = [[], [], []]
+    for _ in range(5):
+        batch = policy.act(observations, infos)
+        assert vector_env.action_space.contains(batch)
+        for row in range(3):
+            actions[row].append(batch[row])
+        observations, _, _, _, infos = vector_env.step(batch)
+    single = gym.make(env_id, max_episode_steps=5, **kwargs)
+    for row in range(3):
+        expected, _, _ = play(single, policy_class(single), seed=20 + row)
+        assert same_actions(actions[row][: len(expected)], expected)
+
+
+def test_vector_policy_runs_on_varying_counts_and_sync_vector_envs() -> None:
+    for vector_env in (
+        gym.make_vec("BearingSLAM-v0", num_envs=2, n_landmarks=(3, 8), max_moves=4),
+        gym.make_vec("BearingSLAM-v0", num_envs=2, vectorization_mode="sync", scenario="khepera"),
+    ):
+        policy = VectorPolicy(vector_env, GreedyOneStep)
+        observations, infos = vector_env.reset(seed=1)
+        policy.reset(seed=1)
+        for _ in range(9):  # through an autoreset
+            observations, _, _, _, infos = vector_env.step(policy.act(observations, infos))
+    with pytest.raises(TypeError, match="VectorEnv"):
+        VectorPolicy(gym.make("BearingSLAM-v0"), GreedyOneStep)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("policy_class", HEURISTICS, ids=lambda c: c.__name__)
+def test_policies_act_alike_on_the_entity_observation(env_id: str, policy_class: type) -> None:
+    kwargs = {"scenario": "khepera", "max_moves": 6, "max_episode_steps": 6}
+    flat = gym.make(env_id, **kwargs)
+    entities = gym.make(env_id, observation="entities", **kwargs)
+    reference, _, _ = play(flat, policy_class(flat), seed=9)
+    actions, _, _ = play(entities, policy_class(entities), seed=9)
+    assert same_actions(reference, actions)
+    vector_env = gym.make_vec(env_id, num_envs=2, observation="entities", scenario="khepera")
+    policy = VectorPolicy(vector_env, policy_class)
+    observations, infos = vector_env.reset(seed=9)
+    policy.reset(seed=9)
+    batch = policy.act(observations, infos)
+    assert vector_env.action_space.contains(batch)
+    assert np.array_equal(np.asarray(batch[0]), np.asarray(reference[0]))
+
+
+# --------------------------------------------------------------------------------------
+# Lookahead
+# --------------------------------------------------------------------------------------
+
+
+def test_lookahead_of_depth_one_in_one_world_is_the_greedy_planner() -> None:
+    # One move ahead, scored at the estimates only, over GreedyOneStep's candidates: the
+    # same decisions (the search is a generalisation, not a different rule).
+    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=10, max_episode_steps=10)
+    for seed in (2, 5):
+        greedy, _, _ = play(env, GreedyOneStep(env), seed)
+        one_step, _, _ = play(env, Lookahead(env, depth=1, hypotheses=1, n_turns=8), seed)
+        assert same_actions(greedy, one_step)
+
+
+def test_lookahead_options_and_planning_times() -> None:
+    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=5, max_episode_steps=5)
+    policy = Lookahead(env, depth=3, width=4, n_turns=12, lengths=2, hypotheses=3)
+    assert len(policy.candidates) == 24
+    _, _, moves = play(env, policy, seed=4)
+    # Every move after the bootstrap is planned, and timed.
+    assert 1 <= len(policy.planning_times) <= moves
+    assert all(t > 0.0 for t in policy.planning_times)
+    for bad in ({"depth": 0}, {"width": -1}, {"hypotheses": 1.5}, {"depth": True}):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            Lookahead(env, **bad)
+    spec = make_policy("lookahead:depth=3,hypotheses=2", env)
+    assert isinstance(spec, Lookahead) and (spec.depth, spec.hypotheses) == (3, 2)
+    assert isinstance(make_policy("lookahead_oracle", env), LookaheadOracle)
+
+
+def test_hypotheses_change_the_plans_and_follow_the_seed() -> None:
+    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=8, max_episode_steps=8)
+    single, _, _ = play(env, Lookahead(env, hypotheses=1), seed=6)
+    first, _, _ = play(env, Lookahead(env, hypotheses=4), seed=6)
+    again, _, _ = play(env, Lookahead(env, hypotheses=4), seed=6)
+    assert same_actions(first, again)
+    assert not same_actions(first, single)
+
+
+def test_samples_fall_inside_the_polygon_uniformly() -> None:
+    square = np.array([0, 2, 2 + 1j, 1j], dtype=np.complex128)  # 2 x 1, CCW
+    points = sample_in_polygon(square, 4000, np.random.default_rng(0))
+    assert np.all((points.real >= 0) & (points.real <= 2) & (points.imag >= 0) & (points.imag <= 1))
+    assert abs(points.mean() - (1 + 0.5j)) < 0.03
+    assert abs(np.mean(points.real < 1.0) - 0.5) < 0.03  # uniform, not per-triangle
+    assert sample_in_polygon(square[:1], 3, np.random.default_rng(0)).tolist() == [0j] * 3

@@ -25,6 +25,7 @@ from bearing_env.envs.bearing_slam import (
     AREA_FLOOR,
     DEFAULT_AREA_CAP,
     DEFAULT_MAX_MOVES,
+    ROBOT_FEATURES,
     observation_size,
     observation_slices,
 )
@@ -45,6 +46,7 @@ INFO_KEYS = {
     "inconsistent",
     "outliers",
     "path_length",
+    "robot_map",
     "rewards",
 }
 
@@ -88,20 +90,22 @@ def test_make_by_module_prefixed_id_without_importing_first() -> None:
 # --------------------------------------------------------------------------------------
 
 
+@pytest.mark.parametrize("observation", ["flat", "entities"])
 @pytest.mark.parametrize("env_id", ENV_IDS)
-def test_gymnasium_check_env_without_warnings(env_id: str) -> None:
-    env = gym.make(env_id)
+def test_gymnasium_check_env_without_warnings(env_id: str, observation: str) -> None:
+    env = gym.make(env_id, observation=observation)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env.unwrapped)
     env.close()
 
 
+@pytest.mark.parametrize("observation", ["flat", "entities"])
 @pytest.mark.parametrize("env_id", ENV_IDS)
-def test_sb3_check_env_without_warnings(env_id: str) -> None:
+def test_sb3_check_env_without_warnings(env_id: str, observation: str) -> None:
     from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
-    env = gym.make(env_id)
+    env = gym.make(env_id, observation=observation)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         sb3_check_env(env)
@@ -259,6 +263,7 @@ def test_info_keys_and_shapes() -> None:
         assert isinstance(info["inconsistent"], int)
         assert 0.0 <= info["path_length"] <= env.move_length[1]
         assert reward == pytest.approx(sum(info["rewards"].values()))
+        assert info["robot_map"]["vertices"].shape[:-2] == info["robot_map"]["counts"].shape
         # Not initialised <=> infinite area <=> infinite error.
         assert np.array_equal(np.isinf(info["landmark_area"]), np.isinf(info["landmark_error"]))
 
@@ -703,3 +708,81 @@ def test_an_env_from_a_read_only_unpickle_still_steps(env_id: str) -> None:
     clone = _read_only_clone(env)
     for action in actions:
         assert_same(env.step(action), clone.step(action))
+
+
+# --------------------------------------------------------------------------------------
+# The entity observation
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_entity_observation_is_the_flat_one_rearranged(env_id: str) -> None:
+    from gymnasium.wrappers import FlattenObservation
+
+    from bearing_env.envs.core import ENTITY_FEATURES
+
+    flat_env = gym.make(env_id, n_landmarks=(3, 6), max_landmarks=7)
+    entity_env = gym.make(env_id, n_landmarks=(3, 6), max_landmarks=7, observation="entities")
+    assert isinstance(entity_env.observation_space, gym.spaces.Dict)
+    slots, width = 7, len(ENTITY_FEATURES)
+    column = {name: index for index, name in enumerate(ENTITY_FEATURES)}
+    for seed in (0, 1, 2):
+        flat, _ = flat_env.reset(seed=seed)
+        entities, _ = entity_env.reset(seed=seed)
+        flat_env.action_space.seed(seed)
+        for _ in range(4):
+            assert entity_env.observation_space.contains(entities)
+            n = entity_env.unwrapped.n_landmarks
+            table = entities["landmarks"].reshape(slots, width)
+            blocks = observation_slices(7)
+            np.testing.assert_array_equal(entities["robot"], flat[blocks["robot"]])
+            np.testing.assert_array_equal(table[:, column["present"]], np.arange(slots) < n)
+            np.testing.assert_array_equal(table[:, column["is_frame"]], np.arange(slots) < 2)
+            np.testing.assert_array_equal(table[:2, column["x"]], [0.0, 1.0])
+            np.testing.assert_array_equal(table[n:], 0.0)  # absent slots are empty
+            mapped = flat[blocks["landmarks"]].reshape(slots - 2, -1)
+            np.testing.assert_array_equal(table[2:, column["x"]], mapped[:, 2])
+            np.testing.assert_array_equal(table[2:, column["log_area"]], mapped[:, 4])
+            bearings = flat[blocks["bearings"]].reshape(slots, -1)
+            np.testing.assert_array_equal(table[:, column["bearing_sin"]], bearings[:, 2])
+            action = flat_env.action_space.sample()
+            flat, _, terminated, truncated, _ = flat_env.step(action)
+            entities, *_ = entity_env.step(action)
+            if terminated or truncated:
+                break
+    wrapped = FlattenObservation(entity_env)
+    observation, _ = wrapped.reset(seed=0)
+    assert wrapped.observation_space.contains(observation)
+    assert observation.shape == (len(ROBOT_FEATURES) + slots * width,)
+    clone = pickle.loads(pickle.dumps(entity_env))
+    assert_same(clone.reset(seed=5), entity_env.reset(seed=5))
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_entity_observation_on_the_vector_env(env_id: str) -> None:
+    kwargs = {"scenario": "khepera", "observation": "entities"}
+    batched = gym.make_vec(env_id, num_envs=3, **kwargs)
+    reference = gym.make_vec(env_id, num_envs=3, vectorization_mode="sync", **kwargs)
+    assert batched.observation_space == reference.observation_space
+    first, _ = batched.reset(seed=3)
+    second, _ = reference.reset(seed=3)
+    for _ in range(25):  # through an autoreset
+        assert batched.observation_space.contains(first)
+        for key in ("robot", "landmarks"):
+            np.testing.assert_array_equal(first[key], second[key])
+        actions = batched.action_space.sample()
+        first, *_ = batched.step(actions)
+        second, *_ = reference.step(actions)
+
+
+def test_observation_kind_is_validated_and_fixed() -> None:
+    with pytest.raises(ValueError, match="unknown observation 'image'"):
+        gym.make("BearingSLAM-v0", observation="image")
+    with pytest.raises(TypeError, match="observation must be a str"):
+        gym.make("BearingSLAM-v0", observation=1)
+    env = BearingSLAMEnv(observation="entities")
+    assert env.observation_kind == "entities"
+    with pytest.raises(AttributeError, match="read-only"):
+        env.observation_kind = "flat"
+    with pytest.raises(ValueError, match="observation cannot change"):
+        env.config = env.config.replace(observation="flat")

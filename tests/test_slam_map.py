@@ -772,3 +772,19 @@ def test_the_threaded_kernel_gives_the_serial_kernels_maps_bit_for_bit(transfer,
     assert serial.n_frame_changes.sum() > 16  # real fusions were compared
     if fusion == "relaxed":
         assert serial.outliers.sum() > 0  # and regions were left out
+
+
+def test_take_copies_maps_by_index_with_repeats() -> None:
+    batch = BatchedPolygonSLAM(3, 4, EPS)
+    rng = np.random.default_rng(0)
+    batch.update(rng.uniform(-3, 3, (3, 4)), rng.uniform(-3, 3, (3, 4)))
+    copies = batch.take(np.array([2, 0, 2]))
+    assert copies.num_maps == 3
+    for i, source in enumerate((2, 0, 2)):
+        for name in STATE_ARRAYS:
+            mine, theirs = getattr(copies, name)[i], getattr(batch, name)[source]
+            assert np.array_equal(mine, theirs, equal_nan=True), name
+    copies.reset([0])  # independent copies
+    assert np.array_equal(batch.counts[2], copies.counts[2])
+    with pytest.raises(ValueError, match="indices"):
+        batch.take(np.array([3]))

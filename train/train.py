@@ -79,6 +79,7 @@ from __future__ import annotations
 import argparse
 import ast
 import contextlib
+import importlib
 import json
 import math
 import shutil
@@ -317,6 +318,11 @@ def parse_hyperparameters(raw: Mapping[str, Any]) -> Hyperparameters:
     if isinstance(entry.get("train_freq"), list):
         entry["train_freq"] = tuple(entry["train_freq"])
     entry.setdefault("policy", "MlpPolicy")
+    if isinstance(entry["policy"], str) and "." in entry["policy"]:
+        # As rl-zoo3: a dotted name is a custom policy class, imported
+        # (e.g. bearing_env.agents.extractors.LandmarkSetPolicy).
+        module, _, name = entry["policy"].rpartition(".")
+        entry["policy"] = getattr(importlib.import_module(module), name)
     if n_envs < 1 or n_timesteps < 1:
         raise ValueError(f"n_envs and n_timesteps must be >= 1, got {n_envs}, {n_timesteps}")
     return Hyperparameters(

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any, Generic, SupportsFloat, TypeVar
+from typing import Any, Generic, SupportsFloat, TypeVar, cast
 
 import gymnasium as gym
 import numpy as np
@@ -197,6 +197,13 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     are the reading at the current position (at reset: the initial reading), relative to
     the current heading. `observation_slices(M)` gives the three blocks as slices.
 
+    With `observation="entities"` the observation is a `Dict` of the same numbers:
+    `"robot"` (the 9 elements above) and `"landmarks"`, a table of one row per landmark
+    slot L1 .. LM, flattened row by row (a Box of `M * 8`; reshape to `(M, 8)`), with the
+    columns `core.ENTITY_FEATURES`: present, is-frame (L1 and L2, at (0, 0) and (1, 0)),
+    not initialised, estimate x, y, log-area (`log(1e-10)` for the exact L1 and L2) and
+    the latest bearing's cos and sin. Absent rows are zeros.
+
     ## Rewards
 
     With `reward="log_area"` (default), the reward is the decrease of the potential
@@ -228,7 +235,20 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     ## Info
 
-    Ground truth, for evaluation only (arrays are over landmarks i >= 3):
+    `robot_map` is the robot's own map, as data (no ground truth; what policies may read:
+    see `bearing_env.agents.env_access.MapReader`): a dict of its state arrays
+    (`bearing_env.slam.batch.STATE_ARRAYS`: `vertices` (M - 2, CAPACITY, 2), the FL
+    region vertices as (x, y), of which the first `counts` are used, `areas`,
+    `centroids` (M - 2, 2), the robot's
+    `robot_vertices`, `robot_counts`, `robot_area`, `robot_centroid`, `robot_heading`, and
+    the counters `n_updates`, `n_frame_changes`, `n_inconsistent`). The per-landmark
+    arrays have `M - 2` slots whatever the episode's landmark count (empty slots: count
+    0), so infos batch on the vector env; the count is the observation's present slots.
+    Unused vertex slots are 0 and unknown values (a centroid without a region, the
+    robot's centroid or heading before it has one) are inf, so equal maps give equal
+    infos.
+
+    The rest is ground truth, for evaluation only (arrays are over landmarks i >= 3):
     `landmark_area` (inf if not initialised), `landmark_error` (centroid to true FL
     position; inf if not initialised), `landmark_contains_truth` (bool), `total_area`
     (sum of `landmark_area`), `robot_error` (robot region centroid to the robot's true FL
@@ -280,6 +300,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     - `on_inconsistency`: `"restart"` (default: a landmark whose regions contradict
       each other restarts from the newest one) or `"keep"` (it keeps its old region).
       With `"relaxed"`, this applies beyond `max_outliers`.
+    - `observation`: `"flat"` (default, the Box above) or `"entities"` (the Dict above).
     - `render_mode`: `None`, `"human"` or `"rgb_array"`.
     - `config`: an `EnvConfig` (`bearing_env.envs.config`) holding all the settings
       above but `render_mode`, instead of the keywords (`EnvConfig.create(...)` takes
@@ -288,9 +309,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     Every setting is also an attribute (`env.area_cap`, `env.path_cost`, ...; `reward`
     is `env.reward_kind`); assigning one replaces `env.config` with a validated copy.
-    `max_landmarks` is read-only (it fixes the observation space). A change of
-    `epsilon_deg`, `transfer`, `fusion`, `max_outliers` or `on_inconsistency` gives the
-    env a new, empty map.
+    `max_landmarks` and `observation_kind` (the `observation` setting) are read-only
+    (they fix the observation space). A change of `epsilon_deg`, `transfer`, `fusion`,
+    `max_outliers` or `on_inconsistency` gives the env a new, empty map.
 
     ## Version History
 
@@ -317,6 +338,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     fusion: Setting[str] = Setting("fusion")
     max_outliers: Setting[int] = Setting("max_outliers")
     on_inconsistency: Setting[str] = Setting("on_inconsistency")
+    observation_kind: Setting[str] = Setting("observation", read_only=FIXES_THE_SPACES)
 
     def __init__(
         self,
@@ -340,6 +362,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         on_inconsistency: str = "restart",
         render_mode: str | None = None,
         config: EnvConfig | None = None,
+        observation: str = "flat",
     ) -> None:
         super().__init__()
         settings = {
@@ -361,6 +384,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             "fusion": fusion,
             "max_outliers": max_outliers,
             "on_inconsistency": on_inconsistency,
+            "observation": observation,
         }
         self._setup(settings_from(config, settings, _CONTINUOUS_DEFAULTS), render_mode)
 
@@ -374,7 +398,13 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         self._config = config
         self.render_mode = render_mode
         self.action_space = self._make_action_space()
-        self.observation_space = observation_space(config)
+        # Any: the entity kind's Dict space is not the Box the class's type parameter names.
+        self.observation_space = cast(
+            Any,
+            entity_observation_space(config)
+            if config.observation == "entities"
+            else observation_space(config),
+        )
         #: The batch of one this env is; its row index array, for the core's functions.
         self._rows = np.array([0])
         self._state = BatchState.empty(1, config.max_landmarks)
@@ -450,7 +480,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         infos = core.infos(self._state, rows, config, self._maps, core.reset_outcome(1))
         if self.render_mode == "human":
             self.render()
-        return observation, core.row_info(infos, 0)
+        return self._observation(observation), core.row_info(infos, 0)
 
     def step(
         self, action: NDArray[np.float32] | ArrayLike
@@ -472,12 +502,18 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         if self.render_mode == "human":
             self.render()
         return (
-            observation,
+            self._observation(observation),
             float(outcome.rewards[0]),
             bool(outcome.terminated[0]),
             bool(outcome.truncated[0]),
             info,
         )
+
+    def _observation(self, flat: NDArray[np.float32]) -> Any:
+        """The observation of the env's kind from the flat vector."""
+        if self.config.observation == "entities":
+            return core.entity_observations(flat, self.config.max_landmarks)
+        return flat
 
     def render(self) -> NDArray[np.uint8] | None:
         if self.render_mode is None:
@@ -557,6 +593,28 @@ def observation_space(config: EnvConfig) -> spaces.Box[np.float32]:
         np.nextafter(low.astype(np.float32), np.float32(-np.inf)),
         np.nextafter(high.astype(np.float32), np.float32(np.inf)),
         dtype=np.float32,
+    )
+
+
+def entity_observation_space(config: EnvConfig) -> spaces.Dict:
+    """The observation space of ``observation="entities"``: the flat space's bounds,
+    rearranged as :func:`~bearing_env.envs.core.entity_observations` rearranges the values
+    (each table column's bounds are its extremes over the slots)."""
+    flat = observation_space(config)
+    low = core.entity_observations(flat.low, config.max_landmarks)
+    high = core.entity_observations(flat.high, config.max_landmarks)
+    rows = (config.max_landmarks, len(core.ENTITY_FEATURES))
+    table_low = np.minimum(low["landmarks"], high["landmarks"]).reshape(rows).min(axis=0)
+    table_high = np.maximum(low["landmarks"], high["landmarks"]).reshape(rows).max(axis=0)
+    return spaces.Dict(
+        {
+            "robot": spaces.Box(low["robot"], high["robot"], dtype=np.float32),
+            "landmarks": spaces.Box(
+                np.tile(table_low, config.max_landmarks),
+                np.tile(table_high, config.max_landmarks),
+                dtype=np.float32,
+            ),
+        }
     )
 
 

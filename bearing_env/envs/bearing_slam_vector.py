@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from types import SimpleNamespace
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 from gymnasium.utils import seeding
@@ -167,6 +167,10 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
         #: Landmark slots of the per-landmark info arrays when counts vary per episode.
         self._info_slots = first.max_landmarks - 2 if first.has_count_range else None
+        #: The sub-envs' observations, flat (the observation kind cannot change per env).
+        self._flat_shape = (self.num_envs, core.observation_size(first.max_landmarks))
+        self._entities = first.observation == "entities"
+        self._max_landmarks = first.max_landmarks
         self._autoreset_envs = np.zeros(self.num_envs, dtype=bool)
         self._elapsed_steps = np.zeros(self.num_envs, dtype=np.int64)
         self._has_reset = False
@@ -187,13 +191,12 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             # generator carries on (or is made from fresh entropy the first time).
             if row_seed is not None or self._rngs[row] is None:
                 self._rngs[row], _ = seeding.np_random(row_seed)
-        shape = cast("tuple[int, ...]", self.observation_space.shape)  # a Box: never None
-        observations = np.zeros(shape, dtype=np.float32)
+        observations = np.zeros(self._flat_shape, dtype=np.float32)
         infos = self._reset_rows(np.arange(self.num_envs), observations, {})
         self._autoreset_envs[:] = False
         self._elapsed_steps[:] = 0
         self._has_reset = True
-        return observations, infos
+        return self._observation(observations), infos
 
     def step(
         self, actions: NDArray[Any]
@@ -220,8 +223,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             for config, rows in self._groups(np.flatnonzero(~resetting))
         ]
 
-        shape = cast("tuple[int, ...]", self.observation_space.shape)  # a Box: never None
-        observations = np.zeros(shape, dtype=np.float32)
+        observations = np.zeros(self._flat_shape, dtype=np.float32)
         rewards = np.zeros(n, dtype=np.float64)
         terminations = np.zeros(n, dtype=bool)
         truncations = np.zeros(n, dtype=bool)
@@ -250,7 +252,13 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             infos = self._reset_rows(np.concatenate(finished), observations, infos)
         infos = self._reset_rows(np.flatnonzero(resetting), observations, infos)
         self._autoreset_envs = terminations | truncations
-        return observations, rewards, terminations, truncations, infos
+        return self._observation(observations), rewards, terminations, truncations, infos
+
+    def _observation(self, flat: NDArray[np.float32]) -> Any:
+        """Observations of the sub-envs' kind from flat ones (as the single env's)."""
+        if self._entities:
+            return core.entity_observations(flat, self._max_landmarks)
+        return flat
 
     def render(self) -> tuple[Any, ...] | None:
         if self.render_mode is None:
@@ -472,7 +480,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         if final_obs is None:
             final_obs = np.full(self.num_envs, None, dtype=object)
         for row in rows.tolist():
-            final_obs[row] = observations[row].copy()
+            final_obs[row] = self._observation(observations[row].copy())
         mask = infos.get("_final_obs", np.zeros(self.num_envs, dtype=np.bool_))
         mask[rows] = True
         infos["final_obs"], infos["_final_obs"] = final_obs, mask

@@ -59,6 +59,9 @@ DEFAULT_N_TURNS = 8
 DEFAULT_N_MOVE_LENGTHS = 3
 
 REWARDS: tuple[str, ...] = ("log_area", "area")
+#: Observation kinds: the flat Box (default) or a Dict of a robot block and a landmark
+#: table (``bearing_env.envs.core.entity_observations``).
+OBSERVATIONS: tuple[str, ...] = ("flat", "entities")
 
 
 def is_number(value: Any) -> bool:
@@ -146,6 +149,7 @@ class EnvConfig:
     fusion: str = "intersect"
     max_outliers: int = DEFAULT_MAX_OUTLIERS
     on_inconsistency: str = "restart"
+    observation: str = "flat"
 
     # ------------------------------------------------------------------------------------
     # Construction
@@ -174,6 +178,7 @@ class EnvConfig:
         fusion: str = "intersect",
         max_outliers: int = DEFAULT_MAX_OUTLIERS,
         on_inconsistency: str = "restart",
+        observation: str = "flat",
     ) -> EnvConfig:
         """A validated config from the envs' keyword arguments, with the scenario's
         defaults for what is left out."""
@@ -213,6 +218,7 @@ class EnvConfig:
             fusion=fusion,
             max_outliers=max_outliers,
             on_inconsistency=on_inconsistency,
+            observation=observation,
         )
 
     def __post_init__(self) -> None:
@@ -270,6 +276,7 @@ class EnvConfig:
         max_outliers = int_at_least(self.max_outliers, 0, "max_outliers")
         normalise("max_outliers", int_at_most(max_outliers, DEFAULT_WINDOW - 1, "max_outliers"))
         choice(self.on_inconsistency, INCONSISTENCY_POLICIES, "on_inconsistency")
+        choice(self.observation, OBSERVATIONS, "observation")
 
     def replace(self, **changes: Any) -> EnvConfig:
         """A copy with some fields changed (validated)."""

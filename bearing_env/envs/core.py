@@ -33,7 +33,13 @@ from bearing_env.envs import kernels
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig, MapSettings
 from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
 from bearing_env.slam import PolygonSLAM
-from bearing_env.slam.batch import CONTAINMENT_TOLERANCE, BatchedPolygonSLAM
+from bearing_env.slam.batch import (
+    CONTAINMENT_TOLERANCE,
+    LANDMARK_AXES,
+    STATE_ARRAYS,
+    VERTEX_COUNTS,
+    BatchedPolygonSLAM,
+)
 from bearing_env.slam.geometry import wrap_angle
 from bearing_env.world import (
     Arena,
@@ -80,6 +86,52 @@ def observation_slices(max_landmarks: int) -> dict[str, slice]:
         "landmarks": slice(robot_end, landmarks_end),
         "bearings": slice(landmarks_end, observation_size(max_landmarks)),
     }
+
+
+#: The columns of the entity observation's landmark table, one row per landmark slot
+#: (L1, L2, L3, ...): present, is-frame (L1 and L2, fixed at (0, 0) and (1, 0) in FL),
+#: not initialised yet, the estimate in FL, the log-area, and the latest bearing.
+ENTITY_FEATURES: tuple[str, ...] = (
+    "present",
+    "is_frame",
+    "uninitialised",
+    "x",
+    "y",
+    "log_area",
+    "bearing_cos",
+    "bearing_sin",
+)
+
+
+def entity_observations(flat: NDArray[np.float32], max_landmarks: int) -> dict[str, Any]:
+    """The entity view of flat observations (..., observation_size): the same numbers,
+    rearranged. ``"robot"`` (..., len(ROBOT_FEATURES)) is the robot block;
+    ``"landmarks"`` (..., max_landmarks * len(ENTITY_FEATURES)) is the landmark table, a
+    row per slot, flattened row by row (a 1-D Box per observation, as SB3's checker
+    wants: reshape to (max_landmarks, len(ENTITY_FEATURES))). L1 and L2 are the frame:
+    estimate (0, 0) and (1, 0), exact (log-area ``log(AREA_FLOOR)``). Rows of absent
+    landmarks are all zeros.
+    """
+    flat = np.asarray(flat, dtype=np.float32)
+    blocks = observation_slices(max_landmarks)
+    lead = flat.shape[:-1]
+    mapped = flat[..., blocks["landmarks"]].reshape(*lead, max_landmarks - 2, -1)
+    bearings = flat[..., blocks["bearings"]].reshape(*lead, max_landmarks, -1)
+    table = np.zeros((*lead, max_landmarks, len(ENTITY_FEATURES)), dtype=np.float32)
+    column = {name: index for index, name in enumerate(ENTITY_FEATURES)}
+    landmark = {name: index for index, name in enumerate(LANDMARK_FEATURES)}
+    bearing = {name: index for index, name in enumerate(BEARING_FEATURES)}
+    table[..., column["present"]] = bearings[..., bearing["present"]]
+    frame = table[..., :2, :]
+    frame[..., column["is_frame"]] = frame[..., column["present"]]
+    frame[..., 1, column["x"]] = frame[..., 1, column["present"]]
+    exact = np.float32(math.log(AREA_FLOOR))
+    frame[..., column["log_area"]] = exact * frame[..., column["present"]]
+    for name in ("uninitialised", "x", "y", "log_area"):
+        table[..., 2:, column[name]] = mapped[..., landmark[name]]
+    table[..., column["bearing_cos"]] = bearings[..., bearing["cos"]]
+    table[..., column["bearing_sin"]] = bearings[..., bearing["sin"]]
+    return {"robot": flat[..., blocks["robot"]].copy(), "landmarks": table.reshape(*lead, -1)}
 
 
 # ----------------------------------------------------------------------------------------
@@ -218,6 +270,11 @@ def check_config_switch(old: EnvConfig, new: EnvConfig, action_grid_fixed: bool)
     if new.max_landmarks != old.max_landmarks:
         raise ValueError(
             f"max_landmarks cannot change ({old.max_landmarks} -> {new.max_landmarks}): "
+            "it fixes the observation space; make a new env"
+        )
+    if new.observation != old.observation:
+        raise ValueError(
+            f"observation cannot change ({old.observation!r} -> {new.observation!r}): "
             "it fixes the observation space; make a new env"
         )
     if action_grid_fixed and (new.n_turns, new.n_move_lengths) != (
@@ -631,12 +688,62 @@ def infos(
         "inconsistent": outcome.inconsistent,
         "outliers": batch.outliers[rows],
         "path_length": outcome.travelled,
+        "robot_map": robot_map_info(batch, rows, config.max_landmarks - 2),
         "rewards": {
             "uncertainty": outcome.uncertainty,
             "path_cost": outcome.path_cost,
             "move_cost": outcome.move_cost,
         },
     }
+
+
+#: Fill of the empty landmark slots of ``info["robot_map"]`` (default 0: count 0 is a
+#: landmark without a region), as the map itself holds an uninitialised landmark.
+ROBOT_MAP_PADDING: dict[str, Any] = {"areas": np.inf, "centroids": complex(np.inf, np.inf)}
+#: The arrays of ``info["robot_map"]`` whose unknown values (NaN in the map: the centroid
+#: of a landmark without a region, the robot's centroid and heading before it has them)
+#: are written as inf, so that equal maps give equal infos (NaN != NaN).
+ROBOT_MAP_UNKNOWN_AS_INF: tuple[str, ...] = ("centroids", "robot_centroid", "robot_heading")
+
+
+def robot_map_info(batch: BatchedPolygonSLAM, rows: IntArray, slots: int) -> dict[str, Any]:
+    """The robot's own map state of the rows, as data (``info["robot_map"]``).
+
+    One array per state array of the map (``bearing_env.slam.batch.STATE_ARRAYS``),
+    restricted to the rows; complex FL points are (x, y) pairs on a last axis of 2. It has
+    a canonical form so that equal maps give equal infos:
+    vertex slots beyond a region's count are 0, and unknown values are inf (see
+    :data:`ROBOT_MAP_UNKNOWN_AS_INF`). The per-landmark arrays
+    (``bearing_env.slam.batch.LANDMARK_AXES``) are padded to ``slots`` landmark slots
+    (``max_landmarks - 2``), so that every episode's info has the same shapes whatever
+    its landmark count.
+    It is what the robot knows, never ground truth.
+    """
+    mapped = batch.n_landmarks - 2
+    out: dict[str, Any] = {}
+    for name in STATE_ARRAYS:
+        values = getattr(batch, name)[rows]
+        if name in VERTEX_COUNTS:
+            used = getattr(batch, VERTEX_COUNTS[name])[rows]
+            values[np.arange(values.shape[-1]) >= used[..., None]] = 0
+        elif name in ROBOT_MAP_UNKNOWN_AS_INF:
+            unknown = np.isnan(values)
+            values[unknown] = complex(np.inf, np.inf) if values.dtype.kind == "c" else np.inf
+        axis = LANDMARK_AXES.get(name)
+        if axis is not None and slots > mapped:
+            shape = list(values.shape)
+            shape[axis] = slots
+            padded = np.full(shape, ROBOT_MAP_PADDING.get(name, 0), dtype=values.dtype)
+            used_slots = [slice(None)] * values.ndim
+            used_slots[axis] = slice(0, mapped)
+            padded[tuple(used_slots)] = values
+            values = padded
+        if values.dtype.kind == "c":
+            # FL points as (x, y) pairs on a last axis: Gymnasium batches real arrays and
+            # scalars only (a complex scalar would become an object array).
+            values = np.stack([values.real, values.imag], axis=-1)
+        out[name] = values
+    return out
 
 
 def row_info(batched: dict[str, Any], row: int) -> dict[str, Any]:

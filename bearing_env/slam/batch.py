@@ -317,6 +317,15 @@ class BatchedPolygonSLAM:
         """The vertices (CCW) of a map's robot region; empty before any frame change."""
         return self.robot_vertices[map_index, : self.robot_counts[map_index]].copy()
 
+    def take(self, maps: ArrayLike) -> BatchedPolygonSLAM:
+        """A new batch whose map ``i`` is a copy of map ``maps[i]`` (indices may repeat):
+        for planning, many candidates from each of a few maps."""
+        rows = self._check_maps(maps, distinct=False)
+        copies = self.empty_like(rows.size)
+        for name in STATE_ARRAYS:
+            getattr(copies, name)[:] = getattr(self, name)[rows]
+        return copies
+
     def _state_arrays(self) -> tuple[NDArray[Any], ...]:
         """The state in the kernels' argument order (see :data:`STATE_ARRAYS`)."""
         d = self.__dict__
@@ -377,6 +386,32 @@ STATE_ARRAYS = (
     "n_dropped",
     "outliers",
 )
+
+
+#: The state arrays with a landmark axis, and which axis it is (the map axis is 0): what
+#: pads or trims a map's state to a number of landmark slots.
+LANDMARK_AXES: dict[str, int] = {
+    "vertices": 1,
+    "counts": 1,
+    "areas": 1,
+    "centroids": 1,
+    "window_vertices": 2,
+    "window_counts": 2,
+    "window_inlier": 2,
+    "base_vertices": 1,
+    "base_counts": 1,
+    "relaxation": 1,
+    "n_dropped": 1,
+    "outliers": 1,
+}
+
+#: The vertex arrays of the state and the arrays counting their used vertices.
+VERTEX_COUNTS: dict[str, str] = {
+    "vertices": "counts",
+    "robot_vertices": "robot_counts",
+    "window_vertices": "window_counts",
+    "base_vertices": "base_counts",
+}
 
 
 def check_bearings(bearings: ArrayLike, shape: tuple[int, ...], name: str) -> FloatArray:

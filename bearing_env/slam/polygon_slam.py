@@ -17,7 +17,6 @@ from bearing_env.slam.batch import (
     FUSIONS,
     INCONSISTENCY_POLICIES,
     LANDMARK_STATUSES,
-    STATE_ARRAYS,
     BatchedPolygonSLAM,
     check_bearings,
 )
@@ -238,11 +237,7 @@ class PolygonSLAM:
         For planning: score many candidate movements with one batched
         :meth:`BatchedPolygonSLAM.update`, each candidate on its own copy.
         """
-        batch = self._batch
-        copies = batch.empty_like(count)
-        for name in STATE_ARRAYS:
-            getattr(copies, name)[:] = getattr(batch, name)[self._index]
-        return copies
+        return self._batch.take(np.full(count, self._index, dtype=np.int64))
 
     @property
     def n_updates(self) -> int:
