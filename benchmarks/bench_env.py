@@ -33,7 +33,7 @@ Sections:
 - ``planning``: ``agents.GreedyOneStep``'s planning time per move (its ``act()``, which
   scores 16 candidate moves on copies of the map), Khepera scenario, the median over the
   moves of several episodes. Seconds, not a ratio.
-- ``ppo``: SB3 ``PPO with ``train/hyperparams/ppo.yml``'s settings for BearingSLAM-v0
+- ``ppo``: SB3 ``PPO`` with the shipped ``ppo.yml``'s settings for BearingSLAM-v0
   (VecNormalize included) on ``--ppo-envs`` envs built by
   ``bearing_env.train.train.make_training_env``
   for each vec env kind (batched, subproc with spawn, dummy). The rate is env steps per

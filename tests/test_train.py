@@ -553,14 +553,20 @@ def rl_zoo3_run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Background
         yield None
         return
     folder = tmp_path_factory.mktemp("rl_zoo3")
+    # As the README runs it: the path printed by `bearing-env hyperparams ppo`, from a
+    # folder that is not the checkout.
+    conf_file = subprocess.run(
+        [PYTHON, "-m", "bearing_env.train.cli", "hyperparams", "ppo"],
+        cwd=folder, capture_output=True, text=True, check=True,
+    ).stdout.strip()  # fmt: skip
     command = [
         PYTHON, "-m", "rl_zoo3.train", "--gym-packages", "bearing_env", "--algo", "ppo",
-        "--env", "BearingSLAM-v0", "--conf-file", "train/hyperparams/ppo.yml", "-n", "300",
+        "--env", "BearingSLAM-v0", "--conf-file", conf_file, "-n", "300",
         "-f", str(folder), "--device", "cpu", "--seed", "0",
         "--hyperparams", "n_envs:2", "n_steps:64", f"policy_kwargs:'{TINY_NET}'",
     ]  # fmt: skip
     process = subprocess.Popen(
-        command, cwd=REPO_ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+        command, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
     )
     background = BackgroundCommand(process, folder)
     yield background

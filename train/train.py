@@ -7,14 +7,15 @@
     bearing-env train --algo ppo --output runs/ppo_khepera --export-only \
         --export agents/pretrained/ppo_khepera
 
-**Hyperparameters** come from ``train/hyperparams/<algo>.yml`` in rl-zoo3's format: one
+**Hyperparameters** come from the shipped ``hyperparams/<algo>.yml`` (``bearing-env
+hyperparams <algo>`` prints its path) in rl-zoo3's format: one
 entry per env id holding ``n_envs``, ``n_timesteps``, ``policy``, ``normalize``,
 ``env_kwargs``, ``policy_kwargs`` (a Python expression string) and the algorithm's
 constructor arguments (``lin_<x>`` is a schedule decaying linearly from ``x`` to 0). The
 same files run under rl-zoo3::
 
     python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 \\
-        --conf-file train/hyperparams/ppo.yml
+        --conf-file "$(bearing-env hyperparams ppo)"
 
 ``--env-kwargs k=v ...`` is merged over the entry's ``env_kwargs`` (rl-zoo3 replaces them
 instead), and ``--hyperparams k=v ...`` over the entry itself. Values are Python literals
@@ -113,6 +114,7 @@ from bearing_env.train.callbacks import (
     save_vecnormalize_atomically,
     write_json_atomically,
 )
+from bearing_env.train.conf_files import default_conf_file
 from bearing_env.train.errors import fail, write_error_message
 from bearing_env.train.vec_env import (
     MONITOR_INFO_KEYWORDS,
@@ -142,7 +144,6 @@ DEFAULT_ENV_IDS: dict[str, str] = {
     "sac": "BearingSLAM-v0",
     "dqn": "BearingSLAMDiscrete-v0",
 }
-HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
 
 #: Validation episode k (periodic evaluation, best-model selection) resets with seed
 #: VALIDATION_SEED_START + k; training seeds stay below it.
@@ -226,12 +227,8 @@ def hyperparams_key(env_id: str) -> str:
     return env_id.split(":")[-1]
 
 
-def default_conf_file(algo: str) -> Path:
-    return HYPERPARAMS_DIR / f"{algo}.yml"
-
-
 def read_hyperparameters(algo: str, env_id: str, conf_file: Path | None = None) -> dict[str, Any]:
-    """The raw entry for ``env_id`` in ``conf_file`` (default ``train/hyperparams/<algo>.yml``)."""
+    """The raw entry for ``env_id`` in ``conf_file`` (default: the shipped ``<algo>.yml``)."""
     path = conf_file if conf_file is not None else default_conf_file(algo)
     if not path.is_file():
         raise FileNotFoundError(f"hyperparameter file not found: {path}")
@@ -1088,7 +1085,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="bearing-env train",
         description="Train PPO/SAC (BearingSLAM-v0) or DQN (BearingSLAMDiscrete-v0) with "
-        "stable-baselines3; hyperparameters from train/hyperparams/<algo>.yml (rl-zoo3 format). "
+        "stable-baselines3; hyperparameters from the shipped <algo>.yml (rl-zoo3 format; "
+        "bearing-env hyperparams ALGO prints its path). "
         "Ctrl-C saves a checkpoint; --resume continues from it.",
     )
     add = parser.add_argument
@@ -1096,7 +1094,7 @@ def build_parser() -> argparse.ArgumentParser:
     add("--env", help="env id (default BearingSLAM-v0; for dqn BearingSLAMDiscrete-v0)")
     add("--env-kwargs", nargs="*", default=[], metavar="K=V", help="merged over the YAML's")
     add("--hyperparams", nargs="*", default=[], metavar="K=V", help="override YAML entries")
-    add("--conf-file", type=Path, help="hyperparameter file (default train/hyperparams/<algo>.yml)")
+    add("--conf-file", type=Path, help="hyperparameter file (default: the shipped <algo>.yml)")
     add("--timesteps", type=int, help="total env steps of the run (default the YAML's n_timesteps)")
     add("--seed", type=int, default=0, help="default %(default)s")
     add("--n-envs", type=int, help="parallel envs (default the YAML's n_envs)")
