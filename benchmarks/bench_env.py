@@ -64,7 +64,6 @@ g. ``GreedyOneStep`` plans a move in <= 0.2 ms (median).
 from __future__ import annotations
 
 import argparse
-import ast
 import contextlib
 import cProfile
 import datetime as _dt
@@ -85,6 +84,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 from bearing_env.benchmarks.bench_slam import cartpole_steps_per_second
+from bearing_env.train.cli_values import json_safe, parse_key_values
 from gymnasium.vector import AutoresetMode
 
 import bearing_env
@@ -796,17 +796,6 @@ def machine_info() -> dict[str, Any]:
     return info
 
 
-def json_safe(value: Any) -> Any:
-    """Settings as JSON: containers kept, numbers/strings as is, anything else as repr."""
-    if isinstance(value, dict):
-        return {str(key): json_safe(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [json_safe(item) for item in value]
-    if value is None or isinstance(value, (bool, int, float, str)):
-        return value
-    return repr(value)
-
-
 def _finite(value: Any) -> Any:
     """JSON without NaN/inf: non-finite floats become null."""
     if isinstance(value, dict):
@@ -1058,21 +1047,6 @@ def profile(section: str, seconds: float, num_envs: int, env_kwargs: dict[str, A
 # --------------------------------------------------------------------------------------
 # Command line
 # --------------------------------------------------------------------------------------
-
-
-def parse_key_values(pairs: Sequence[str], option: str) -> dict[str, Any]:
-    """``["k=v", ...]`` -> ``{"k": v}``, ``v`` a Python literal when it parses as one
-    (as ``bearing-env train --env-kwargs``)."""
-    parsed: dict[str, Any] = {}
-    for pair in pairs:
-        key, separator, value = pair.partition("=")
-        if not separator or not key.strip():
-            raise ValueError(f"{option} expects key=value items, got {pair!r}")
-        try:
-            parsed[key.strip()] = ast.literal_eval(value.strip())
-        except (ValueError, SyntaxError):
-            parsed[key.strip()] = value.strip()
-    return parsed
 
 
 def _split_list(values: Sequence[str]) -> list[str]:

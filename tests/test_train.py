@@ -29,11 +29,15 @@ import pytest
 import yaml
 from bearing_env.agents import SB3Policy
 from bearing_env.train.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
-from bearing_env.train.train import (
-    EXIT_INTERRUPTED,
-    MAX_EVAL_EPISODES,
+from bearing_env.train.cli_values import parse_key_values
+from bearing_env.train.seeds import (
+    MAX_VALIDATION_EPISODES,
     TRAINING_SEED_LIMIT,
     VALIDATION_SEED_START,
+    training_seed_start,
+)
+from bearing_env.train.train import (
+    EXIT_INTERRUPTED,
     EpisodeSeedCycle,
     LinearSchedule,
     TrainResult,
@@ -43,10 +47,8 @@ from bearing_env.train.train import (
     load_vecnormalize,
     make_validation_env,
     parse_hyperparameters,
-    parse_key_values,
     read_hyperparameters,
     train,
-    training_seed_start,
 )
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
@@ -512,14 +514,14 @@ def test_hyperparameter_parsing_follows_rl_zoo3() -> None:
         "move_length": (0.1, 0.3),
         "n": 4,
     }
-    with pytest.raises(ValueError, match="key=value"):
+    with pytest.raises(ValueError, match="KEY=VALUE"):
         parse_key_values(["scenario"], "--env-kwargs")
 
 
 def test_seed_ranges_are_disjoint_and_validation_episodes_repeat() -> None:
-    import bearing_env.train.compare as compare
+    from bearing_env.train.seeds import EVAL_SEED_START
     assert TRAINING_SEED_LIMIT <= VALIDATION_SEED_START
-    assert VALIDATION_SEED_START + MAX_EVAL_EPISODES <= compare.EVAL_SEED_START
+    assert VALIDATION_SEED_START + MAX_VALIDATION_EPISODES <= EVAL_SEED_START
     assert training_seed_start(7, 10**9, 8) + 8 <= TRAINING_SEED_LIMIT
     with pytest.raises(ValueError):
         training_seed_start(TRAINING_SEED_LIMIT, 0, 1)

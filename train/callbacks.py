@@ -29,16 +29,14 @@ trained on), writes in place and does not prune; only its file names are kept.
 from __future__ import annotations
 
 import json
-import os
 import re
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bearing_env.train.errors import with_path
+from bearing_env.train.files import atomic_path, write_json_atomically
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
 from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
@@ -52,27 +50,6 @@ BEST_VECNORMALIZE_NAME = "vecnormalize.pkl"
 BEST_SUMMARY_NAME = "best.json"
 #: Validation metrics are reported at this move count (and at the end of the episode).
 AREA_REPORT_MOVE = 10
-
-
-@contextmanager
-def atomic_path(final_path: Path) -> Iterator[Path]:
-    """A temporary path in the same folder, renamed to ``final_path`` if the block succeeds."""
-    temporary = final_path.with_name(f".{final_path.name}.{os.getpid()}.tmp")
-    try:
-        final_path.parent.mkdir(parents=True, exist_ok=True)
-        yield temporary
-        os.replace(temporary, final_path)
-    except OSError as error:
-        # Disk full, no permission, ...: name the file being written, not its temporary.
-        raise with_path(error, final_path) from None
-    finally:
-        if temporary.exists():
-            temporary.unlink()
-
-
-def write_json_atomically(path: Path, payload: dict[str, Any]) -> None:
-    with atomic_path(path) as temporary:
-        temporary.write_text(json.dumps(payload, indent=2, sort_keys=True) + "\n")
 
 
 def save_model_atomically(model: BaseAlgorithm, path: Path) -> None:

@@ -37,8 +37,9 @@ own random stream, where ``s = --seed`` for a new run and ``(seed + t) mod (9000
 n_envs)`` for a segment resumed at timestep ``t``: every training seed is below
 ``VALIDATION_SEED_START = 900000``. The periodic evaluation that picks the best model
 plays validation episode ``k`` with seed ``900000 + k`` (``k < --eval-episodes``), the
-same episodes at every evaluation. Both ranges lie below ``bearing_env.train.compare``'s test seeds
-(1000000 and up), so neither training nor model selection ever sees a test episode.
+same episodes at every evaluation. Both ranges lie below ``compare``'s test seeds
+(1000000 and up), so neither training nor model selection ever sees a test episode;
+``bearing_env.train.seeds`` defines every range.
 
 **Run folder** (``--output``, default ``runs/<algo>_<env>_seed<seed>``)::
 
@@ -78,7 +79,6 @@ resumes from. Each segment's ``status`` is ``finished``, ``interrupted`` or ``ki
 from __future__ import annotations
 
 import argparse
-import ast
 import contextlib
 import json
 import math
@@ -107,15 +107,21 @@ from bearing_env.train.callbacks import (
     PeriodicCheckpointCallback,
     StopOnRequestCallback,
     StopRequest,
-    atomic_path,
     callback_calls,
     rewind_to_boundary,
     save_model_atomically,
     save_vecnormalize_atomically,
-    write_json_atomically,
 )
+from bearing_env.train.cli_values import json_safe, parse_key_values
 from bearing_env.train.conf_files import default_conf_file
 from bearing_env.train.errors import fail, write_error_message
+from bearing_env.train.files import atomic_path, write_json_atomically
+from bearing_env.train.seeds import (
+    TRAINING_SEED_LIMIT,
+    VALIDATION_SEED_START,
+    training_seed_start,
+    validation_seeds,
+)
 from bearing_env.train.vec_env import (
     MONITOR_INFO_KEYWORDS,
     gym_make_kwargs,
@@ -145,13 +151,6 @@ DEFAULT_ENV_IDS: dict[str, str] = {
     "dqn": "BearingSLAMDiscrete-v0",
 }
 
-#: Validation episode k (periodic evaluation, best-model selection) resets with seed
-#: VALIDATION_SEED_START + k; training seeds stay below it.
-VALIDATION_SEED_START = 900_000
-TRAINING_SEED_LIMIT = VALIDATION_SEED_START
-#: Validation seeds stay below this (``bearing_env.train.compare``'s test episodes start here).
-TEST_SEED_START = 1_000_000
-MAX_EVAL_EPISODES = TEST_SEED_START - VALIDATION_SEED_START
 
 DEFAULT_EVAL_FREQ = 25_000
 DEFAULT_EVAL_EPISODES = 50
@@ -325,25 +324,6 @@ def parse_hyperparameters(raw: Mapping[str, Any]) -> Hyperparameters:
     )
 
 
-def parse_literal(text: str) -> Any:
-    """A Python literal when ``text`` is one (``4``, ``0.25``, ``(0.1, 0.3)``), else ``text``."""
-    try:
-        return ast.literal_eval(text)
-    except (ValueError, SyntaxError):
-        return text
-
-
-def parse_key_values(pairs: Sequence[str], option: str) -> dict[str, Any]:
-    """``["k=v", ...]`` -> ``{"k": literal(v)}``."""
-    parsed: dict[str, Any] = {}
-    for pair in pairs:
-        key, separator, value = pair.partition("=")
-        if not separator or not key.strip():
-            raise ValueError(f"{option} expects key=value items, got {pair!r}")
-        parsed[key.strip()] = parse_literal(value.strip())
-    return parsed
-
-
 # --------------------------------------------------------------------------------------
 # Environments
 # --------------------------------------------------------------------------------------
@@ -468,12 +448,6 @@ def make_training_env(
     return DummyVecEnv(factories)
 
 
-def validation_seeds(n_episodes: int) -> tuple[int, ...]:
-    if not 1 <= n_episodes <= MAX_EVAL_EPISODES:
-        raise ValueError(f"eval episodes must be in [1, {MAX_EVAL_EPISODES}], got {n_episodes}")
-    return tuple(range(VALIDATION_SEED_START, VALIDATION_SEED_START + n_episodes))
-
-
 def make_validation_env(
     env_id: str, env_kwargs: dict[str, Any], n_episodes: int, vec_monitor: bool = False
 ) -> VecEnv:
@@ -492,13 +466,6 @@ def make_validation_env(
     )
     venv: VecEnv = DummyVecEnv([factory])
     return VecMonitor(venv, info_keywords=MONITOR_INFO_KEYWORDS) if vec_monitor else venv
-
-
-def training_seed_start(seed: int, start_timesteps: int, n_envs: int) -> int:
-    """The reset seed of training env 0 in a segment starting at ``start_timesteps``."""
-    if not 0 <= seed < TRAINING_SEED_LIMIT - n_envs:
-        raise ValueError(f"--seed must be in [0, {TRAINING_SEED_LIMIT - n_envs}), got {seed}")
-    return (seed + start_timesteps) % (TRAINING_SEED_LIMIT - n_envs)
 
 
 # --------------------------------------------------------------------------------------
@@ -668,17 +635,6 @@ def _versions() -> dict[str, str]:
     }
 
 
-def _json_safe(value: Any) -> Any:
-    """YAML/CLI values as JSON (tuples become lists; anything else unusual becomes repr)."""
-    if isinstance(value, dict):
-        return {str(key): _json_safe(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(item) for item in value]
-    if value is None or isinstance(value, (bool, int, float, str)):
-        return value
-    return repr(value)
-
-
 @contextlib.contextmanager
 def stop_on_signals(request: StopRequest) -> Iterator[None]:
     """While active, Ctrl-C and SIGTERM set ``request`` (the trainer stops at the next step);
@@ -738,7 +694,7 @@ def _resolve_run(settings: TrainSettings) -> tuple[dict[str, Any], Checkpoint | 
     changed = {
         key: value
         for key, value in settings.env_kwargs.items()
-        if _json_safe(saved_env_kwargs.get(key)) != _json_safe(value)
+        if json_safe(saved_env_kwargs.get(key)) != json_safe(value)
     }
     if changed:
         raise ValueError(
@@ -748,7 +704,7 @@ def _resolve_run(settings: TrainSettings) -> tuple[dict[str, Any], Checkpoint | 
     different = {
         key: value
         for key, value in settings.hyperparam_overrides.items()
-        if _json_safe(raw.get(key)) != _json_safe(value)
+        if json_safe(raw.get(key)) != json_safe(value)
     }
     if different:
         raise ValueError(
@@ -870,8 +826,8 @@ def train(settings: TrainSettings) -> TrainResult:
             "format": RUN_FORMAT_VERSION,
             "algo": settings.algo,
             "env_id": settings.env_id,
-            "env_kwargs": _json_safe(env_kwargs),
-            "hyperparams": _json_safe(raw),
+            "env_kwargs": json_safe(env_kwargs),
+            "hyperparams": json_safe(raw),
             "n_envs": n_envs,
             "seed": settings.seed,
             "vec_env": vec_env_kind,
