@@ -35,7 +35,7 @@ Sections:
   moves of several episodes. Seconds, not a ratio.
 - ``ppo``: SB3 ``PPO`` with the shipped ``ppo.yml``'s settings for BearingSLAM-v0
   (VecNormalize included) on ``--ppo-envs`` envs built by
-  ``bearing_env.train.train.make_training_env``
+  ``bearing_env.train.training_envs.make_training_env``
   for each vec env kind (batched, subproc with spawn, dummy). The rate is env steps per
   second of wall time of ``model.learn()``, measured after a warm-up ``learn()`` of one
   rollout, so process start-up and torch initialisation are excluded. PPO always finishes
@@ -46,8 +46,8 @@ Sections:
   during the run favours no kind.
 
 When the batched pieces are missing (no ``vector_entry_point`` on the spec, or no
-``"batched"`` in ``bearing_env.train.train.VEC_ENV_KINDS``), the rows fall back to ``sync`` and
-``dummy`` and are labelled as fallbacks; the targets that depend on them say so.
+``"batched"`` in ``bearing_env.train.training_envs.VEC_ENV_KINDS``), the rows fall back
+to ``sync`` and ``dummy`` and are labelled as fallbacks; the targets that depend on them say so.
 
 Targets (printed as met / not met and stored in the JSON):
 
@@ -484,7 +484,7 @@ def vector_label(row: dict[str, Any]) -> str:
 
 
 def available_vec_env_kinds() -> tuple[str, ...]:
-    from bearing_env.train.train import VEC_ENV_KINDS
+    from bearing_env.train.training_envs import VEC_ENV_KINDS
 
     return tuple(VEC_ENV_KINDS)
 
@@ -493,12 +493,12 @@ def ppo_settings(
     env_kwargs: dict[str, Any], overrides: dict[str, Any]
 ) -> tuple[dict[str, Any], dict[str, Any] | None, dict[str, Any]]:
     """(PPO constructor kwargs, VecNormalize kwargs or None, env kwargs) from ppo.yml."""
-    from bearing_env.train.train import parse_hyperparameters, read_hyperparameters
+    from bearing_env.train.zoo import parse_hyperparameters, read_hyperparameters
 
     raw = read_hyperparameters("ppo", ENV_ID)
     raw.update(overrides)
     raw["env_kwargs"] = {**(raw.get("env_kwargs") or {}), **env_kwargs}
-    hyperparams = parse_hyperparameters(raw)
+    hyperparams = parse_hyperparameters(raw, "ppo")
     return dict(hyperparams.algorithm_kwargs), hyperparams.normalize, hyperparams.env_kwargs
 
 
@@ -584,7 +584,7 @@ def build_ppo_run(
     overrides: dict[str, Any],
 ) -> PPORun:
     """Build PPO on one vec env kind and warm it up (one rollout and one update)."""
-    from bearing_env.train.train import make_training_env
+    from bearing_env.train.training_envs import make_training_env
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
 
@@ -635,7 +635,7 @@ def bench_ppo(
     """
     if "batched" in kinds and "batched" not in available_vec_env_kinds():
         log(
-            "  bearing_env.train.train.VEC_ENV_KINDS has no 'batched':"
+            "  bearing_env.train.training_envs.VEC_ENV_KINDS has no 'batched':"
             " that row uses dummy (fallback)"
         )
     runs: list[PPORun] = []

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import bearing_env.train.train
+import bearing_env.train.training_envs
 import gymnasium as gym
 import pytest
 from bearing_env.benchmarks import bench_env
@@ -135,9 +136,9 @@ def test_batched_rows_are_not_fallbacks_when_available(
 ) -> None:
     """With a vector entry point and a "batched" vec env kind, nothing is labelled fallback."""
     monkeypatch.setattr(gym.spec(bench_env.ENV_ID), "vector_entry_point", stand_in_vector_env)
-    kinds = tuple(dict.fromkeys((*bearing_env.train.train.VEC_ENV_KINDS, "batched")))
-    monkeypatch.setattr(bearing_env.train.train, "VEC_ENV_KINDS", kinds)
-    make_training_env = bearing_env.train.train.make_training_env
+    kinds = tuple(dict.fromkeys((*bearing_env.train.training_envs.VEC_ENV_KINDS, "batched")))
+    monkeypatch.setattr(bearing_env.train.training_envs, "VEC_ENV_KINDS", kinds)
+    make_training_env = bearing_env.train.training_envs.make_training_env
 
     def make_with_batched(
         env_id: str, env_kwargs: dict[str, Any], n_envs: int, kind: str, monitor_dir: Path | None
@@ -146,7 +147,7 @@ def test_batched_rows_are_not_fallbacks_when_available(
             env_id, env_kwargs, n_envs, "dummy" if kind == "batched" else kind, monitor_dir
         )
 
-    monkeypatch.setattr(bearing_env.train.train, "make_training_env", make_with_batched)
+    monkeypatch.setattr(bearing_env.train.training_envs, "make_training_env", make_with_batched)
     results, _ = run_quick(
         tmp_path, "--sections", "vector,ppo", "--num-envs", "2", "--ppo-kinds", "batched"
     )

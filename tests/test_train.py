@@ -26,6 +26,7 @@ import bearing_env.train.train as train_module
 import gymnasium as gym
 import numpy as np
 import pytest
+import torch
 import yaml
 from bearing_env.agents import SB3Policy
 from bearing_env.train.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
@@ -38,18 +39,23 @@ from bearing_env.train.seeds import (
 )
 from bearing_env.train.train import (
     EXIT_INTERRUPTED,
-    EpisodeSeedCycle,
-    LinearSchedule,
     TrainResult,
     TrainSettings,
     export_run,
-    load_model,
-    load_vecnormalize,
-    make_validation_env,
-    parse_hyperparameters,
-    read_hyperparameters,
     train,
 )
+from bearing_env.train.training_envs import EnvFactory, EpisodeSeedCycle, make_validation_env
+from bearing_env.train.zoo import (
+    DEFAULT_ENV_IDS,
+    algorithm_class_for,
+    load_model,
+    load_vecnormalize,
+    parse_hyperparameters,
+    read_hyperparameters,
+)
+from rl_zoo3.utils import SimpleLinearSchedule
+from stable_baselines3 import PPO
+from stable_baselines3.common.utils import ConstantSchedule
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 ALGOS = ("ppo", "sac", "dqn")
@@ -81,7 +87,7 @@ PYTHON = sys.executable
 def tiny_settings(algo: str, output: Path, **changes: Any) -> TrainSettings:
     settings = TrainSettings(
         algo=algo,
-        env_id=train_module.DEFAULT_ENV_IDS[algo],
+        env_id=DEFAULT_ENV_IDS[algo],
         output=output,
         hyperparam_overrides=dict(TINY_HYPERPARAMS[algo]),
         timesteps=TINY_TIMESTEPS,
@@ -156,13 +162,13 @@ def test_saved_model_and_statistics_predict_like_the_trained_model(
     tiny_runs: dict[str, TrainResult], algo: str
 ) -> None:
     result = tiny_runs[algo]
-    raw = _observations(train_module.DEFAULT_ENV_IDS[algo])
+    raw = _observations(DEFAULT_ENV_IDS[algo])
     trained_normalizer = result.model.get_vec_normalize_env()
     assert trained_normalizer is not None
     expected, _ = result.model.predict(trained_normalizer.normalize_obs(raw), deterministic=True)
 
     loaded = load_model(result.run_dir / "model.zip", algo)
-    eval_venv = make_validation_env(train_module.DEFAULT_ENV_IDS[algo], {"scenario": "khepera"}, 1)
+    eval_venv = make_validation_env(DEFAULT_ENV_IDS[algo], {"scenario": "khepera"}, 1)
     loaded_normalizer = load_vecnormalize(result.run_dir / "vecnormalize.pkl", eval_venv)
     actual, _ = loaded.predict(loaded_normalizer.normalize_obs(raw), deterministic=True)
     eval_venv.close()
@@ -475,7 +481,7 @@ def test_exported_models_load_by_name_and_join_the_comparison(
 )  # fmt: skip
 def test_shipped_hyperparameters_parse(algo: str, env_id: str) -> None:
     raw = read_hyperparameters(algo, env_id)
-    parsed = parse_hyperparameters(raw)
+    parsed = parse_hyperparameters(raw, algo)
     assert parsed.n_envs >= 1 and parsed.n_timesteps >= 1
     assert parsed.env_kwargs == {"scenario": "khepera"}
     assert parsed.normalize is not None and parsed.normalize["gamma"] == raw["gamma"]
@@ -484,31 +490,52 @@ def test_shipped_hyperparameters_parse(algo: str, env_id: str) -> None:
     constructor_kwargs = {k: v for k, v in parsed.algorithm_kwargs.items() if k != "policy"}
     if algo != "ppo":
         constructor_kwargs["buffer_size"] = 10  # the model builds, without a big buffer
-    algorithm_class = train_module.ALGORITHMS[algo]
+    algorithm_class = algorithm_class_for(algo)
     algorithm_class(parsed.algorithm_kwargs["policy"], env_id, device="cpu", **constructor_kwargs)
 
 
-def test_hyperparameter_parsing_follows_rl_zoo3() -> None:
-    parsed = parse_hyperparameters(
-        {
-            "n_timesteps": 1e5,
-            "policy": "MlpPolicy",
-            "learning_rate": "lin_0.001",
-            "normalize": "dict(norm_obs=True, norm_reward=False)",
-            "gamma": 0.9,
-            "policy_kwargs": "dict(net_arch=[64, 64], activation_fn=nn.ReLU)",
-            "train_freq": [4, "step"],
-        }
-    )
+def test_hyperparameters_are_preprocessed_by_rl_zoo3() -> None:
+    raw = {
+        "n_timesteps": 1e5,
+        "policy": "MlpPolicy",
+        "learning_rate": "lin_0.001",
+        "clip_range": 0.2,
+        "normalize": "dict(norm_obs=True, norm_reward=False)",
+        "gamma": 0.9,
+        "policy_kwargs": "dict(net_arch=[64, 64], activation_fn=nn.ReLU)",
+        "train_freq": [4, "step"],
+    }
+    parsed = parse_hyperparameters(raw, "ppo")
+    # rl-zoo3's own schedule classes: lin_<x> decays linearly, a number stays constant.
     schedule = parsed.algorithm_kwargs["learning_rate"]
-    assert isinstance(schedule, LinearSchedule) and schedule(0.5) == pytest.approx(5e-4)
+    assert isinstance(schedule, SimpleLinearSchedule)
+    assert schedule(1.0) == pytest.approx(1e-3) and schedule(0.5) == pytest.approx(5e-4)
+    clip_range = parsed.algorithm_kwargs["clip_range"]
+    assert isinstance(clip_range, ConstantSchedule) and clip_range(0.3) == pytest.approx(0.2)
     assert parsed.normalize == {"norm_obs": True, "norm_reward": False, "gamma": 0.9}
+    assert parsed.algorithm_kwargs["policy_kwargs"]["activation_fn"] is torch.nn.ReLU
     assert parsed.algorithm_kwargs["train_freq"] == (4, "step")
     assert parsed.n_envs == 1 and parsed.n_timesteps == 100_000
+    assert not {"n_timesteps", "normalize", "env_kwargs"} & parsed.algorithm_kwargs.keys()
+    assert raw["learning_rate"] == "lin_0.001"  # the raw entry (run.json's record) is kept
+    assert parse_hyperparameters({"n_timesteps": 10, "normalize": False}).normalize is None
+    # SB3 takes them as they are: the model's learning rate follows the schedule.
+    kwargs = {k: v for k, v in parsed.algorithm_kwargs.items() if k not in ("policy", "train_freq")}
+    model = PPO("MlpPolicy", "BearingSLAM-v0", n_steps=8, batch_size=8, device="cpu", **kwargs)
+    assert model.lr_schedule(0.5) == pytest.approx(5e-4)
+
+
+def test_hyperparameters_that_this_trainer_cannot_apply_are_refused_by_name() -> None:
     with pytest.raises(ValueError, match="frame_stack"):
         parse_hyperparameters({"n_timesteps": 10, "frame_stack": 4})
-    with pytest.raises(ValueError, match="policy_kwargs"):
-        parse_hyperparameters({"n_timesteps": 10, "policy_kwargs": "__import__('os')"})
+    with pytest.raises(ValueError, match="policy_kwargs must evaluate to a dict"):
+        parse_hyperparameters({"n_timesteps": 10, "policy_kwargs": "[1, 2]"})
+    with pytest.raises(ValueError, match="n_envs and n_timesteps must be >= 1"):
+        parse_hyperparameters({"n_timesteps": 10, "n_envs": 0})
+    with pytest.raises(ValueError, match="needs n_timesteps"):
+        parse_hyperparameters({"n_envs": 2})
+    with pytest.raises(ValueError, match="learning_rate"):
+        parse_hyperparameters({"n_timesteps": 10, "learning_rate": "lin_fast"})
     assert parse_key_values(["scenario=khepera", "move_length=(0.1, 0.3)", "n=4"], "x") == {
         "scenario": "khepera",
         "move_length": (0.1, 0.3),
@@ -595,7 +622,7 @@ def test_rl_zoo3_trains_with_the_shipped_yaml(rl_zoo3_run: BackgroundCommand | N
 
 
 def test_env_factory_raises_the_time_limit_with_max_moves() -> None:
-    env = train_module.EnvFactory("BearingSLAM-v0", {"scenario": "khepera", "max_moves": 23})()
+    env = EnvFactory("BearingSLAM-v0", {"scenario": "khepera", "max_moves": 23})()
     assert env.spec is not None and env.spec.max_episode_steps == 23
     env.reset(seed=1)
     moves, done = 0, False
