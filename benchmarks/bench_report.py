@@ -200,6 +200,11 @@ def _times(value: float | None) -> str:
     return "-" if value is None else f"{value:.2f}x"
 
 
+def _relative(ratio: float | None, reference: str) -> str:
+    """``"1.5x sync"``, or empty where the reference row was not measured."""
+    return "" if ratio is None else f"{_times(ratio)} {reference}"
+
+
 def table_rows(results: dict[str, Any]) -> list[tuple[str, ...]]:
     """(section, case, steps/s, % nearest ref, ref, % start ref, relative) rows."""
     rows: list[tuple[str, ...]] = []
@@ -224,18 +229,10 @@ def table_rows(results: dict[str, Any]) -> list[tuple[str, ...]]:
             case = "khepera, gym.make wrappers"
         else:
             case = f"random, {row['n_landmarks']} landmarks"
-        relative = (
-            f"{_times(row['ratio_to_4_landmarks'])} 4-landmark rate"
-            if row["ratio_to_4_landmarks"] is not None
-            else ""
-        )
-        add("single", case, row, relative)
+        add("single", case, row, _relative(row["ratio_to_4_landmarks"], "4-landmark rate"))
     for row in results.get("vector", []):
         case = f"{vector_label(row)}, {row['num_envs']} envs"
-        relative = (
-            f"{_times(row['ratio_to_sync'])} sync" if row["ratio_to_sync"] is not None else ""
-        )
-        add("vector", case, row, relative)
+        add("vector", case, row, _relative(row["ratio_to_sync"], "sync"))
     slam_rows = results.get("slam", [])
     for row in slam_rows:
         base = next(
@@ -247,12 +244,7 @@ def table_rows(results: dict[str, Any]) -> list[tuple[str, ...]]:
         add("slam", case, row, f"{_times(row['steps_per_s'] / base)} 4-landmark rate")
     for row in results.get("ppo", []):
         case = f"PPO {ppo_label(row)}, {row['n_envs']} envs"
-        relative = (
-            f"{_times(row['ratio_to_subproc'])} subproc"
-            if row["ratio_to_subproc"] is not None
-            else ""
-        )
-        add("ppo", case, row, relative)
+        add("ppo", case, row, _relative(row["ratio_to_subproc"], "subproc"))
     return rows
 
 

@@ -37,14 +37,19 @@ def test_unknown_subcommand_is_rejected() -> None:
     assert "invalid choice" in result.stderr
 
 
-def test_hyperparams_prints_the_shipped_file_from_any_folder(tmp_path) -> None:
-    result = subprocess.run(
-        [sys.executable, "-m", "bearing_env.train.cli", "hyperparams", "ppo"],
+def hyperparams_command(algo: str, cwd) -> subprocess.CompletedProcess[str]:
+    """``bearing-env hyperparams ALGO`` run from ``cwd`` (not the checkout)."""
+    return subprocess.run(
+        [sys.executable, "-m", "bearing_env.train.cli", "hyperparams", algo],
         capture_output=True,
         text=True,
         timeout=60,
-        cwd=tmp_path,
+        cwd=cwd,
     )
+
+
+def test_hyperparams_prints_the_shipped_file_from_any_folder(tmp_path) -> None:
+    result = hyperparams_command("ppo", tmp_path)
     assert result.returncode == 0, result.stderr
     from pathlib import Path
 
@@ -57,12 +62,6 @@ def test_hyperparams_prints_the_shipped_file_from_any_folder(tmp_path) -> None:
 
 
 def test_hyperparams_rejects_an_algorithm_without_a_file(tmp_path) -> None:
-    result = subprocess.run(
-        [sys.executable, "-m", "bearing_env.train.cli", "hyperparams", "td3"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        cwd=tmp_path,
-    )
+    result = hyperparams_command("td3", tmp_path)
     assert result.returncode == 2
     assert "'td3'" in result.stderr and "dqn, ppo, sac" in result.stderr

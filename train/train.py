@@ -87,7 +87,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -296,6 +296,14 @@ def _close_quietly(venv: VecEnv) -> None:
         venv.close()
 
 
+def _changed_settings(given: Mapping[str, Any], saved: Mapping[str, Any]) -> dict[str, Any]:
+    """The entries of ``given`` that differ from ``saved`` once both are JSON (a tuple
+    given on the command line equals the list run.json read back)."""
+    return {
+        key: value for key, value in given.items() if json_safe(saved.get(key)) != json_safe(value)
+    }
+
+
 def _resolve_run(settings: TrainSettings) -> tuple[dict[str, Any], Checkpoint | None]:
     """The raw hyperparameter entry and, when resuming, the checkpoint to start from."""
     files = RunFiles(settings.output)
@@ -320,21 +328,13 @@ def _resolve_run(settings: TrainSettings) -> tuple[dict[str, Any], Checkpoint | 
             )
     raw = dict(record["hyperparams"])
     saved_env_kwargs = raw.get("env_kwargs") or {}
-    changed = {
-        key: value
-        for key, value in settings.env_kwargs.items()
-        if json_safe(saved_env_kwargs.get(key)) != json_safe(value)
-    }
+    changed = _changed_settings(settings.env_kwargs, saved_env_kwargs)
     if changed:
         raise ValueError(
             f"cannot resume {settings.output} with different env kwargs {changed}; "
             f"it was trained with {saved_env_kwargs}"
         )
-    different = {
-        key: value
-        for key, value in settings.hyperparam_overrides.items()
-        if json_safe(raw.get(key)) != json_safe(value)
-    }
+    different = _changed_settings(settings.hyperparam_overrides, raw)
     if different:
         raise ValueError(
             f"cannot resume {settings.output} with different hyperparameters {different}; "
