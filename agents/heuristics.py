@@ -294,6 +294,8 @@ class GreedyOneStep(MovementPolicy):
             raise ValueError(f"n_turns must be >= 1, got {n_turns!r}")
         self.candidates = self.codec.candidates(int(n_turns), lengths)
         self.area_cap = float(bearing_env_of(env).area_cap)
+        # Score moves with the potential the env rewards (reward="log_area" or "area").
+        self.log_area = bearing_env_of(env).config.reward == "log_area"
         self.belief = RobotBelief(bearing_env_of(env).epsilon)
 
     def reset(self, seed: int | None = None) -> None:
@@ -318,9 +320,10 @@ class GreedyOneStep(MovementPolicy):
             for c in candidates
         ]
         potentials = simulate_potentials(
-            slam, pose.position, landmark_positions_fl(slam), moves, self.area_cap
-        )
-        if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap):
+            slam, pose.position, landmark_positions_fl(slam), moves, self.area_cap,
+            log_area=self.log_area,
+        )  # fmt: skip
+        if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap, self.log_area):
             # No candidate is predicted to help (e.g. every landmark is uninitialised):
             # fall back on the move that keeps every landmark off the line of motion.
             return bootstrap_movement(self.codec, view)
@@ -368,7 +371,8 @@ class GreedyOracle(GreedyOneStep):
             truth[:, 0] + 1j * truth[:, 1],
             moves,
             self.area_cap,
+            log_area=self.log_area,
         )
-        if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap):
+        if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap, self.log_area):
             return bootstrap_movement(self.codec, view)
         return self.candidates[int(np.argmin(potentials))]
