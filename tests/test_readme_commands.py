@@ -132,8 +132,9 @@ def _parse(argv: list[str]) -> None:
         # rl-zoo3 builds its parser inside train(), so the run itself is in test_train
         # (test_rl_zoo3_trains_with_the_shipped_yaml, with this substitution's path); here
         # the module imports and the substituted path exists.
-        import rl_zoo3.train  # noqa: F401
+        from bearing_env.train.zoo import rl_zoo3_module
 
+        assert callable(rl_zoo3_module("rl_zoo3.train").train)
         conf = rest.index("--conf-file") + 1
         assert rest[conf] == "$(bearing-env hyperparams ppo)"
         from bearing_env.train.conf_files import default_conf_file

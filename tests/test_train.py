@@ -52,8 +52,8 @@ from bearing_env.train.zoo import (
     load_vecnormalize,
     parse_hyperparameters,
     read_hyperparameters,
+    rl_zoo3_module,
 )
-from rl_zoo3.utils import SimpleLinearSchedule
 from stable_baselines3 import PPO
 from stable_baselines3.common.utils import ConstantSchedule
 
@@ -506,6 +506,7 @@ def test_hyperparameters_are_preprocessed_by_rl_zoo3() -> None:
         "train_freq": [4, "step"],
     }
     parsed = parse_hyperparameters(raw, "ppo")
+    SimpleLinearSchedule = rl_zoo3_module("rl_zoo3.utils").SimpleLinearSchedule
     # rl-zoo3's own schedule classes: lin_<x> decays linearly, a number stays constant.
     schedule = parsed.algorithm_kwargs["learning_rate"]
     assert isinstance(schedule, SimpleLinearSchedule)
@@ -523,6 +524,19 @@ def test_hyperparameters_are_preprocessed_by_rl_zoo3() -> None:
     kwargs = {k: v for k, v in parsed.algorithm_kwargs.items() if k not in ("policy", "train_freq")}
     model = PPO("MlpPolicy", "BearingSLAM-v0", n_steps=8, batch_size=8, device="cpu", **kwargs)
     assert model.lr_schedule(0.5) == pytest.approx(5e-4)
+
+
+def test_using_rl_zoo3_leaves_gymnasium_unpatched() -> None:
+    """rl-zoo3 replaces TimeLimit on import; the trainer's use of it must not leak."""
+    read_hyperparameters("ppo", "BearingSLAM-v0")
+    algorithm_class_for("ppo")
+    assert gym.wrappers.TimeLimit.__module__.startswith("gymnasium.")
+    env = gym.make("BearingSLAM-v0", max_episode_steps=1)
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    info = env.step(env.action_space.sample())[4]
+    assert "TimeLimit.truncated" not in info
+    assert "bool8" not in vars(np)
 
 
 def test_hyperparameters_that_this_trainer_cannot_apply_are_refused_by_name() -> None:

@@ -11,22 +11,29 @@ algorithm's ``gamma``, ``policy_kwargs`` strings are evaluated with ``nn`` and `
 scope, ``train_freq`` lists become tuples). The keys rl-zoo3 turns into wrappers,
 callbacks or noise (:data:`UNSUPPORTED_ZOO_KEYS`) are refused: this trainer builds its
 own envs and callbacks. The algorithm classes are rl-zoo3's ``ALGOS``.
+
+Importing ``rl_zoo3`` patches Gymnasium for the whole process (``rl_zoo3.gym_patches``
+replaces ``TimeLimit``, which then adds a ``TimeLimit.truncated`` info key to every
+``gym.make`` env, and sets ``np.bool8``). :func:`rl_zoo3_module` imports it and puts
+Gymnasium and numpy back as they were, so using rl-zoo3's code here leaves the envs'
+contract untouched; under ``python -m rl_zoo3.train`` rl-zoo3 patches as it always does.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import importlib
 import io
 import zipfile
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
+import numpy as np
 from bearing_env.train.conf_files import default_conf_file
-from rl_zoo3.exp_manager import ExperimentManager
-from rl_zoo3.utils import ALGOS
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
@@ -66,6 +73,38 @@ class Hyperparameters:
     algorithm_kwargs: dict[str, Any]
 
 
+#: The Gymnasium attributes ``rl_zoo3.gym_patches`` replaces (module, attribute name).
+_PATCHED_BY_RL_ZOO3: tuple[tuple[str, str], ...] = (
+    ("gymnasium.wrappers", "TimeLimit"),
+    ("gymnasium.wrappers.common", "TimeLimit"),
+    ("gymnasium.envs.registration", "TimeLimit"),
+)
+
+
+_ABSENT = object()
+
+
+def rl_zoo3_module(name: str) -> ModuleType:
+    """``importlib.import_module(name)`` of an ``rl_zoo3`` module, with Gymnasium's
+    ``TimeLimit`` and numpy's attributes restored after rl-zoo3's import-time patches."""
+    saved = [
+        (module, attribute, vars(module).get(attribute, _ABSENT))
+        for module, attribute in [
+            (importlib.import_module(module_name), attribute)
+            for module_name, attribute in _PATCHED_BY_RL_ZOO3
+        ]
+    ]
+    saved.append((np, "bool8", vars(np).get("bool8", _ABSENT)))
+    try:
+        return importlib.import_module(name)
+    finally:
+        for module, attribute, value in saved:
+            if value is _ABSENT:
+                vars(module).pop(attribute, None)
+            else:
+                setattr(module, attribute, value)
+
+
 def hyperparams_key(env_id: str) -> str:
     """The file key of an env id: ``bearing_env:BearingSLAM-v0`` -> ``BearingSLAM-v0``."""
     return env_id.split(":")[-1]
@@ -76,7 +115,8 @@ def _experiment_manager(algo: str, env_id: str, conf_file: Path | None = None) -
     creates no folder and no env until ``setup_experiment``, which is never called)."""
     import bearing_env  # noqa: F401  (registers the env ids rl-zoo3 looks up)
 
-    return ExperimentManager(
+    experiment_manager = rl_zoo3_module("rl_zoo3.exp_manager").ExperimentManager
+    return experiment_manager(
         argparse.Namespace(),
         algo,
         hyperparams_key(env_id),
@@ -161,7 +201,8 @@ def algorithm_class_for(algo: str) -> type[BaseAlgorithm]:
     key = algo.lower()
     if key not in DEFAULT_ENV_IDS:
         raise ValueError(f"unknown algorithm {algo!r}; expected one of {sorted(DEFAULT_ENV_IDS)}")
-    return ALGOS[key]
+    algorithms: dict[str, type[BaseAlgorithm]] = rl_zoo3_module("rl_zoo3.utils").ALGOS
+    return algorithms[key]
 
 
 def _existing_file(path: Path, what: str) -> Path:
