@@ -652,3 +652,17 @@ def test_train_is_a_bearing_env_subcommand() -> None:
     from bearing_env.train.cli import SUBCOMMANDS
 
     assert SUBCOMMANDS["train"][0] == "bearing_env.train.train"
+
+
+def test_checkpoints_keep_sb3_checkpoint_callback_names(tmp_path: Path) -> None:
+    from bearing_env.train.callbacks import PeriodicCheckpointCallback
+    from stable_baselines3.common.callbacks import CheckpointCallback
+
+    checkpoint = CheckpointStore(tmp_path, keep=1).checkpoint_at(48)
+    assert checkpoint.model_path == tmp_path / "rl_model_48_steps.zip"
+    assert checkpoint.vecnormalize_path == tmp_path / "rl_model_vecnormalize_48_steps.pkl"
+    assert checkpoint.replay_buffer_path == tmp_path / "rl_model_replay_buffer_48_steps.pkl"
+    callback = PeriodicCheckpointCallback(CheckpointStore(tmp_path), save_freq=16)
+    assert isinstance(callback, CheckpointCallback)
+    assert callback._on_step() is True  # SB3's mid-rollout save never runs
+    assert not list(tmp_path.iterdir())

@@ -17,9 +17,10 @@
 - :class:`StopOnRequestCallback`: ends ``learn()`` cleanly at the next env step once a
   :class:`StopRequest` is set (by the Ctrl-C handler).
 
-SB3's own ``CheckpointCallback`` is not used: it saves from ``_on_step`` on a call count,
-in the middle of a rollout (the steps of the partial rollout are counted but were never
-trained on), writes in place and does not prune; only its file names are kept.
+:class:`PeriodicCheckpointCallback` subclasses SB3's ``CheckpointCallback`` and keeps its
+file names (``_checkpoint_path``), but not its saving: SB3 saves from ``_on_step`` on a
+call count, in the middle of a rollout (the steps of the partial rollout are counted but
+were never trained on), writes in place and does not prune.
 - :class:`FixedSeedEvalCallback`: SB3's ``EvalCallback`` that plays the same validation
   episodes (fixed reset seeds) at every evaluation, logs the total uncertainty area, saves
   the VecNormalize statistics beside the best model, and carries its history over a
@@ -38,7 +39,7 @@ from typing import Any
 import numpy as np
 from bearing_env.train.files import atomic_path, write_json_atomically
 from stable_baselines3.common.base_class import BaseAlgorithm
-from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
+from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
@@ -88,13 +89,15 @@ class CheckpointStore:
         self.keep = keep
 
     def checkpoint_at(self, timesteps: int) -> Checkpoint:
+        """The files of the checkpoint at ``timesteps``, named by SB3's own
+        ``CheckpointCallback._checkpoint_path``."""
+        namer = CheckpointCallback(1, str(self.folder), name_prefix=CHECKPOINT_PREFIX)
+        namer.num_timesteps = timesteps
         return Checkpoint(
             timesteps=timesteps,
-            model_path=self.folder / f"{CHECKPOINT_PREFIX}_{timesteps}_steps.zip",
-            vecnormalize_path=self.folder
-            / f"{CHECKPOINT_PREFIX}_vecnormalize_{timesteps}_steps.pkl",
-            replay_buffer_path=self.folder
-            / f"{CHECKPOINT_PREFIX}_replay_buffer_{timesteps}_steps.pkl",
+            model_path=Path(namer._checkpoint_path(extension="zip")),
+            vecnormalize_path=Path(namer._checkpoint_path("vecnormalize_", extension="pkl")),
+            replay_buffer_path=Path(namer._checkpoint_path("replay_buffer_", extension="pkl")),
         )
 
     def list(self) -> list[Checkpoint]:
@@ -197,9 +200,11 @@ def rewind_to_boundary(model: BaseAlgorithm, boundary: UpdateBoundary) -> int:
     return dropped
 
 
-class PeriodicCheckpointCallback(BaseCallback):
-    """Saves a checkpoint at the first update boundary at or past each multiple of
-    ``save_freq`` env steps, and remembers the last boundary (:attr:`boundary`).
+class PeriodicCheckpointCallback(CheckpointCallback):
+    """SB3's ``CheckpointCallback`` (its folder, prefix and file names) that saves at the
+    first update boundary at or past each multiple of ``save_freq`` env steps instead of
+    from ``_on_step`` in the middle of a rollout, writes through :class:`CheckpointStore`
+    (atomic files, pruning), and remembers the last boundary (:attr:`boundary`).
 
     ``on_save`` is called with each checkpoint written (the trainer updates ``run.json``).
     """
@@ -211,9 +216,16 @@ class PeriodicCheckpointCallback(BaseCallback):
         verbose: int = 0,
         on_save: Callable[[Checkpoint], None] | None = None,
     ) -> None:
-        super().__init__(verbose)
         if save_freq < 1:
             raise ValueError(f"save_freq must be >= 1 env steps, got {save_freq}")
+        super().__init__(
+            save_freq,
+            str(store.folder),
+            name_prefix=CHECKPOINT_PREFIX,
+            save_replay_buffer=True,
+            save_vecnormalize=True,
+            verbose=verbose,
+        )
         self.store = store
         self.save_freq = save_freq
         self.on_save = on_save
@@ -238,6 +250,7 @@ class PeriodicCheckpointCallback(BaseCallback):
                 self.on_save(checkpoint)
 
     def _on_step(self) -> bool:
+        # Never SB3's save here: mid-rollout, it would count steps not yet trained on.
         return True
 
 
