@@ -1,4 +1,5 @@
-"""stable-baselines3 callbacks and file helpers for ``bearing-env train``.
+"""The stable-baselines3 callbacks of ``bearing-env train``: checkpoints at update
+boundaries, stopping on request, and the fixed-seed evaluation.
 
 - :class:`CheckpointStore`: the run's ``checkpoints/`` folder. A checkpoint is the model
   (``rl_model_<N>_steps.zip``), its VecNormalize statistics

@@ -1,5 +1,5 @@
-"""The reports of a comparison, from its summary and records: the terminal tables, ``report.md``,
-``summary.csv`` and ``episodes.csv`` (stdlib ``csv``), the PNG plots, ``summary.json``
+"""The reports of a comparison, from its summary and records: the terminal tables,
+``report.md``, ``summary.csv`` and ``episodes.csv`` (stdlib ``csv``), the PNG plots, ``summary.json``
 and ``timing.json``, each written atomically.
 """
 
