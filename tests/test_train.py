@@ -31,6 +31,7 @@ import yaml
 from bearing_env.agents import SB3Policy
 from bearing_env.train.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
 from bearing_env.train.cli_values import parse_key_values
+from bearing_env.train.export import export_run
 from bearing_env.train.seeds import (
     MAX_VALIDATION_EPISODES,
     TRAINING_SEED_LIMIT,
@@ -41,7 +42,6 @@ from bearing_env.train.train import (
     EXIT_INTERRUPTED,
     TrainResult,
     TrainSettings,
-    export_run,
     train,
 )
 from bearing_env.train.training_envs import EnvFactory, EpisodeSeedCycle, make_validation_env

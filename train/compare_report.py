@@ -1,6 +1,6 @@
 """The reports of a comparison, from its summary and records: the terminal tables,
-``report.md``, ``summary.csv`` and ``episodes.csv`` (stdlib ``csv``), the PNG plots, ``summary.json``
-and ``timing.json``, each written atomically.
+``report.md``, ``summary.csv`` and ``episodes.csv`` (stdlib ``csv``), the PNG plots,
+``summary.json`` and ``timing.json``, each written atomically.
 """
 
 from __future__ import annotations

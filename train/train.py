@@ -80,9 +80,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import json
 import math
-import shutil
 import signal
 import sys
 import threading
@@ -96,9 +94,6 @@ import gymnasium as gym
 import numpy as np
 import torch
 from bearing_env.train.callbacks import (
-    BEST_MODEL_NAME,
-    BEST_SUMMARY_NAME,
-    BEST_VECNORMALIZE_NAME,
     Checkpoint,
     CheckpointStore,
     FixedSeedEvalCallback,
@@ -112,7 +107,12 @@ from bearing_env.train.callbacks import (
 )
 from bearing_env.train.cli_values import json_safe, parse_key_values
 from bearing_env.train.errors import fail, write_error_message
-from bearing_env.train.files import atomic_path, write_json_atomically
+from bearing_env.train.export import ExportedModel, export_run
+from bearing_env.train.files import write_json_atomically
+from bearing_env.train.run_folder import (
+    RunFiles,
+    read_run_record,
+)
 from bearing_env.train.seeds import (
     TRAINING_SEED_LIMIT,
     VALIDATION_SEED_START,
@@ -149,10 +149,6 @@ DEFAULT_CHECKPOINT_FREQ = 50_000
 DEFAULT_KEEP_CHECKPOINTS = 3
 DEFAULT_RUNS_DIR = Path("runs")
 
-RUN_RECORD_NAME = "run.json"
-FINAL_MODEL_NAME = "model.zip"
-FINAL_VECNORMALIZE_NAME = "vecnormalize.pkl"
-EXPORT_VECNORMALIZE_SUFFIX = "_vecnormalize.pkl"
 RUN_FORMAT_VERSION = 1
 EXIT_INTERRUPTED = 130
 
@@ -201,54 +197,6 @@ class TrainResult:
     #: Env steps per second of wall time in this invocation (``learn()`` only).
     steps_per_second: float
     wall_seconds: float
-
-
-@dataclass(frozen=True)
-class RunFiles:
-    """Paths inside a run folder."""
-
-    root: Path
-
-    @property
-    def record(self) -> Path:
-        return self.root / RUN_RECORD_NAME
-
-    @property
-    def final_model(self) -> Path:
-        return self.root / FINAL_MODEL_NAME
-
-    @property
-    def final_vecnormalize(self) -> Path:
-        return self.root / FINAL_VECNORMALIZE_NAME
-
-    @property
-    def best(self) -> Path:
-        return self.root / "best"
-
-    @property
-    def checkpoints(self) -> Path:
-        return self.root / "checkpoints"
-
-    @property
-    def monitor(self) -> Path:
-        return self.root / "monitor"
-
-    @property
-    def tensorboard(self) -> Path:
-        return self.root / "tensorboard"
-
-
-def read_run_record(run_dir: Path) -> dict[str, Any]:
-    path = RunFiles(run_dir).record
-    if not path.is_file():
-        raise FileNotFoundError(f"no run to resume: {path} does not exist")
-    try:
-        record = json.loads(path.read_text())
-    except json.JSONDecodeError as error:
-        raise ValueError(f"run record {path} is corrupt: {error}") from error
-    if not isinstance(record, dict):
-        raise ValueError(f"run record {path} is corrupt: not a JSON object")
-    return record
 
 
 def _versions() -> dict[str, str]:
@@ -576,88 +524,6 @@ def train(settings: TrainSettings) -> TrainResult:
         checkpoint=saved,
         steps_per_second=steps_per_second,
         wall_seconds=wall_seconds,
-    )
-
-
-# --------------------------------------------------------------------------------------
-# Export
-# --------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class ExportedModel:
-    model_path: Path
-    vecnormalize_path: Path | None
-    metadata_path: Path
-    source: str
-
-
-def export_run(run_dir: Path, destination: Path) -> ExportedModel:
-    """Copy a run's best model (or its final model) to ``destination``: ``<dest>.zip``,
-    ``<dest>_vecnormalize.pkl`` (when the run normalised) and ``<dest>.json``."""
-    record = read_run_record(run_dir)
-    files = RunFiles(run_dir)
-    best_model = files.best / BEST_MODEL_NAME
-    if best_model.is_file():
-        source, model_path = "best", best_model
-        stats_path: Path | None = files.best / BEST_VECNORMALIZE_NAME
-        summary_path = files.best / BEST_SUMMARY_NAME
-        validation = json.loads(summary_path.read_text()) if summary_path.is_file() else None
-    elif files.final_model.is_file():
-        source, model_path, stats_path, validation = (
-            "final",
-            files.final_model,
-            files.final_vecnormalize,
-            None,
-        )
-    else:
-        raise FileNotFoundError(
-            f"{run_dir} has neither {best_model} nor {files.final_model}: train it further first"
-        )
-    model = load_model(model_path, record["algo"])  # refuses a corrupt file before copying
-    normalizes = record["hyperparams"].get("normalize") not in (None, False)
-    if normalizes and (stats_path is None or not stats_path.is_file()):
-        raise FileNotFoundError(f"the run normalises observations but {stats_path} is missing")
-    if not normalizes:
-        stats_path = None
-
-    name = destination.name.removesuffix(".zip")
-    folder = destination.parent
-    folder.mkdir(parents=True, exist_ok=True)
-    exported_model = folder / f"{name}.zip"
-    exported_stats = folder / f"{name}{EXPORT_VECNORMALIZE_SUFFIX}"
-    with atomic_path(exported_model) as temporary:
-        shutil.copyfile(model_path, temporary)
-    if stats_path is not None:
-        with atomic_path(exported_stats) as temporary:
-            shutil.copyfile(stats_path, temporary)
-    else:
-        exported_stats.unlink(missing_ok=True)
-    metadata = {
-        "name": name,
-        "algo": record["algo"],
-        "env_id": record["env_id"],
-        "env_kwargs": record["env_kwargs"],
-        "source": source,
-        "num_timesteps": int(model.num_timesteps),
-        "run_timesteps": record.get("num_timesteps"),
-        "seed": record.get("seed"),
-        "validation": validation,
-        "validation_seeds": record.get("seeds", {}).get("validation"),
-        "hyperparams": record["hyperparams"],
-        "versions": record.get("versions"),
-        "files": {
-            "model": exported_model.name,
-            "vecnormalize": exported_stats.name if stats_path is not None else None,
-        },
-    }
-    metadata_path = folder / f"{name}.json"
-    write_json_atomically(metadata_path, metadata)
-    return ExportedModel(
-        model_path=exported_model,
-        vecnormalize_path=exported_stats if stats_path is not None else None,
-        metadata_path=metadata_path,
-        source=source,
     )
 
 
