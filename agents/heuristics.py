@@ -157,7 +157,20 @@ class RandomPolygonal(MovementPolicy):
 PARALLAX_SIGN_RULES: tuple[str, ...] = ("inward", "axis")
 
 
-class Parallax(MovementPolicy):
+class BeliefPolicy(MovementPolicy):
+    """A :class:`MovementPolicy` that tracks its own pose from the map, its commands and
+    the observation (:class:`RobotBelief`), reset with each episode."""
+
+    def __init__(self, env: gym.Env) -> None:
+        super().__init__(env)
+        self.belief = RobotBelief(bearing_env_of(env).epsilon)
+
+    def reset(self, seed: int | None = None) -> None:
+        super().reset(seed)
+        self.belief.reset()
+
+
+class Parallax(BeliefPolicy):
     """Move perpendicular to the line of sight of the most uncertain landmark.
 
     The most uncertain landmark is the one with the largest region (an uninitialised one
@@ -197,11 +210,6 @@ class Parallax(MovementPolicy):
             raise ValueError(f"sign_rule must be one of {PARALLAX_SIGN_RULES}, got {sign_rule!r}")
         self.length = self.codec.max_length if length is None else float(length)
         self.sign_rule = sign_rule
-        self.belief = RobotBelief(bearing_env_of(env).epsilon)
-
-    def reset(self, seed: int | None = None) -> None:
-        super().reset(seed)
-        self.belief.reset()
 
     def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
         view = self.reader.read(observation)
@@ -252,7 +260,7 @@ def _principal_axis(polygon: NDArray[np.float64]) -> float:
     return float(math.atan2(vh[0, 1], vh[0, 0]))
 
 
-class GreedyOneStep(MovementPolicy):
+class GreedyOneStep(BeliefPolicy):
     """One-step greedy planner on the robot's own map.
 
     For each of K candidate movements (``n_turns`` turns x ``lengths`` lengths, K = 16 by
@@ -296,11 +304,6 @@ class GreedyOneStep(MovementPolicy):
         self.area_cap = float(bearing_env_of(env).area_cap)
         # Score moves with the potential the env rewards (reward="log_area" or "area").
         self.log_area = bearing_env_of(env).config.reward == "log_area"
-        self.belief = RobotBelief(bearing_env_of(env).epsilon)
-
-    def reset(self, seed: int | None = None) -> None:
-        super().reset(seed)
-        self.belief.reset()
 
     def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
         view = self.reader.read(observation)
