@@ -23,6 +23,8 @@ import numpy as np
 from gymnasium import spaces
 from numpy.typing import NDArray
 
+from bearing_env.slam.geometry import wrap_angle as _wrap_angles
+
 from .env_access import bearing_env_of
 
 if TYPE_CHECKING:
@@ -57,8 +59,9 @@ def policy_rng(seed: int | None) -> np.random.Generator:
 
 
 def wrap_angle(angle: float) -> float:
-    """Wrap an angle to [-pi, pi)."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+    """Wrap an angle to [-pi, pi): ``bearing_env.slam.geometry.wrap_angle`` of one angle,
+    as a Python float."""
+    return float(_wrap_angles(angle))
 
 
 @dataclass(frozen=True)

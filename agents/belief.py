@@ -172,10 +172,6 @@ class RobotBelief:
         self._scale_samples: list[float] = []
         self._blocked_samples: list[float] = []
 
-    @property
-    def scale_samples(self) -> list[float]:
-        return list(self._scale_samples)
-
     def observe(self, view: ObservationView) -> None:
         """Account for the outcome of the last commanded movement."""
         if view.progress == 0.0:

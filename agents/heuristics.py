@@ -171,7 +171,20 @@ class RandomPolygonal(MovementPolicy):
 PARALLAX_SIGN_RULES: tuple[str, ...] = ("inward", "axis")
 
 
-class Parallax(MovementPolicy):
+class BeliefPolicy(MovementPolicy):
+    """A :class:`MovementPolicy` that tracks its own pose from the map, its commands and
+    the observation (:class:`RobotBelief`), reset with each episode."""
+
+    def __init__(self, env: gym.Env) -> None:
+        super().__init__(env)
+        self.belief = RobotBelief(bearing_env_of(env).epsilon)
+
+    def reset(self, seed: int | None = None) -> None:
+        super().reset(seed)
+        self.belief.reset()
+
+
+class Parallax(BeliefPolicy):
     """Move perpendicular to the line of sight of the most uncertain landmark.
 
     The most uncertain landmark is the one with the largest region (an uninitialised one
@@ -211,11 +224,6 @@ class Parallax(MovementPolicy):
             raise ValueError(f"sign_rule must be one of {PARALLAX_SIGN_RULES}, got {sign_rule!r}")
         self.length = self.codec.max_length if length is None else float(length)
         self.sign_rule = sign_rule
-        self.belief = RobotBelief(bearing_env_of(env).epsilon)
-
-    def reset(self, seed: int | None = None) -> None:
-        super().reset(seed)
-        self.belief.reset()
 
     def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
         view = self.reader.read(observation)
@@ -266,7 +274,7 @@ def _principal_axis(polygon: NDArray[np.float64]) -> float:
     return float(math.atan2(vh[0, 1], vh[0, 0]))
 
 
-class GreedyOneStep(MovementPolicy):
+class GreedyOneStep(BeliefPolicy):
     """One-step greedy planner on the robot's own map.
 
     For each of K candidate movements (``n_turns`` turns x ``lengths`` lengths, K = 16 by
@@ -309,11 +317,8 @@ class GreedyOneStep(MovementPolicy):
             raise ValueError(f"n_turns must be >= 1, got {n_turns!r}")
         self.candidates = self.codec.candidates(int(n_turns), lengths)
         self.area_cap = float(bearing_env_of(env).area_cap)
-        self.belief = RobotBelief(bearing_env_of(env).epsilon)
-
-    def reset(self, seed: int | None = None) -> None:
-        super().reset(seed)
-        self.belief.reset()
+        # Score moves with the potential the env rewards (reward="log_area" or "area").
+        self.log_area = bearing_env_of(env).config.reward == "log_area"
 
     def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
         view = self.reader.read(observation)
@@ -332,9 +337,10 @@ class GreedyOneStep(MovementPolicy):
             for c in candidates
         ]
         potentials = simulate_potentials(
-            slam, pose.position, landmark_positions_fl(slam), moves, self.area_cap
-        )
-        if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap):
+            slam, pose.position, landmark_positions_fl(slam), moves, self.area_cap,
+            log_area=self.log_area,
+        )  # fmt: skip
+        if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap, self.log_area):
             # No candidate is predicted to help (e.g. every landmark is uninitialised):
             # fall back on the move that keeps every landmark off the line of motion.
             return bootstrap_movement(self.codec, view)
@@ -381,7 +387,8 @@ class GreedyOracle(GreedyOneStep):
             truth[:, 0] + 1j * truth[:, 1],
             moves,
             self.area_cap,
+            log_area=self.log_area,
         )
-        if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap):
+        if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap, self.log_area):
             return bootstrap_movement(self.codec, view)
         return self.candidates[int(np.argmin(potentials))]

@@ -16,13 +16,24 @@ import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env.envs.bearing_slam import AREA_FLOOR
+from bearing_env.envs.kernels import potential_of
 from bearing_env.slam import PolygonSLAM
+from bearing_env.slam.geometry import wrap_angle
 
 
-def uncertainty_potential(areas: NDArray[np.float64], area_cap: float) -> NDArray[np.float64]:
-    """The env's default potential: sum of log areas, capped (uninitialised = cap), over
-    the last axis (one value per map for areas (..., n - 2))."""
-    return np.sum(np.log(np.clip(areas, AREA_FLOOR, area_cap)), axis=-1)
+def uncertainty_potential(
+    areas: NDArray[np.float64], area_cap: float, log_area: bool = True
+) -> NDArray[np.float64]:
+    """The env's uncertainty potential over the last axis (one value per map for areas
+    (..., n - 2)): the compiled ``potential_of`` the env's reward uses, so the planner
+    scores moves as the env rewards them, for ``reward="log_area"`` (sum of log capped
+    areas, the default) and ``reward="area"`` (``log_area=False``: sum of capped areas)."""
+    values = np.asarray(areas, dtype=np.float64)
+    rows = np.ascontiguousarray(values.reshape(-1, values.shape[-1]))
+    potentials = np.array(
+        [potential_of(row, row.size, log_area, AREA_FLOOR, float(area_cap)) for row in rows]
+    )
+    return potentials.reshape(values.shape[:-1])
 
 
 def bearings_from(
@@ -33,7 +44,7 @@ def bearings_from(
     """Noise-free bearings (..., n) of ``points`` (n,) in FL from ``position`` facing
     ``heading`` (scalars, or arrays of one shape for many poses)."""
     angles = np.angle(points - np.asarray(position)[..., None]) - np.asarray(heading)[..., None]
-    return (angles + np.pi) % (2.0 * np.pi) - np.pi
+    return wrap_angle(angles)
 
 
 @dataclass(frozen=True)
@@ -51,6 +62,7 @@ def simulate_potentials(
     moves: Sequence[SimulatedMove],
     area_cap: float,
     min_distance: float = 1e-9,
+    log_area: bool = True,
 ) -> NDArray[np.float64]:
     """The uncertainty potential after each candidate move, simulated on a copy of ``slam``.
 
@@ -63,10 +75,11 @@ def simulate_potentials(
         moves: the candidates.
         area_cap: the cap (and the value of an uninitialised landmark) of the potential.
         min_distance: a move shorter than this (FL units) does not update the map.
+        log_area: the env's ``reward`` is ``"log_area"`` (True) or ``"area"`` (False).
 
     Every candidate is fused into its own copy of the map, all in one batched update.
     """
-    current = uncertainty_potential(slam.areas, area_cap)
+    current = uncertainty_potential(slam.areas, area_cap, log_area)
     known = np.isfinite(landmarks)
     targets = np.where(known, landmarks, 0.0)
     potentials = np.full(len(moves), current)
@@ -86,7 +99,7 @@ def simulate_potentials(
     bearings_end = np.where(known, bearings_from(ends, headings, targets), bearings_start)
     trials = slam.replicate(len(moving))
     trials.update(bearings_start, bearings_end, robot=False)  # scores need areas only
-    potentials[moving] = uncertainty_potential(trials.areas, area_cap)
+    potentials[moving] = uncertainty_potential(trials.areas, area_cap, log_area)
     return potentials
 
 

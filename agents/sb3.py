@@ -20,6 +20,7 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from bearing_env.extras import require
+from bearing_env.shipped import shipped_dir
 
 from .base import Action
 
@@ -51,7 +52,7 @@ _ALGORITHM_MODULES = {
 
 #: Where shipped models live: ``<name>.zip``, ``<name>_vecnormalize.pkl`` and a
 #: ``<name>.json`` record of how the model was trained (env id and kwargs, timesteps).
-PRETRAINED_DIR = Path(__file__).resolve().parent / "pretrained"
+PRETRAINED_DIR = shipped_dir("bearing_env.agents", "pretrained")
 
 
 def pretrained_names() -> list[str]:

@@ -669,3 +669,30 @@ def test_samples_fall_inside_the_polygon_uniformly() -> None:
     assert abs(points.mean() - (1 + 0.5j)) < 0.03
     assert abs(np.mean(points.real < 1.0) - 0.5) < 0.03  # uniform, not per-triangle
     assert sample_in_polygon(square[:1], 3, np.random.default_rng(0)).tolist() == [0j] * 3
+
+
+@pytest.mark.parametrize("reward", ["log_area", "area"])
+def test_the_planner_scores_moves_with_the_potential_the_env_rewards(reward: str) -> None:
+    """The reward is the decrease of the env's potential; the planner's potential is the
+    same function, for either reward (the old copy always took log areas)."""
+    from bearing_env.agents.heuristics import GreedyOneStep
+    from bearing_env.agents.planning import uncertainty_potential
+
+    env = gym.make("BearingSLAM-v0", scenario="khepera", reward=reward)
+    env.reset(seed=5)
+    env.action_space.seed(5)
+    planner = GreedyOneStep(env)
+    assert planner.log_area is (reward == "log_area")
+    cap = env.unwrapped.area_cap
+    before = uncertainty_potential(env.unwrapped.slam.areas, cap, planner.log_area)
+    rewards = []
+    for _ in range(10):
+        _, step_reward, terminated, truncated, _ = env.step(env.action_space.sample())
+        after = uncertainty_potential(env.unwrapped.slam.areas, cap, planner.log_area)
+        assert float(before - after) == pytest.approx(float(step_reward), rel=1e-12, abs=1e-12)
+        rewards.append(step_reward)
+        before = after
+        if terminated or truncated:
+            break
+    assert any(r != 0.0 for r in rewards)
+    env.close()

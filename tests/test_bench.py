@@ -10,9 +10,10 @@ from pathlib import Path
 from typing import Any
 
 import bearing_env.train.train
+import bearing_env.train.training_envs
 import gymnasium as gym
 import pytest
-from bearing_env.benchmarks import bench_env
+from bearing_env.benchmarks import bench_env, bench_report, bench_timing
 from bearing_env.train import cli
 from gymnasium.vector import AutoresetMode
 
@@ -39,7 +40,7 @@ def run_quick(tmp_path: Path, *arguments: str) -> tuple[dict[str, Any], Path]:
 
 
 def check_common(results: dict[str, Any], sections: set[str]) -> None:
-    assert results["format"] == bench_env.JSON_FORMAT
+    assert results["format"] == bench_report.JSON_FORMAT
     assert MACHINE_KEYS <= results["machine"].keys()
     assert results["machine"]["cpu_count"] >= 1
     assert set(results["settings"]["sections"]) == sections
@@ -47,9 +48,9 @@ def check_common(results: dict[str, Any], sections: set[str]) -> None:
     labels = [ref["label"] for ref in references]
     assert labels[0] == "start" and labels[-1] == "end"
     assert all(positive_finite(ref["steps_per_s"]) for ref in references)
-    assert {section for section in bench_env.SECTIONS if section in results} == sections
+    assert {section for section in bench_timing.SECTIONS if section in results} == sections
     targets = {target["id"]: target for target in results["targets"]}
-    assert set(targets) == set(bench_env.TARGETS)
+    assert set(targets) == set(bench_report.TARGETS)
     for target in targets.values():
         assert target["met"] in (True, False, None)
         assert (target["met"] is None) == (target["value"] is None)
@@ -126,7 +127,7 @@ def test_quick_ppo_subproc(tmp_path: Path) -> None:
 
 def stand_in_vector_env(num_envs: int, max_episode_steps: int, **env_kwargs: Any) -> Any:
     """A vector entry point for the test (SAME_STEP autoreset, unlike the default)."""
-    factories = [lambda: gym.make(bench_env.ENV_ID, **env_kwargs)] * num_envs
+    factories = [lambda: gym.make(bench_timing.ENV_ID, **env_kwargs)] * num_envs
     return gym.vector.SyncVectorEnv(factories, autoreset_mode=AutoresetMode.SAME_STEP)
 
 
@@ -134,10 +135,10 @@ def test_batched_rows_are_not_fallbacks_when_available(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """With a vector entry point and a "batched" vec env kind, nothing is labelled fallback."""
-    monkeypatch.setattr(gym.spec(bench_env.ENV_ID), "vector_entry_point", stand_in_vector_env)
-    kinds = tuple(dict.fromkeys((*bearing_env.train.train.VEC_ENV_KINDS, "batched")))
-    monkeypatch.setattr(bearing_env.train.train, "VEC_ENV_KINDS", kinds)
-    make_training_env = bearing_env.train.train.make_training_env
+    monkeypatch.setattr(gym.spec(bench_timing.ENV_ID), "vector_entry_point", stand_in_vector_env)
+    kinds = tuple(dict.fromkeys((*bearing_env.train.training_envs.VEC_ENV_KINDS, "batched")))
+    monkeypatch.setattr(bearing_env.train.training_envs, "VEC_ENV_KINDS", kinds)
+    make_training_env = bearing_env.train.training_envs.make_training_env
 
     def make_with_batched(
         env_id: str, env_kwargs: dict[str, Any], n_envs: int, kind: str, monitor_dir: Path | None
@@ -146,7 +147,7 @@ def test_batched_rows_are_not_fallbacks_when_available(
             env_id, env_kwargs, n_envs, "dummy" if kind == "batched" else kind, monitor_dir
         )
 
-    monkeypatch.setattr(bearing_env.train.train, "make_training_env", make_with_batched)
+    monkeypatch.setattr(bearing_env.train.training_envs, "make_training_env", make_with_batched)
     results, _ = run_quick(
         tmp_path, "--sections", "vector,ppo", "--num-envs", "2", "--ppo-kinds", "batched"
     )
@@ -177,20 +178,20 @@ def test_targets_from_results() -> None:
             fake_figure(100.0, kind="subproc", fallback=False),
         ],
     }
-    targets = {target["id"]: target for target in bench_env.evaluate_targets(results)}
+    targets = {target["id"]: target for target in bench_report.evaluate_targets(results)}
     assert targets["a"]["met"] is True and targets["a"]["value"] == pytest.approx(0.2)
     assert targets["b"]["met"] is True and targets["b"]["fallback"] is False
     assert targets["c"]["met"] is False and targets["c"]["value"] == pytest.approx(0.05)
     assert targets["d"]["met"] is True and targets["d"]["fallback"] is True
     assert "fallback" in targets["d"]["note"]
-    assert all(target["met"] is None for target in bench_env.evaluate_targets({}))
+    assert all(target["met"] is None for target in bench_report.evaluate_targets({}))
 
 
 def test_write_json_is_atomic_and_finite(tmp_path: Path) -> None:
     path = tmp_path / "a" / "b.json"
-    bench_env.write_json(path, {"x": float("nan"), "y": [1.5, float("inf")]})
+    bench_report.write_json(path, {"x": float("nan"), "y": [1.5, float("inf")]})
     assert json.loads(path.read_text()) == {"x": None, "y": [1.5, None]}
-    bench_env.write_json(path, {"x": 2})
+    bench_report.write_json(path, {"x": 2})
     assert json.loads(path.read_text()) == {"x": 2}
     assert [p.name for p in path.parent.iterdir()] == ["b.json"]
 
@@ -256,7 +257,7 @@ def test_quick_slam_and_startup(tmp_path: Path, capsys: pytest.CaptureFixture[st
     for row in rows.values():
         assert positive_finite(row["steps_per_s"]) and positive_finite(row["ratio_to_cartpole"])
     startup = results["startup"]
-    assert len(startup["warm_runs_s"]) == bench_env.STARTUP_WARM_RUNS
+    assert len(startup["warm_runs_s"]) == bench_timing.STARTUP_WARM_RUNS
     assert startup["warm_first_step_s"] == sorted(startup["warm_runs_s"])[1]
     # Compiling from an empty cache takes longer than loading it (by far: seconds vs ~1).
     assert startup["cold_first_step_s"] > startup["warm_first_step_s"]

@@ -35,3 +35,33 @@ def test_unknown_subcommand_is_rejected() -> None:
     )
     assert result.returncode != 0
     assert "invalid choice" in result.stderr
+
+
+def hyperparams_command(algo: str, cwd) -> subprocess.CompletedProcess[str]:
+    """``bearing-env hyperparams ALGO`` run from ``cwd`` (not the checkout)."""
+    return subprocess.run(
+        [sys.executable, "-m", "bearing_env.train.cli", "hyperparams", algo],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        cwd=cwd,
+    )
+
+
+def test_hyperparams_prints_the_shipped_file_from_any_folder(tmp_path) -> None:
+    result = hyperparams_command("ppo", tmp_path)
+    assert result.returncode == 0, result.stderr
+    from pathlib import Path
+
+    import bearing_env.train
+
+    path = Path(result.stdout.strip())
+    assert path.is_absolute() and path.name == "ppo.yml"
+    assert path.parent.parent == Path(bearing_env.train.__file__).parent
+    assert "BearingSLAM-v0:" in path.read_text()
+
+
+def test_hyperparams_rejects_an_algorithm_without_a_file(tmp_path) -> None:
+    result = hyperparams_command("td3", tmp_path)
+    assert result.returncode == 2
+    assert "'td3'" in result.stderr and "dqn, ppo, sac" in result.stderr

@@ -5,25 +5,22 @@ from __future__ import annotations
 import csv
 import json
 import os
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 from bearing_env.train import cli
-from bearing_env.train.compare import (
-    EVAL_SEED_START,
-    LOG_NAME,
-    CompareConfig,
-    EpisodeLog,
-    RunMismatchError,
-    bootstrap_mean_ci,
-    csv_text,
-    main,
-    parse_env_kwargs,
-    policies_from_specs,
-    run_comparison,
-)
+from bearing_env.train.cli_values import parse_key_values
+from bearing_env.train.compare import main
+from bearing_env.train.compare_config import CompareConfig, policies_from_specs
+from bearing_env.train.compare_log import LOG_NAME, EpisodeLog
+from bearing_env.train.compare_report import csv_text
+from bearing_env.train.compare_runner import EpisodeTask, episode_tasks, run_locally
+from bearing_env.train.compare_stats import bootstrap_mean_ci
+from bearing_env.train.comparison import RunMismatchError, run_comparison
+from bearing_env.train.seeds import EVAL_SEED_START
 
 SMALL_ENV = {"scenario": "khepera", "max_moves": 4}
 OUTPUT_FILES = (
@@ -105,6 +102,34 @@ def test_parallel_workers_give_the_same_results(tmp_path: Path) -> None:
         tmp_path / "parallel/summary.json"
     ).read_text()
 
+    # The executor yields in task order (seed-major), so both logs hold the same lines.
+    def logged(out: Path) -> list[dict[str, Any]]:
+        records = EpisodeLog(out / LOG_NAME).load()
+        return [{k: v for k, v in r.items() if k != "policy_seconds"} for r in records]
+
+    tasks = episode_tasks(config, set())
+    assert [(r["policy"], r["seed"]) for r in logged(tmp_path / "parallel")] == [
+        (task.label, task.seed) for task in tasks
+    ]
+    assert logged(tmp_path / "parallel") == logged(tmp_path / "serial")
+
+
+def test_an_executor_gets_only_the_missing_episodes_and_its_records_are_logged(
+    tmp_path: Path,
+) -> None:
+    config = small_config(episodes=3)
+    run(config, tmp_path, stop_after=2)
+    given: list[list[tuple[str, int]]] = []
+
+    def recording_executor(tasks: Sequence[EpisodeTask], workers: int) -> Iterator[dict[str, Any]]:
+        given.append([(task.label, task.seed) for task in tasks])
+        return run_locally(tasks, workers)
+
+    result = run(config, tmp_path, resume=True, executor=recording_executor)
+    assert result.complete
+    assert given == [[(t.label, t.seed) for t in episode_tasks(config, set())][2:]]
+    assert len(EpisodeLog(tmp_path / LOG_NAME).load()) == 6
+
 
 def test_a_resumed_run_reproduces_the_uninterrupted_one(tmp_path: Path) -> None:
     config = small_config(episodes=5)
@@ -168,14 +193,18 @@ def test_bootstrap_ci_is_seeded_and_sensible() -> None:
 
 
 def test_env_kwargs_and_policy_labels_parse() -> None:
-    assert parse_env_kwargs(["scenario=khepera", "move_length=0.25", "noise=gaussian"]) == {
+    assert parse_key_values(
+        ["scenario=khepera", "move_length=0.25", "noise=gaussian"], "--env-kwargs"
+    ) == {
         "scenario": "khepera",
         "move_length": 0.25,
         "noise": "gaussian",
     }
-    assert parse_env_kwargs(["move_length=0.05,0.3"]) == {"move_length": (0.05, 0.3)}
-    with pytest.raises(ValueError, match="KEY=VALUE"):
-        parse_env_kwargs(["khepera"])
+    assert parse_key_values(["move_length=0.05,0.3"], "--env-kwargs") == {
+        "move_length": (0.05, 0.3)
+    }
+    with pytest.raises(ValueError, match=r"--env-kwargs expects KEY=VALUE.*'khepera'"):
+        parse_key_values(["khepera"], "--env-kwargs")
     labels = policies_from_specs(["random", "random", "random:length=0.25"])
     assert list(labels) == [
         "random_polygonal",
@@ -264,7 +293,7 @@ def test_bearing_env_dispatches_compare(
 
 
 def test_atomic_outputs_leave_no_partial_files(tmp_path: Path) -> None:
-    from bearing_env.train.compare import atomic_write_text
+    from bearing_env.train.files import atomic_write_text
 
     target = tmp_path / "deep" / "file.json"
     atomic_write_text(target, "{}\n")

@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
-from bearing_env.train.compare import LOG_NAME
+from bearing_env.train.compare_log import LOG_NAME
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 

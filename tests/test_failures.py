@@ -12,8 +12,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from bearing_env.train import compare
-from bearing_env.train.compare import LOG_NAME, CorruptLogError, EpisodeLog
+from bearing_env.train import compare, compare_log, compare_report
+from bearing_env.train.compare_log import LOG_NAME, CorruptLogError, EpisodeLog
 from bearing_env.train.errors import EXIT_ERROR, os_error_message, with_path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -95,7 +95,7 @@ def test_compare_on_a_full_disk_names_the_file(
     def disk_full(fd: int) -> None:
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    monkeypatch.setattr(compare.os, "fsync", disk_full)
+    monkeypatch.setattr(os, "fsync", disk_full)
     out = tmp_path / "out"
     line = compare_exit([*COMPARE_ARGS, "--out", str(out)], capsys)
     assert str(out / "config.json") in line  # the first file written
@@ -106,14 +106,14 @@ def test_compare_on_a_full_disk_names_the_file(
 def test_compare_without_permission_names_the_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    write = compare.atomic_write_text
+    write = compare_report.atomic_write_text
 
     def refuse_the_report(path: Path, text: str, newline: str | None = None) -> None:
         if path.name == "report.md":
             raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(path))
         write(path, text, newline)
 
-    monkeypatch.setattr(compare, "atomic_write_text", refuse_the_report)
+    monkeypatch.setattr(compare_report, "atomic_write_text", refuse_the_report)
     out = tmp_path / "out"
     line = compare_exit([*COMPARE_ARGS, "--out", str(out)], capsys)
     assert str(out / "report.md") in line
@@ -126,7 +126,7 @@ def test_an_episode_log_that_cannot_be_appended_names_it(
     def disk_full(fd: int) -> None:
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    monkeypatch.setattr(compare.os, "fsync", disk_full)
+    monkeypatch.setattr(os, "fsync", disk_full)
     log = EpisodeLog(tmp_path / LOG_NAME)
     with pytest.raises(OSError, match="No space left on device") as error:
         log.append({"policy": "x"})
@@ -162,7 +162,7 @@ def test_a_corrupt_middle_line_is_reported_with_its_number_and_the_way_out(
 
 def test_a_valid_json_line_that_is_no_record_is_corrupt(tmp_path: Path) -> None:
     path = tmp_path / LOG_NAME
-    good: dict[str, Any] = dict.fromkeys(compare.RECORD_KEYS, 0)
+    good: dict[str, Any] = dict.fromkeys(compare_log.RECORD_KEYS, 0)
     path.write_text(json.dumps(good) + "\n[1, 2]\n" + json.dumps(good) + "\n")
     with pytest.raises(CorruptLogError, match=r"line 2: not an episode record") as error:
         EpisodeLog(path).load()
@@ -218,14 +218,10 @@ def test_train_on_a_full_disk_names_the_file(
     pytest.importorskip("stable_baselines3")
     from bearing_env.train import train as train_module
 
-    original = Path.write_text
+    def disk_full(fd: int) -> None:  # the atomic writers fsync their temporary files
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    def disk_full(self: Path, *args: Any, **kwargs: Any) -> int:
-        if self.name.endswith(".tmp"):  # the atomic writers' temporary files
-            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-        return original(self, *args, **kwargs)
-
-    monkeypatch.setattr(Path, "write_text", disk_full)
+    monkeypatch.setattr(os, "fsync", disk_full)
     run = tmp_path / "run"
     with pytest.raises(SystemExit) as exit_info:
         train_module.main([*TRAIN_ARGS, "--output", str(run)])

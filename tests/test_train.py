@@ -26,28 +26,36 @@ import bearing_env.train.train as train_module
 import gymnasium as gym
 import numpy as np
 import pytest
+import torch
 import yaml
 from bearing_env.agents import SB3Policy
 from bearing_env.train.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
-from bearing_env.train.train import (
-    EXIT_INTERRUPTED,
-    MAX_EVAL_EPISODES,
+from bearing_env.train.cli_values import parse_key_values
+from bearing_env.train.export import export_run
+from bearing_env.train.seeds import (
+    MAX_VALIDATION_EPISODES,
     TRAINING_SEED_LIMIT,
     VALIDATION_SEED_START,
-    EpisodeSeedCycle,
-    LinearSchedule,
-    TrainResult,
-    TrainSettings,
-    export_run,
-    load_model,
-    load_vecnormalize,
-    make_validation_env,
-    parse_hyperparameters,
-    parse_key_values,
-    read_hyperparameters,
-    train,
     training_seed_start,
 )
+from bearing_env.train.train import (
+    EXIT_INTERRUPTED,
+    TrainResult,
+    TrainSettings,
+    train,
+)
+from bearing_env.train.training_envs import EnvFactory, EpisodeSeedCycle, make_validation_env
+from bearing_env.train.zoo import (
+    DEFAULT_ENV_IDS,
+    algorithm_class_for,
+    load_model,
+    load_vecnormalize,
+    parse_hyperparameters,
+    read_hyperparameters,
+    rl_zoo3_module,
+)
+from stable_baselines3 import PPO
+from stable_baselines3.common.utils import ConstantSchedule
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 ALGOS = ("ppo", "sac", "dqn")
@@ -79,7 +87,7 @@ PYTHON = sys.executable
 def tiny_settings(algo: str, output: Path, **changes: Any) -> TrainSettings:
     settings = TrainSettings(
         algo=algo,
-        env_id=train_module.DEFAULT_ENV_IDS[algo],
+        env_id=DEFAULT_ENV_IDS[algo],
         output=output,
         hyperparam_overrides=dict(TINY_HYPERPARAMS[algo]),
         timesteps=TINY_TIMESTEPS,
@@ -154,13 +162,13 @@ def test_saved_model_and_statistics_predict_like_the_trained_model(
     tiny_runs: dict[str, TrainResult], algo: str
 ) -> None:
     result = tiny_runs[algo]
-    raw = _observations(train_module.DEFAULT_ENV_IDS[algo])
+    raw = _observations(DEFAULT_ENV_IDS[algo])
     trained_normalizer = result.model.get_vec_normalize_env()
     assert trained_normalizer is not None
     expected, _ = result.model.predict(trained_normalizer.normalize_obs(raw), deterministic=True)
 
     loaded = load_model(result.run_dir / "model.zip", algo)
-    eval_venv = make_validation_env(train_module.DEFAULT_ENV_IDS[algo], {"scenario": "khepera"}, 1)
+    eval_venv = make_validation_env(DEFAULT_ENV_IDS[algo], {"scenario": "khepera"}, 1)
     loaded_normalizer = load_vecnormalize(result.run_dir / "vecnormalize.pkl", eval_venv)
     actual, _ = loaded.predict(loaded_normalizer.normalize_obs(raw), deterministic=True)
     eval_venv.close()
@@ -473,7 +481,7 @@ def test_exported_models_load_by_name_and_join_the_comparison(
 )  # fmt: skip
 def test_shipped_hyperparameters_parse(algo: str, env_id: str) -> None:
     raw = read_hyperparameters(algo, env_id)
-    parsed = parse_hyperparameters(raw)
+    parsed = parse_hyperparameters(raw, algo)
     assert parsed.n_envs >= 1 and parsed.n_timesteps >= 1
     assert parsed.env_kwargs == {"scenario": "khepera"}
     assert parsed.normalize is not None and parsed.normalize["gamma"] == raw["gamma"]
@@ -482,44 +490,79 @@ def test_shipped_hyperparameters_parse(algo: str, env_id: str) -> None:
     constructor_kwargs = {k: v for k, v in parsed.algorithm_kwargs.items() if k != "policy"}
     if algo != "ppo":
         constructor_kwargs["buffer_size"] = 10  # the model builds, without a big buffer
-    algorithm_class = train_module.ALGORITHMS[algo]
+    algorithm_class = algorithm_class_for(algo)
     algorithm_class(parsed.algorithm_kwargs["policy"], env_id, device="cpu", **constructor_kwargs)
 
 
-def test_hyperparameter_parsing_follows_rl_zoo3() -> None:
-    parsed = parse_hyperparameters(
-        {
-            "n_timesteps": 1e5,
-            "policy": "MlpPolicy",
-            "learning_rate": "lin_0.001",
-            "normalize": "dict(norm_obs=True, norm_reward=False)",
-            "gamma": 0.9,
-            "policy_kwargs": "dict(net_arch=[64, 64], activation_fn=nn.ReLU)",
-            "train_freq": [4, "step"],
-        }
-    )
+def test_hyperparameters_are_preprocessed_by_rl_zoo3() -> None:
+    raw = {
+        "n_timesteps": 1e5,
+        "policy": "MlpPolicy",
+        "learning_rate": "lin_0.001",
+        "clip_range": 0.2,
+        "normalize": "dict(norm_obs=True, norm_reward=False)",
+        "gamma": 0.9,
+        "policy_kwargs": "dict(net_arch=[64, 64], activation_fn=nn.ReLU)",
+        "train_freq": [4, "step"],
+    }
+    parsed = parse_hyperparameters(raw, "ppo")
+    SimpleLinearSchedule = rl_zoo3_module("rl_zoo3.utils").SimpleLinearSchedule
+    # rl-zoo3's own schedule classes: lin_<x> decays linearly, a number stays constant.
     schedule = parsed.algorithm_kwargs["learning_rate"]
-    assert isinstance(schedule, LinearSchedule) and schedule(0.5) == pytest.approx(5e-4)
+    assert isinstance(schedule, SimpleLinearSchedule)
+    assert schedule(1.0) == pytest.approx(1e-3) and schedule(0.5) == pytest.approx(5e-4)
+    clip_range = parsed.algorithm_kwargs["clip_range"]
+    assert isinstance(clip_range, ConstantSchedule) and clip_range(0.3) == pytest.approx(0.2)
     assert parsed.normalize == {"norm_obs": True, "norm_reward": False, "gamma": 0.9}
+    assert parsed.algorithm_kwargs["policy_kwargs"]["activation_fn"] is torch.nn.ReLU
     assert parsed.algorithm_kwargs["train_freq"] == (4, "step")
     assert parsed.n_envs == 1 and parsed.n_timesteps == 100_000
+    assert not {"n_timesteps", "normalize", "env_kwargs"} & parsed.algorithm_kwargs.keys()
+    assert raw["learning_rate"] == "lin_0.001"  # the raw entry (run.json's record) is kept
+    assert parse_hyperparameters({"n_timesteps": 10, "normalize": False}).normalize is None
+    # SB3 takes them as they are: the model's learning rate follows the schedule.
+    kwargs = {k: v for k, v in parsed.algorithm_kwargs.items() if k not in ("policy", "train_freq")}
+    model = PPO("MlpPolicy", "BearingSLAM-v0", n_steps=8, batch_size=8, device="cpu", **kwargs)
+    assert model.lr_schedule(0.5) == pytest.approx(5e-4)
+
+
+def test_using_rl_zoo3_leaves_gymnasium_unpatched() -> None:
+    """rl-zoo3 replaces TimeLimit on import; the trainer's use of it must not leak."""
+    read_hyperparameters("ppo", "BearingSLAM-v0")
+    algorithm_class_for("ppo")
+    assert gym.wrappers.TimeLimit.__module__.startswith("gymnasium.")
+    env = gym.make("BearingSLAM-v0", max_episode_steps=1)
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    info = env.step(env.action_space.sample())[4]
+    assert "TimeLimit.truncated" not in info
+    assert "bool8" not in vars(np)
+
+
+def test_hyperparameters_that_this_trainer_cannot_apply_are_refused_by_name() -> None:
     with pytest.raises(ValueError, match="frame_stack"):
         parse_hyperparameters({"n_timesteps": 10, "frame_stack": 4})
-    with pytest.raises(ValueError, match="policy_kwargs"):
-        parse_hyperparameters({"n_timesteps": 10, "policy_kwargs": "__import__('os')"})
+    with pytest.raises(ValueError, match="policy_kwargs must evaluate to a dict"):
+        parse_hyperparameters({"n_timesteps": 10, "policy_kwargs": "[1, 2]"})
+    with pytest.raises(ValueError, match="n_envs and n_timesteps must be >= 1"):
+        parse_hyperparameters({"n_timesteps": 10, "n_envs": 0})
+    with pytest.raises(ValueError, match="needs n_timesteps"):
+        parse_hyperparameters({"n_envs": 2})
+    with pytest.raises(ValueError, match="learning_rate"):
+        parse_hyperparameters({"n_timesteps": 10, "learning_rate": "lin_fast"})
     assert parse_key_values(["scenario=khepera", "move_length=(0.1, 0.3)", "n=4"], "x") == {
         "scenario": "khepera",
         "move_length": (0.1, 0.3),
         "n": 4,
     }
-    with pytest.raises(ValueError, match="key=value"):
+    with pytest.raises(ValueError, match="KEY=VALUE"):
         parse_key_values(["scenario"], "--env-kwargs")
 
 
 def test_seed_ranges_are_disjoint_and_validation_episodes_repeat() -> None:
-    import bearing_env.train.compare as compare
+    from bearing_env.train.seeds import EVAL_SEED_START
     assert TRAINING_SEED_LIMIT <= VALIDATION_SEED_START
-    assert VALIDATION_SEED_START + MAX_EVAL_EPISODES <= compare.EVAL_SEED_START
+    assert VALIDATION_SEED_START + MAX_VALIDATION_EPISODES <= EVAL_SEED_START
     assert training_seed_start(7, 10**9, 8) + 8 <= TRAINING_SEED_LIMIT
     with pytest.raises(ValueError):
         training_seed_start(TRAINING_SEED_LIMIT, 0, 1)
@@ -553,14 +596,20 @@ def rl_zoo3_run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Background
         yield None
         return
     folder = tmp_path_factory.mktemp("rl_zoo3")
+    # As the README runs it: the path printed by `bearing-env hyperparams ppo`, from a
+    # folder that is not the checkout.
+    conf_file = subprocess.run(
+        [PYTHON, "-m", "bearing_env.train.cli", "hyperparams", "ppo"],
+        cwd=folder, capture_output=True, text=True, check=True,
+    ).stdout.strip()  # fmt: skip
     command = [
         PYTHON, "-m", "rl_zoo3.train", "--gym-packages", "bearing_env", "--algo", "ppo",
-        "--env", "BearingSLAM-v0", "--conf-file", "train/hyperparams/ppo.yml", "-n", "300",
+        "--env", "BearingSLAM-v0", "--conf-file", conf_file, "-n", "300",
         "-f", str(folder), "--device", "cpu", "--seed", "0",
         "--hyperparams", "n_envs:2", "n_steps:64", f"policy_kwargs:'{TINY_NET}'",
     ]  # fmt: skip
     process = subprocess.Popen(
-        command, cwd=REPO_ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+        command, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
     )
     background = BackgroundCommand(process, folder)
     yield background
@@ -587,7 +636,7 @@ def test_rl_zoo3_trains_with_the_shipped_yaml(rl_zoo3_run: BackgroundCommand | N
 
 
 def test_env_factory_raises_the_time_limit_with_max_moves() -> None:
-    env = train_module.EnvFactory("BearingSLAM-v0", {"scenario": "khepera", "max_moves": 23})()
+    env = EnvFactory("BearingSLAM-v0", {"scenario": "khepera", "max_moves": 23})()
     assert env.spec is not None and env.spec.max_episode_steps == 23
     env.reset(seed=1)
     moves, done = 0, False
@@ -603,3 +652,17 @@ def test_train_is_a_bearing_env_subcommand() -> None:
     from bearing_env.train.cli import SUBCOMMANDS
 
     assert SUBCOMMANDS["train"][0] == "bearing_env.train.train"
+
+
+def test_checkpoints_keep_sb3_checkpoint_callback_names(tmp_path: Path) -> None:
+    from bearing_env.train.callbacks import PeriodicCheckpointCallback
+    from stable_baselines3.common.callbacks import CheckpointCallback
+
+    checkpoint = CheckpointStore(tmp_path, keep=1).checkpoint_at(48)
+    assert checkpoint.model_path == tmp_path / "rl_model_48_steps.zip"
+    assert checkpoint.vecnormalize_path == tmp_path / "rl_model_vecnormalize_48_steps.pkl"
+    assert checkpoint.replay_buffer_path == tmp_path / "rl_model_replay_buffer_48_steps.pkl"
+    callback = PeriodicCheckpointCallback(CheckpointStore(tmp_path), save_freq=16)
+    assert isinstance(callback, CheckpointCallback)
+    assert callback._on_step() is True  # SB3's mid-rollout save never runs
+    assert not list(tmp_path.iterdir())

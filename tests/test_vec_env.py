@@ -19,7 +19,8 @@ import bearing_env.train.train as train_module
 import gymnasium as gym
 import numpy as np
 import pytest
-from bearing_env.train.train import EnvFactory, TrainSettings, resolve_vec_env_kind, train
+from bearing_env.train.train import TrainSettings, train
+from bearing_env.train.training_envs import EnvFactory, resolve_vec_env_kind
 from bearing_env.train.vec_env import GymnasiumVecEnv, gym_make_kwargs, make_batched_vec_env
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 from stable_baselines3 import DQN, PPO

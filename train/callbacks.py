@@ -1,4 +1,5 @@
-"""stable-baselines3 callbacks and file helpers for ``bearing-env train``.
+"""The stable-baselines3 callbacks of ``bearing-env train``: checkpoints at update
+boundaries, stopping on request, and the fixed-seed evaluation.
 
 - :class:`CheckpointStore`: the run's ``checkpoints/`` folder. A checkpoint is the model
   (``rl_model_<N>_steps.zip``), its VecNormalize statistics
@@ -17,9 +18,10 @@
 - :class:`StopOnRequestCallback`: ends ``learn()`` cleanly at the next env step once a
   :class:`StopRequest` is set (by the Ctrl-C handler).
 
-SB3's own ``CheckpointCallback`` is not used: it saves from ``_on_step`` on a call count,
-in the middle of a rollout (the steps of the partial rollout are counted but were never
-trained on), writes in place and does not prune; only its file names are kept.
+:class:`PeriodicCheckpointCallback` subclasses SB3's ``CheckpointCallback`` and keeps its
+file names (``_checkpoint_path``), but not its saving: SB3 saves from ``_on_step`` on a
+call count, in the middle of a rollout (the steps of the partial rollout are counted but
+were never trained on), writes in place and does not prune.
 - :class:`FixedSeedEvalCallback`: SB3's ``EvalCallback`` that plays the same validation
   episodes (fixed reset seeds) at every evaluation, logs the total uncertainty area, saves
   the VecNormalize statistics beside the best model, and carries its history over a
@@ -29,18 +31,16 @@ trained on), writes in place and does not prune; only its file names are kept.
 from __future__ import annotations
 
 import json
-import os
 import re
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bearing_env.train.errors import with_path
+from bearing_env.train.files import atomic_path, write_json_atomically
 from stable_baselines3.common.base_class import BaseAlgorithm
-from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
+from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
@@ -52,27 +52,6 @@ BEST_VECNORMALIZE_NAME = "vecnormalize.pkl"
 BEST_SUMMARY_NAME = "best.json"
 #: Validation metrics are reported at this move count (and at the end of the episode).
 AREA_REPORT_MOVE = 10
-
-
-@contextmanager
-def atomic_path(final_path: Path) -> Iterator[Path]:
-    """A temporary path in the same folder, renamed to ``final_path`` if the block succeeds."""
-    temporary = final_path.with_name(f".{final_path.name}.{os.getpid()}.tmp")
-    try:
-        final_path.parent.mkdir(parents=True, exist_ok=True)
-        yield temporary
-        os.replace(temporary, final_path)
-    except OSError as error:
-        # Disk full, no permission, ...: name the file being written, not its temporary.
-        raise with_path(error, final_path) from None
-    finally:
-        if temporary.exists():
-            temporary.unlink()
-
-
-def write_json_atomically(path: Path, payload: dict[str, Any]) -> None:
-    with atomic_path(path) as temporary:
-        temporary.write_text(json.dumps(payload, indent=2, sort_keys=True) + "\n")
 
 
 def save_model_atomically(model: BaseAlgorithm, path: Path) -> None:
@@ -111,13 +90,15 @@ class CheckpointStore:
         self.keep = keep
 
     def checkpoint_at(self, timesteps: int) -> Checkpoint:
+        """The files of the checkpoint at ``timesteps``, named by SB3's own
+        ``CheckpointCallback._checkpoint_path``."""
+        namer = CheckpointCallback(1, str(self.folder), name_prefix=CHECKPOINT_PREFIX)
+        namer.num_timesteps = timesteps
         return Checkpoint(
             timesteps=timesteps,
-            model_path=self.folder / f"{CHECKPOINT_PREFIX}_{timesteps}_steps.zip",
-            vecnormalize_path=self.folder
-            / f"{CHECKPOINT_PREFIX}_vecnormalize_{timesteps}_steps.pkl",
-            replay_buffer_path=self.folder
-            / f"{CHECKPOINT_PREFIX}_replay_buffer_{timesteps}_steps.pkl",
+            model_path=Path(namer._checkpoint_path(extension="zip")),
+            vecnormalize_path=Path(namer._checkpoint_path("vecnormalize_", extension="pkl")),
+            replay_buffer_path=Path(namer._checkpoint_path("replay_buffer_", extension="pkl")),
         )
 
     def list(self) -> list[Checkpoint]:
@@ -220,9 +201,11 @@ def rewind_to_boundary(model: BaseAlgorithm, boundary: UpdateBoundary) -> int:
     return dropped
 
 
-class PeriodicCheckpointCallback(BaseCallback):
-    """Saves a checkpoint at the first update boundary at or past each multiple of
-    ``save_freq`` env steps, and remembers the last boundary (:attr:`boundary`).
+class PeriodicCheckpointCallback(CheckpointCallback):
+    """SB3's ``CheckpointCallback`` (its folder, prefix and file names) that saves at the
+    first update boundary at or past each multiple of ``save_freq`` env steps instead of
+    from ``_on_step`` in the middle of a rollout, writes through :class:`CheckpointStore`
+    (atomic files, pruning), and remembers the last boundary (:attr:`boundary`).
 
     ``on_save`` is called with each checkpoint written (the trainer updates ``run.json``).
     """
@@ -234,9 +217,16 @@ class PeriodicCheckpointCallback(BaseCallback):
         verbose: int = 0,
         on_save: Callable[[Checkpoint], None] | None = None,
     ) -> None:
-        super().__init__(verbose)
         if save_freq < 1:
             raise ValueError(f"save_freq must be >= 1 env steps, got {save_freq}")
+        super().__init__(
+            save_freq,
+            str(store.folder),
+            name_prefix=CHECKPOINT_PREFIX,
+            save_replay_buffer=True,
+            save_vecnormalize=True,
+            verbose=verbose,
+        )
         self.store = store
         self.save_freq = save_freq
         self.on_save = on_save
@@ -261,6 +251,7 @@ class PeriodicCheckpointCallback(BaseCallback):
                 self.on_save(checkpoint)
 
     def _on_step(self) -> bool:
+        # Never SB3's save here: mid-rollout, it would count steps not yet trained on.
         return True
 
 

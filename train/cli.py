@@ -7,7 +7,8 @@
                                   (benchmarks/bench_slam.py; also ``bearing-env bench --slam``)
     bearing-env compare [...]     exploration policies on the same evaluation episodes
     bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
-    bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (train/hyperparams/*.yml)
+    bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (shipped rl-zoo3 files)
+    bearing-env hyperparams ALGO  the path of a shipped rl-zoo3 hyperparameter file
 
 Each subcommand forwards its remaining arguments to the module that implements it, so
 ``bearing-env demo --help`` shows that module's options. A subcommand that needs an
@@ -39,7 +40,11 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     ),
     "train": (
         "bearing_env.train.train",
-        "train PPO/SAC/DQN agents with stable-baselines3 (train/hyperparams)",
+        "train PPO/SAC/DQN agents with stable-baselines3 (rl-zoo3 hyperparameter files)",
+    ),
+    "hyperparams": (
+        "bearing_env.train.conf_files",
+        "print the path of a shipped rl-zoo3 hyperparameter file (for --conf-file)",
     ),
     "compare": (
         "bearing_env.train.compare",

@@ -49,13 +49,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bearing_env.train.compare import (
-    EVAL_SEED_START,
-    atomic_save_figure,
-    atomic_write_text,
-    make_env,
-)
+from bearing_env.train.compare_runner import make_env
 from bearing_env.train.errors import fail
+from bearing_env.train.files import atomic_save_figure, atomic_write_text
+from bearing_env.train.seeds import EVAL_SEED_START
 from numpy.typing import NDArray
 
 from bearing_env.extras import MissingExtraError, available

@@ -7,14 +7,15 @@
     bearing-env train --algo ppo --output runs/ppo_khepera --export-only \
         --export agents/pretrained/ppo_khepera
 
-**Hyperparameters** come from ``train/hyperparams/<algo>.yml`` in rl-zoo3's format: one
+**Hyperparameters** come from the shipped ``hyperparams/<algo>.yml`` (``bearing-env
+hyperparams <algo>`` prints its path) in rl-zoo3's format: one
 entry per env id holding ``n_envs``, ``n_timesteps``, ``policy``, ``normalize``,
 ``env_kwargs``, ``policy_kwargs`` (a Python expression string) and the algorithm's
 constructor arguments (``lin_<x>`` is a schedule decaying linearly from ``x`` to 0). The
 same files run under rl-zoo3::
 
     python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 \\
-        --conf-file train/hyperparams/ppo.yml
+        --conf-file "$(bearing-env hyperparams ppo)"
 
 ``--env-kwargs k=v ...`` is merged over the entry's ``env_kwargs`` (rl-zoo3 replaces them
 instead), and ``--hyperparams k=v ...`` over the entry itself. Values are Python literals
@@ -36,8 +37,9 @@ own random stream, where ``s = --seed`` for a new run and ``(seed + t) mod (9000
 n_envs)`` for a segment resumed at timestep ``t``: every training seed is below
 ``VALIDATION_SEED_START = 900000``. The periodic evaluation that picks the best model
 plays validation episode ``k`` with seed ``900000 + k`` (``k < --eval-episodes``), the
-same episodes at every evaluation. Both ranges lie below ``bearing_env.train.compare``'s test seeds
-(1000000 and up), so neither training nor model selection ever sees a test episode.
+same episodes at every evaluation. Both ranges lie below ``compare``'s test seeds
+(1000000 and up), so neither training nor model selection ever sees a test episode;
+``bearing_env.train.seeds`` defines every range.
 
 **Run folder** (``--output``, default ``runs/<algo>_<env>_seed<seed>``)::
 
@@ -77,81 +79,69 @@ resumes from. Each segment's ``status`` is ``finished``, ``interrupted`` or ``ki
 from __future__ import annotations
 
 import argparse
-import ast
 import contextlib
-import importlib
-import json
 import math
-import shutil
 import signal
 import sys
 import threading
 import time
-import zipfile
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, SupportsFloat
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
 import torch
-import yaml
 from bearing_env.train.callbacks import (
-    BEST_MODEL_NAME,
-    BEST_SUMMARY_NAME,
-    BEST_VECNORMALIZE_NAME,
     Checkpoint,
     CheckpointStore,
     FixedSeedEvalCallback,
     PeriodicCheckpointCallback,
     StopOnRequestCallback,
     StopRequest,
-    atomic_path,
     callback_calls,
     rewind_to_boundary,
     save_model_atomically,
     save_vecnormalize_atomically,
-    write_json_atomically,
 )
+from bearing_env.train.cli_values import json_safe, parse_key_values
 from bearing_env.train.errors import fail, write_error_message
-from bearing_env.train.vec_env import (
-    MONITOR_INFO_KEYWORDS,
-    gym_make_kwargs,
-    has_vector_entry_point,
-    make_batched_vec_env,
-    monitor_csv_path,
+from bearing_env.train.export import ExportedModel, export_run
+from bearing_env.train.files import write_json_atomically
+from bearing_env.train.run_folder import (
+    RunFiles,
+    read_run_record,
 )
-from stable_baselines3 import DQN, PPO, SAC
+from bearing_env.train.seeds import (
+    TRAINING_SEED_LIMIT,
+    VALIDATION_SEED_START,
+    training_seed_start,
+)
+from bearing_env.train.training_envs import (
+    VEC_ENV_CHOICES,
+    make_training_env,
+    make_validation_env,
+    resolve_vec_env_kind,
+)
+from bearing_env.train.zoo import (
+    DEFAULT_ENV_IDS,
+    algorithm_class_for,
+    hyperparams_key,
+    load_model,
+    load_vecnormalize,
+    parse_hyperparameters,
+    read_hyperparameters,
+)
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback
-from stable_baselines3.common.monitor import Monitor
 from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
 from stable_baselines3.common.vec_env import (
-    DummyVecEnv,
-    SubprocVecEnv,
     VecEnv,
-    VecMonitor,
     VecNormalize,
 )
 
 import bearing_env
-
-ALGORITHMS: dict[str, type[BaseAlgorithm]] = {"ppo": PPO, "sac": SAC, "dqn": DQN}
-DEFAULT_ENV_IDS: dict[str, str] = {
-    "ppo": "BearingSLAM-v0",
-    "sac": "BearingSLAM-v0",
-    "dqn": "BearingSLAMDiscrete-v0",
-}
-HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
-
-#: Validation episode k (periodic evaluation, best-model selection) resets with seed
-#: VALIDATION_SEED_START + k; training seeds stay below it.
-VALIDATION_SEED_START = 900_000
-TRAINING_SEED_LIMIT = VALIDATION_SEED_START
-#: Validation seeds stay below this (``bearing_env.train.compare``'s test episodes start here).
-TEST_SEED_START = 1_000_000
-MAX_EVAL_EPISODES = TEST_SEED_START - VALIDATION_SEED_START
 
 DEFAULT_EVAL_FREQ = 25_000
 DEFAULT_EVAL_EPISODES = 50
@@ -159,415 +149,8 @@ DEFAULT_CHECKPOINT_FREQ = 50_000
 DEFAULT_KEEP_CHECKPOINTS = 3
 DEFAULT_RUNS_DIR = Path("runs")
 
-RUN_RECORD_NAME = "run.json"
-FINAL_MODEL_NAME = "model.zip"
-FINAL_VECNORMALIZE_NAME = "vecnormalize.pkl"
-EXPORT_VECNORMALIZE_SUFFIX = "_vecnormalize.pkl"
 RUN_FORMAT_VERSION = 1
 EXIT_INTERRUPTED = 130
-
-#: How the training envs run: ``batched`` is one Gymnasium vector env (the id's natively
-#: batched ``vector_entry_point``, else a ``SyncVectorEnv``) behind ``bearing_env.train.vec_env``'s
-#: adapter; ``subproc`` one process per env (spawn); ``dummy`` all envs in this process.
-VEC_ENV_KINDS: tuple[str, ...] = ("batched", "subproc", "dummy")
-#: ``--vec-env`` also takes ``auto``: ``batched`` when the env id registers a batched
-#: vector env (``vector_entry_point``), else ``subproc``.
-VEC_ENV_CHOICES: tuple[str, ...] = ("auto", *VEC_ENV_KINDS)
-
-#: rl-zoo3 keys that this trainer does not implement (rl-zoo3 itself does).
-UNSUPPORTED_ZOO_KEYS: frozenset[str] = frozenset(
-    {
-        "env_wrapper",
-        "vec_env_wrapper",
-        "frame_stack",
-        "callback",
-        "monitor_kwargs",
-        "noise_type",
-        "noise_std",
-        "replay_buffer_class",
-    }
-)
-SCHEDULE_KEYS: tuple[str, ...] = ("learning_rate", "clip_range", "clip_range_vf")
-EXPRESSION_KEYS: tuple[str, ...] = ("policy_kwargs", "replay_buffer_kwargs")
-
-
-# --------------------------------------------------------------------------------------
-# Hyperparameters (rl-zoo3 format)
-# --------------------------------------------------------------------------------------
-
-
-class LinearSchedule:
-    """rl-zoo3's ``lin_<x>``: ``x`` at the start of training, decaying linearly to 0."""
-
-    def __init__(self, initial_value: float) -> None:
-        self.initial_value = float(initial_value)
-
-    def __call__(self, progress_remaining: float) -> float:
-        return float(progress_remaining * self.initial_value)
-
-    def __repr__(self) -> str:
-        return f"LinearSchedule({self.initial_value})"
-
-
-@dataclass(frozen=True)
-class Hyperparameters:
-    """One parsed entry of a hyperparameter file."""
-
-    n_envs: int
-    n_timesteps: int
-    env_kwargs: dict[str, Any]
-    #: VecNormalize keyword arguments, or None to train without VecNormalize.
-    normalize: dict[str, Any] | None
-    #: Keyword arguments of the SB3 algorithm's constructor (``policy`` included).
-    algorithm_kwargs: dict[str, Any]
-
-
-def hyperparams_key(env_id: str) -> str:
-    """The file key of an env id: ``bearing_env:BearingSLAM-v0`` -> ``BearingSLAM-v0``."""
-    return env_id.split(":")[-1]
-
-
-def default_conf_file(algo: str) -> Path:
-    return HYPERPARAMS_DIR / f"{algo}.yml"
-
-
-def read_hyperparameters(algo: str, env_id: str, conf_file: Path | None = None) -> dict[str, Any]:
-    """The raw entry for ``env_id`` in ``conf_file`` (default ``train/hyperparams/<algo>.yml``)."""
-    path = conf_file if conf_file is not None else default_conf_file(algo)
-    if not path.is_file():
-        raise FileNotFoundError(f"hyperparameter file not found: {path}")
-    try:
-        entries = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as error:
-        raise ValueError(f"cannot parse hyperparameter file {path}: {error}") from error
-    key = hyperparams_key(env_id)
-    if not isinstance(entries, dict) or key not in entries:
-        known = sorted(entries) if isinstance(entries, dict) else []
-        raise ValueError(f"no entry {key!r} in {path} (entries: {known})")
-    entry = entries[key]
-    if not isinstance(entry, dict):
-        raise ValueError(f"entry {key!r} in {path} must be a mapping, got {entry!r}")
-    return dict(entry)
-
-
-def _evaluate_expression(text: str, key: str) -> Any:
-    """rl-zoo3 evaluates ``policy_kwargs`` strings; allow its usual names and nothing else."""
-    namespace = {"__builtins__": {}, "dict": dict, "list": list, "tuple": tuple, "nn": torch.nn}
-    namespace["th"] = torch
-    try:
-        return eval(text, namespace)
-    except Exception as error:
-        raise ValueError(
-            f"cannot evaluate {key}={text!r}: {type(error).__name__}: {error}"
-        ) from error
-
-
-def _schedule(value: Any, key: str) -> Any:
-    if isinstance(value, str):
-        kind, _, initial = value.partition("_")
-        if kind != "lin":
-            raise ValueError(f"{key}={value!r}: only 'lin_<value>' schedules are supported")
-        try:
-            return LinearSchedule(float(initial))
-        except ValueError as error:
-            raise ValueError(f"{key}={value!r}: bad initial value") from error
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f"{key} must be a number or 'lin_<value>', got {value!r}")
-    return float(value)
-
-
-def _normalize_kwargs(value: Any, gamma: Any) -> dict[str, Any] | None:
-    if value is False or value is None:
-        return None
-    if value is True:
-        kwargs: dict[str, Any] = {}
-    elif isinstance(value, str):
-        kwargs = dict(_evaluate_expression(value, "normalize"))
-    elif isinstance(value, dict):
-        kwargs = dict(value)
-    else:
-        raise ValueError(f"normalize must be a bool, a dict or a dict expression, got {value!r}")
-    if gamma is not None:  # as rl-zoo3: the return statistics use the algorithm's gamma
-        kwargs["gamma"] = float(gamma)
-    return kwargs
-
-
-def parse_hyperparameters(raw: Mapping[str, Any]) -> Hyperparameters:
-    """Turn a raw rl-zoo3 entry into environment settings and constructor arguments."""
-    entry = dict(raw)
-    unsupported = sorted(UNSUPPORTED_ZOO_KEYS & entry.keys())
-    if unsupported:
-        raise ValueError(
-            f"hyperparameters {unsupported} are rl-zoo3 features that bearing-env train does "
-            "not implement; train this config with rl_zoo3.train instead"
-        )
-    if "n_timesteps" not in entry:
-        raise ValueError("the hyperparameter entry needs n_timesteps")
-    n_timesteps = int(float(entry.pop("n_timesteps")))
-    n_envs = int(entry.pop("n_envs", 1))
-    env_kwargs = entry.pop("env_kwargs", None) or {}
-    if not isinstance(env_kwargs, dict):
-        raise ValueError(f"env_kwargs must be a mapping, got {env_kwargs!r}")
-    normalize = _normalize_kwargs(entry.pop("normalize", False), entry.get("gamma"))
-    for key in SCHEDULE_KEYS:
-        if key in entry:
-            entry[key] = _schedule(entry[key], key)
-    for key in EXPRESSION_KEYS:
-        if isinstance(entry.get(key), str):
-            entry[key] = _evaluate_expression(entry[key], key)
-    if isinstance(entry.get("train_freq"), list):
-        entry["train_freq"] = tuple(entry["train_freq"])
-    entry.setdefault("policy", "MlpPolicy")
-    if isinstance(entry["policy"], str) and "." in entry["policy"]:
-        # As rl-zoo3: a dotted name is a custom policy class, imported
-        # (e.g. bearing_env.agents.extractors.LandmarkSetPolicy).
-        module, _, name = entry["policy"].rpartition(".")
-        entry["policy"] = getattr(importlib.import_module(module), name)
-    if n_envs < 1 or n_timesteps < 1:
-        raise ValueError(f"n_envs and n_timesteps must be >= 1, got {n_envs}, {n_timesteps}")
-    return Hyperparameters(
-        n_envs=n_envs,
-        n_timesteps=n_timesteps,
-        env_kwargs=dict(env_kwargs),
-        normalize=normalize,
-        algorithm_kwargs=entry,
-    )
-
-
-def parse_literal(text: str) -> Any:
-    """A Python literal when ``text`` is one (``4``, ``0.25``, ``(0.1, 0.3)``), else ``text``."""
-    try:
-        return ast.literal_eval(text)
-    except (ValueError, SyntaxError):
-        return text
-
-
-def parse_key_values(pairs: Sequence[str], option: str) -> dict[str, Any]:
-    """``["k=v", ...]`` -> ``{"k": literal(v)}``."""
-    parsed: dict[str, Any] = {}
-    for pair in pairs:
-        key, separator, value = pair.partition("=")
-        if not separator or not key.strip():
-            raise ValueError(f"{option} expects key=value items, got {pair!r}")
-        parsed[key.strip()] = parse_literal(value.strip())
-    return parsed
-
-
-# --------------------------------------------------------------------------------------
-# Environments
-# --------------------------------------------------------------------------------------
-
-
-class EpisodeSeedCycle(gym.Wrapper[Any, Any, Any, Any]):
-    """Resets with the next seed of a fixed list whenever no seed is given.
-
-    ``rewind_episode_seeds()`` starts the list again, so every evaluation plays the same
-    episodes. An explicit ``reset(seed=...)`` is honoured and does not advance the list.
-    """
-
-    def __init__(self, env: gym.Env[Any, Any], seeds: Sequence[int]) -> None:
-        super().__init__(env)
-        if not seeds:
-            raise ValueError("EpisodeSeedCycle needs at least one seed")
-        self.episode_seeds = [int(seed) for seed in seeds]
-        self._next_index = 0
-
-    def rewind_episode_seeds(self) -> None:
-        self._next_index = 0
-
-    def reset(
-        self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[Any, dict[str, Any]]:
-        if seed is None:
-            seed = self.episode_seeds[self._next_index % len(self.episode_seeds)]
-            self._next_index += 1
-        return self.env.reset(seed=seed, options=options)
-
-
-class SuccessInfo(gym.Wrapper[Any, Any, Any, Any]):
-    """Adds ``info["is_success"]`` at the end of an episode (the env's termination is success),
-    so SB3 logs ``rollout/success_rate`` and ``eval/success_rate``."""
-
-    def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
-        observation, reward, terminated, truncated, info = self.env.step(action)
-        if terminated or truncated:
-            info["is_success"] = bool(terminated)
-        return observation, reward, terminated, truncated, info
-
-
-@dataclass(frozen=True, eq=False)
-class EnvFactory:
-    """Builds one wrapped env; picklable, so ``SubprocVecEnv`` (spawn) can call it in a worker."""
-
-    env_id: str
-    env_kwargs: dict[str, Any] = field(default_factory=dict)
-    monitor_path: str | None = None
-    episode_seeds: tuple[int, ...] | None = None
-    #: Log episodes with SB3's ``Monitor``; False when a ``VecMonitor`` does it instead.
-    monitor: bool = True
-    #: In worker processes: leave Ctrl-C to the trainer, which stops and checkpoints.
-    ignore_interrupts: bool = False
-
-    def __call__(self) -> gym.Env[Any, Any]:
-        if self.ignore_interrupts:
-            signal.signal(signal.SIGINT, signal.SIG_IGN)
-        bearing_env.registration.register_envs()
-        env: gym.Env[Any, Any] = gym.make(self.env_id, **gym_make_kwargs(self.env_kwargs))
-        env = SuccessInfo(env)
-        if self.monitor:
-            env = Monitor(
-                env,
-                filename=self.monitor_path,
-                info_keywords=("is_success",),
-                # A resumed run appends; a new log starts with SB3's header (load_results
-                # needs it).
-                override_existing=self.monitor_path is None
-                or not Path(monitor_csv_path(self.monitor_path)).is_file(),
-            )
-        if self.episode_seeds is not None:
-            env = EpisodeSeedCycle(env, self.episode_seeds)
-        return env
-
-
-def resolve_vec_env_kind(vec_env_kind: str, env_id: str) -> str:
-    """The kind of :data:`VEC_ENV_KINDS` that ``vec_env_kind`` means for ``env_id``.
-
-    ``auto`` is ``batched`` when the id registers a natively batched vector env, which
-    steps all envs in one batched computation, and ``subproc`` otherwise: a ``SyncVectorEnv``
-    fallback would step the envs one by one in this process, and processes are faster.
-    """
-    if vec_env_kind == "auto":
-        return "batched" if has_vector_entry_point(env_id) else "subproc"
-    if vec_env_kind not in VEC_ENV_KINDS:
-        raise ValueError(f"unknown vec env {vec_env_kind!r}; expected one of {VEC_ENV_CHOICES}")
-    return vec_env_kind
-
-
-def make_training_env(
-    env_id: str,
-    env_kwargs: dict[str, Any],
-    n_envs: int,
-    vec_env_kind: str,
-    monitor_dir: Path | None,
-) -> VecEnv:
-    """``n_envs`` training envs: one batched Gymnasium vector env (``batched``, logged to
-    ``monitor_dir/batched.monitor.csv``), a ``SubprocVecEnv`` (spawn) or a ``DummyVecEnv``
-    (logged to ``monitor_dir/<i>.monitor.csv``). ``auto``: see :func:`resolve_vec_env_kind`.
-
-    Every kind seeds env ``i`` with ``seed + i`` at ``venv.seed(seed)``, so the kinds train
-    on the same data when the batched env reproduces the single env.
-    """
-    vec_env_kind = resolve_vec_env_kind(vec_env_kind, env_id)
-    if monitor_dir is not None:
-        monitor_dir.mkdir(parents=True, exist_ok=True)
-    if vec_env_kind == "batched":
-        monitor_path = None if monitor_dir is None else str(monitor_dir / "batched")
-        return make_batched_vec_env(env_id, env_kwargs, n_envs, monitor_path)
-    factories = [
-        EnvFactory(
-            env_id=env_id,
-            env_kwargs=dict(env_kwargs),
-            monitor_path=None if monitor_dir is None else str(monitor_dir / str(rank)),
-            ignore_interrupts=vec_env_kind == "subproc",
-        )
-        for rank in range(n_envs)
-    ]
-    if vec_env_kind == "subproc":
-        return SubprocVecEnv(factories, start_method="spawn")
-    return DummyVecEnv(factories)
-
-
-def validation_seeds(n_episodes: int) -> tuple[int, ...]:
-    if not 1 <= n_episodes <= MAX_EVAL_EPISODES:
-        raise ValueError(f"eval episodes must be in [1, {MAX_EVAL_EPISODES}], got {n_episodes}")
-    return tuple(range(VALIDATION_SEED_START, VALIDATION_SEED_START + n_episodes))
-
-
-def make_validation_env(
-    env_id: str, env_kwargs: dict[str, Any], n_episodes: int, vec_monitor: bool = False
-) -> VecEnv:
-    """One in-process env cycling through the validation seeds.
-
-    ``vec_monitor``: log episodes with a ``VecMonitor`` instead of a ``Monitor``, so that the
-    wrappers stack up as in a ``batched`` training env. SB3's evaluation copies the
-    ``VecNormalize`` statistics by walking both stacks in step, and fails on a
-    ``VecMonitor`` that only the training env has.
-    """
-    factory = EnvFactory(
-        env_id,
-        dict(env_kwargs),
-        episode_seeds=validation_seeds(n_episodes),
-        monitor=not vec_monitor,
-    )
-    venv: VecEnv = DummyVecEnv([factory])
-    return VecMonitor(venv, info_keywords=MONITOR_INFO_KEYWORDS) if vec_monitor else venv
-
-
-def training_seed_start(seed: int, start_timesteps: int, n_envs: int) -> int:
-    """The reset seed of training env 0 in a segment starting at ``start_timesteps``."""
-    if not 0 <= seed < TRAINING_SEED_LIMIT - n_envs:
-        raise ValueError(f"--seed must be in [0, {TRAINING_SEED_LIMIT - n_envs}), got {seed}")
-    return (seed + start_timesteps) % (TRAINING_SEED_LIMIT - n_envs)
-
-
-# --------------------------------------------------------------------------------------
-# Loading with clear errors
-# --------------------------------------------------------------------------------------
-
-
-def _existing_file(path: Path, what: str) -> Path:
-    if path.is_file():
-        return path
-    if path.suffix != ".zip" and path.with_name(path.name + ".zip").is_file():
-        return path.with_name(path.name + ".zip")
-    raise FileNotFoundError(f"{what} not found: {path}")
-
-
-def load_model(
-    path: str | Path,
-    algo: str,
-    env: VecEnv | None = None,
-    device: str = "cpu",
-    **kwargs: Any,
-) -> BaseAlgorithm:
-    """Load a saved SB3 model.
-
-    Raises:
-        FileNotFoundError: no file at ``path`` (nor at ``path.zip``).
-        ValueError: the file is not a loadable ``algo`` model (corrupt, truncated, another
-            algorithm, or spaces that do not fit ``env``); the message names the path.
-    """
-    algorithm_class = algorithm_class_for(algo)
-    model_path = _existing_file(Path(path), "model file")
-    if not zipfile.is_zipfile(model_path):
-        raise ValueError(f"model file {model_path} is corrupt: not a zip archive")
-    try:
-        return algorithm_class.load(model_path, env=env, device=device, **kwargs)
-    except Exception as error:  # SB3 raises many kinds on damaged or foreign archives
-        raise ValueError(
-            f"cannot load {algo.upper()} model {model_path}: {type(error).__name__}: {error}"
-        ) from error
-
-
-def load_vecnormalize(path: str | Path, venv: VecEnv) -> VecNormalize:
-    """``VecNormalize.load`` with errors that name the file (see :func:`load_model`)."""
-    stats_path = _existing_file(Path(path), "VecNormalize statistics")
-    try:
-        normalizer = VecNormalize.load(str(stats_path), venv)
-    except Exception as error:  # a truncated or foreign pickle raises many kinds
-        raise ValueError(
-            f"cannot load VecNormalize statistics {stats_path}: {type(error).__name__}: {error}"
-        ) from error
-    return normalizer
-
-
-def algorithm_class_for(algo: str) -> type[BaseAlgorithm]:
-    try:
-        return ALGORITHMS[algo.lower()]
-    except KeyError:
-        raise ValueError(
-            f"unknown algorithm {algo!r}; expected one of {sorted(ALGORITHMS)}"
-        ) from None
 
 
 # --------------------------------------------------------------------------------------
@@ -616,54 +199,6 @@ class TrainResult:
     wall_seconds: float
 
 
-@dataclass(frozen=True)
-class RunFiles:
-    """Paths inside a run folder."""
-
-    root: Path
-
-    @property
-    def record(self) -> Path:
-        return self.root / RUN_RECORD_NAME
-
-    @property
-    def final_model(self) -> Path:
-        return self.root / FINAL_MODEL_NAME
-
-    @property
-    def final_vecnormalize(self) -> Path:
-        return self.root / FINAL_VECNORMALIZE_NAME
-
-    @property
-    def best(self) -> Path:
-        return self.root / "best"
-
-    @property
-    def checkpoints(self) -> Path:
-        return self.root / "checkpoints"
-
-    @property
-    def monitor(self) -> Path:
-        return self.root / "monitor"
-
-    @property
-    def tensorboard(self) -> Path:
-        return self.root / "tensorboard"
-
-
-def read_run_record(run_dir: Path) -> dict[str, Any]:
-    path = RunFiles(run_dir).record
-    if not path.is_file():
-        raise FileNotFoundError(f"no run to resume: {path} does not exist")
-    try:
-        record = json.loads(path.read_text())
-    except json.JSONDecodeError as error:
-        raise ValueError(f"run record {path} is corrupt: {error}") from error
-    if not isinstance(record, dict):
-        raise ValueError(f"run record {path} is corrupt: not a JSON object")
-    return record
-
-
 def _versions() -> dict[str, str]:
     import stable_baselines3
 
@@ -675,17 +210,6 @@ def _versions() -> dict[str, str]:
         "numpy": np.__version__,
         "python": sys.version.split()[0],
     }
-
-
-def _json_safe(value: Any) -> Any:
-    """YAML/CLI values as JSON (tuples become lists; anything else unusual becomes repr)."""
-    if isinstance(value, dict):
-        return {str(key): _json_safe(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(item) for item in value]
-    if value is None or isinstance(value, (bool, int, float, str)):
-        return value
-    return repr(value)
 
 
 @contextlib.contextmanager
@@ -720,6 +244,14 @@ def _close_quietly(venv: VecEnv) -> None:
         venv.close()
 
 
+def _changed_settings(given: Mapping[str, Any], saved: Mapping[str, Any]) -> dict[str, Any]:
+    """The entries of ``given`` that differ from ``saved`` once both are JSON (a tuple
+    given on the command line equals the list run.json read back)."""
+    return {
+        key: value for key, value in given.items() if json_safe(saved.get(key)) != json_safe(value)
+    }
+
+
 def _resolve_run(settings: TrainSettings) -> tuple[dict[str, Any], Checkpoint | None]:
     """The raw hyperparameter entry and, when resuming, the checkpoint to start from."""
     files = RunFiles(settings.output)
@@ -744,21 +276,13 @@ def _resolve_run(settings: TrainSettings) -> tuple[dict[str, Any], Checkpoint | 
             )
     raw = dict(record["hyperparams"])
     saved_env_kwargs = raw.get("env_kwargs") or {}
-    changed = {
-        key: value
-        for key, value in settings.env_kwargs.items()
-        if _json_safe(saved_env_kwargs.get(key)) != _json_safe(value)
-    }
+    changed = _changed_settings(settings.env_kwargs, saved_env_kwargs)
     if changed:
         raise ValueError(
             f"cannot resume {settings.output} with different env kwargs {changed}; "
             f"it was trained with {saved_env_kwargs}"
         )
-    different = {
-        key: value
-        for key, value in settings.hyperparam_overrides.items()
-        if _json_safe(raw.get(key)) != _json_safe(value)
-    }
+    different = _changed_settings(settings.hyperparam_overrides, raw)
     if different:
         raise ValueError(
             f"cannot resume {settings.output} with different hyperparameters {different}; "
@@ -804,7 +328,7 @@ def train(settings: TrainSettings) -> TrainResult:
     """Train (or resume) a run; see the module docstring for the files it writes."""
     algorithm_class = algorithm_class_for(settings.algo)
     raw, checkpoint = _resolve_run(settings)
-    hyperparams = parse_hyperparameters(raw)
+    hyperparams = parse_hyperparameters(raw, settings.algo)
     env_kwargs = hyperparams.env_kwargs
     n_envs = settings.n_envs if settings.n_envs is not None else hyperparams.n_envs
     target = settings.timesteps if settings.timesteps is not None else hyperparams.n_timesteps
@@ -879,8 +403,8 @@ def train(settings: TrainSettings) -> TrainResult:
             "format": RUN_FORMAT_VERSION,
             "algo": settings.algo,
             "env_id": settings.env_id,
-            "env_kwargs": _json_safe(env_kwargs),
-            "hyperparams": _json_safe(raw),
+            "env_kwargs": json_safe(env_kwargs),
+            "hyperparams": json_safe(raw),
             "n_envs": n_envs,
             "seed": settings.seed,
             "vec_env": vec_env_kind,
@@ -1004,88 +528,6 @@ def train(settings: TrainSettings) -> TrainResult:
 
 
 # --------------------------------------------------------------------------------------
-# Export
-# --------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class ExportedModel:
-    model_path: Path
-    vecnormalize_path: Path | None
-    metadata_path: Path
-    source: str
-
-
-def export_run(run_dir: Path, destination: Path) -> ExportedModel:
-    """Copy a run's best model (or its final model) to ``destination``: ``<dest>.zip``,
-    ``<dest>_vecnormalize.pkl`` (when the run normalised) and ``<dest>.json``."""
-    record = read_run_record(run_dir)
-    files = RunFiles(run_dir)
-    best_model = files.best / BEST_MODEL_NAME
-    if best_model.is_file():
-        source, model_path = "best", best_model
-        stats_path: Path | None = files.best / BEST_VECNORMALIZE_NAME
-        summary_path = files.best / BEST_SUMMARY_NAME
-        validation = json.loads(summary_path.read_text()) if summary_path.is_file() else None
-    elif files.final_model.is_file():
-        source, model_path, stats_path, validation = (
-            "final",
-            files.final_model,
-            files.final_vecnormalize,
-            None,
-        )
-    else:
-        raise FileNotFoundError(
-            f"{run_dir} has neither {best_model} nor {files.final_model}: train it further first"
-        )
-    model = load_model(model_path, record["algo"])  # refuses a corrupt file before copying
-    normalizes = record["hyperparams"].get("normalize") not in (None, False)
-    if normalizes and (stats_path is None or not stats_path.is_file()):
-        raise FileNotFoundError(f"the run normalises observations but {stats_path} is missing")
-    if not normalizes:
-        stats_path = None
-
-    name = destination.name.removesuffix(".zip")
-    folder = destination.parent
-    folder.mkdir(parents=True, exist_ok=True)
-    exported_model = folder / f"{name}.zip"
-    exported_stats = folder / f"{name}{EXPORT_VECNORMALIZE_SUFFIX}"
-    with atomic_path(exported_model) as temporary:
-        shutil.copyfile(model_path, temporary)
-    if stats_path is not None:
-        with atomic_path(exported_stats) as temporary:
-            shutil.copyfile(stats_path, temporary)
-    else:
-        exported_stats.unlink(missing_ok=True)
-    metadata = {
-        "name": name,
-        "algo": record["algo"],
-        "env_id": record["env_id"],
-        "env_kwargs": record["env_kwargs"],
-        "source": source,
-        "num_timesteps": int(model.num_timesteps),
-        "run_timesteps": record.get("num_timesteps"),
-        "seed": record.get("seed"),
-        "validation": validation,
-        "validation_seeds": record.get("seeds", {}).get("validation"),
-        "hyperparams": record["hyperparams"],
-        "versions": record.get("versions"),
-        "files": {
-            "model": exported_model.name,
-            "vecnormalize": exported_stats.name if stats_path is not None else None,
-        },
-    }
-    metadata_path = folder / f"{name}.json"
-    write_json_atomically(metadata_path, metadata)
-    return ExportedModel(
-        model_path=exported_model,
-        vecnormalize_path=exported_stats if stats_path is not None else None,
-        metadata_path=metadata_path,
-        source=source,
-    )
-
-
-# --------------------------------------------------------------------------------------
 # Command line
 # --------------------------------------------------------------------------------------
 
@@ -1094,15 +536,16 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="bearing-env train",
         description="Train PPO/SAC (BearingSLAM-v0) or DQN (BearingSLAMDiscrete-v0) with "
-        "stable-baselines3; hyperparameters from train/hyperparams/<algo>.yml (rl-zoo3 format). "
+        "stable-baselines3; hyperparameters from the shipped <algo>.yml (rl-zoo3 format; "
+        "bearing-env hyperparams ALGO prints its path). "
         "Ctrl-C saves a checkpoint; --resume continues from it.",
     )
     add = parser.add_argument
-    add("--algo", required=True, choices=sorted(ALGORITHMS))
+    add("--algo", required=True, choices=sorted(DEFAULT_ENV_IDS))
     add("--env", help="env id (default BearingSLAM-v0; for dqn BearingSLAMDiscrete-v0)")
     add("--env-kwargs", nargs="*", default=[], metavar="K=V", help="merged over the YAML's")
     add("--hyperparams", nargs="*", default=[], metavar="K=V", help="override YAML entries")
-    add("--conf-file", type=Path, help="hyperparameter file (default train/hyperparams/<algo>.yml)")
+    add("--conf-file", type=Path, help="hyperparameter file (default: the shipped <algo>.yml)")
     add("--timesteps", type=int, help="total env steps of the run (default the YAML's n_timesteps)")
     add("--seed", type=int, default=0, help="default %(default)s")
     add("--n-envs", type=int, help="parallel envs (default the YAML's n_envs)")

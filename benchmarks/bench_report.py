@@ -1,0 +1,378 @@
+"""The report of ``bearing-env bench``: the targets each figure is held to (met / not
+met), the JSON results file and the terminal table.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import platform
+import sys
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from bearing_env.benchmarks.bench_timing import (
+    ppo_label,
+    vector_label,
+)
+
+import bearing_env
+
+#: Relative to the working directory, so an installed package never writes into itself.
+DEFAULT_JSON = Path("outputs") / "bench_env.json"
+JSON_FORMAT = 1
+TARGETS: dict[str, str] = {
+    "a": "single env, Khepera: env.step >= 10% of CartPole-v1",
+    "b": "batched env, 64 envs x 4 landmarks: total steps/s >= 30% of CartPole-v1",
+    "c": "single env, 64 landmarks >= 1/16 of the 4-landmark rate",
+    "d": "PPO on the batched env >= 2x PPO on SubprocVecEnv (same n_envs)",
+    "e": "PolygonSLAM.update, 4 landmarks: >= 20% of CartPole-v1",
+    "f": "first env step, fresh process, warm cache: <= 1.5 s",
+    "g": "GreedyOneStep planning per move (median): <= 0.2 ms",
+}
+TARGET_THRESHOLDS: dict[str, float] = {
+    "a": 0.10,
+    "b": 0.30,
+    "c": 1.0 / 16.0,
+    "d": 2.0,
+    "e": 0.20,
+    "f": 1.5,
+    "g": 0.2e-3,
+}
+#: Targets that are upper bounds (seconds); the others are lower bounds (ratios).
+UPPER_BOUND_TARGETS = frozenset({"f", "g"})
+
+
+# --------------------------------------------------------------------------------------
+# Targets
+# --------------------------------------------------------------------------------------
+
+
+def _target(
+    key: str, value: float | None, note: str | None = None, fallback: bool = False
+) -> dict[str, Any]:
+    threshold = TARGET_THRESHOLDS[key]
+    if value is None:
+        met = None
+    elif key in UPPER_BOUND_TARGETS:
+        met = bool(value <= threshold)
+    else:
+        met = bool(value >= threshold)
+    return {
+        "id": key,
+        "description": TARGETS[key],
+        "value": value,
+        "threshold": threshold,
+        "met": met,
+        "fallback": fallback,
+        "note": note,
+    }
+
+
+def evaluate_targets(results: dict[str, Any]) -> list[dict[str, Any]]:
+    single = {row["name"]: row for row in results.get("single", [])}
+    vector = results.get("vector", [])
+    ppo = {row["kind"]: row for row in results.get("ppo", [])}
+    targets = []
+
+    khepera = single.get("khepera")
+    if khepera is None:
+        targets.append(_target("a", None, "needs the single-env Khepera row"))
+    else:
+        targets.append(_target("a", khepera["ratio_to_cartpole"]))
+
+    batched_64 = next(
+        (row for row in vector if row["kind"] == "batched" and row["num_envs"] == 64), None
+    )
+    if batched_64 is None:
+        targets.append(_target("b", None, "no batched row with 64 envs measured"))
+    else:
+        fallback = batched_64["fallback"]
+        note = "measured with sync (fallback): no vector_entry_point" if fallback else None
+        targets.append(
+            _target("b", batched_64["ratio_to_cartpole"], note, fallback=batched_64["fallback"])
+        )
+
+    many = single.get("random_64")
+    few = single.get("random_4")
+    if many is None or few is None:
+        targets.append(_target("c", None, "needs the 4- and 64-landmark single-env rows"))
+    else:
+        targets.append(_target("c", many["steps_per_s"] / few["steps_per_s"]))
+
+    slam = {(row["transfer"], row["n_landmarks"]): row for row in results.get("slam", [])}
+    update_4 = slam.get(("conservative", 4))
+    if update_4 is None:
+        targets.append(_target("e", None, "needs the slam section's 4-landmark row"))
+    else:
+        targets.append(_target("e", update_4["ratio_to_cartpole"]))
+    startup = results.get("startup")
+    if startup is None:
+        targets.append(_target("f", None, "needs the startup section"))
+    else:
+        targets.append(_target("f", startup["warm_first_step_s"]))
+
+    planning = results.get("planning")
+    if planning is None:
+        targets.append(_target("g", None, "needs the planning section"))
+    else:
+        targets.append(_target("g", planning["median_s"]))
+
+    batched, subproc = ppo.get("batched"), ppo.get("subproc")
+    if batched is None or subproc is None:
+        targets.append(_target("d", None, "needs the batched and subproc PPO rows"))
+    else:
+        note = "batched measured with dummy (fallback)" if batched["fallback"] else None
+        targets.append(
+            _target(
+                "d",
+                # The median of the per-round ratios (rounds are interleaved), as in the table.
+                batched.get("ratio_to_subproc") or batched["steps_per_s"] / subproc["steps_per_s"],
+                note,
+                fallback=batched["fallback"],
+            )
+        )
+    return targets
+
+
+# --------------------------------------------------------------------------------------
+# Output
+# --------------------------------------------------------------------------------------
+
+
+def machine_info() -> dict[str, Any]:
+    info: dict[str, Any] = {
+        "platform": platform.platform(),
+        "processor": platform.processor() or platform.machine(),
+        "python": sys.version.split()[0],
+        "cpu_count": os.cpu_count(),
+        "numpy": np.__version__,
+        "gymnasium": gym.__version__,
+        "bearing_env": bearing_env.__version__,
+    }
+    with contextlib.suppress(AttributeError):
+        info["usable_cpus"] = len(os.sched_getaffinity(0))
+    for module in ("torch", "stable_baselines3"):
+        if module in sys.modules:
+            info[module] = getattr(sys.modules[module], "__version__", None)
+    return info
+
+
+def _finite(value: Any) -> Any:
+    """JSON without NaN/inf: non-finite floats become null."""
+    if isinstance(value, dict):
+        return {str(key): _finite(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(item) for item in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, np.generic):
+        return _finite(value.item())
+    return value
+
+
+def write_json(path: Path, results: dict[str, Any]) -> None:
+    """Write ``results`` to ``path`` atomically (temp file in the same folder + os.replace)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    text = json.dumps(_finite(results), indent=2, allow_nan=False) + "\n"
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(handle, "w") as fh:
+            fh.write(text)
+        os.replace(temporary, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temporary)
+        raise
+
+
+def _pct(value: float | None) -> str:
+    return "-" if value is None else f"{value:.2%}"
+
+
+def _times(value: float | None) -> str:
+    return "-" if value is None else f"{value:.2f}x"
+
+
+def _relative(ratio: float | None, reference: str) -> str:
+    """``"1.5x sync"``, or empty where the reference row was not measured."""
+    return "" if ratio is None else f"{_times(ratio)} {reference}"
+
+
+def table_rows(results: dict[str, Any]) -> list[tuple[str, ...]]:
+    """(section, case, steps/s, % nearest ref, ref, % start ref, relative) rows."""
+    rows: list[tuple[str, ...]] = []
+
+    def add(section: str, case: str, figure: dict[str, Any], relative: str) -> None:
+        rows.append(
+            (
+                section,
+                case,
+                f"{figure['steps_per_s']:,.0f}",
+                _pct(figure["ratio_to_cartpole"]),
+                figure["cartpole_reference"],
+                _pct(figure["ratio_to_cartpole_start"]),
+                relative,
+            )
+        )
+
+    for row in results.get("single", []):
+        if row["name"] == "khepera":
+            case = "khepera, 4 landmarks"
+        elif row["name"] == "khepera_wrapped":
+            case = "khepera, gym.make wrappers"
+        else:
+            case = f"random, {row['n_landmarks']} landmarks"
+        add("single", case, row, _relative(row["ratio_to_4_landmarks"], "4-landmark rate"))
+    for row in results.get("vector", []):
+        case = f"{vector_label(row)}, {row['num_envs']} envs"
+        add("vector", case, row, _relative(row["ratio_to_sync"], "sync"))
+    slam_rows = results.get("slam", [])
+    for row in slam_rows:
+        base = next(
+            other["steps_per_s"]
+            for other in slam_rows
+            if other["transfer"] == row["transfer"] and other["n_landmarks"] == 4
+        )
+        case = f"update(), {row['transfer']}, {row['n_landmarks']} landmarks"
+        add("slam", case, row, f"{_times(row['steps_per_s'] / base)} 4-landmark rate")
+    for row in results.get("ppo", []):
+        case = f"PPO {ppo_label(row)}, {row['n_envs']} envs"
+        add("ppo", case, row, _relative(row["ratio_to_subproc"], "subproc"))
+    return rows
+
+
+TABLE_HEADER: tuple[str, ...] = (
+    "section",
+    "case",
+    "steps/s",
+    "% CartPole",
+    "(ref)",
+    "% CartPole@start",
+    "relative",
+)
+NUMERIC_COLUMNS = frozenset({2, 3, 5})
+
+
+def references_line(results: dict[str, Any]) -> str:
+    references = ", ".join(
+        f"{ref['label']} {ref['steps_per_s']:,.0f}" for ref in results["cartpole_references"]
+    )
+    return f"CartPole-v1 env.step references (steps/s, same run): {references}"
+
+
+def column_widths(rows: Sequence[Sequence[str]]) -> list[int]:
+    return [max(len(text) for text in column) for column in zip(*rows, strict=True)]
+
+
+def table_notes(results: dict[str, Any]) -> list[str]:
+    """The targets and what the columns mean, printed under the table."""
+    lines = []
+    startup = results.get("startup")
+    if startup is not None:
+        warm = ", ".join(f"{t:.2f}" for t in startup["warm_runs_s"])
+        lines += [
+            "",
+            f"Start-up (fresh processes): first env step {startup['cold_first_step_s']:.1f} s "
+            f"compiling from an empty numba cache; {startup['warm_first_step_s']:.2f} s with "
+            f"the cache warm (median of {warm} s).",
+        ]
+    planning = results.get("planning")
+    if planning is not None:
+        lines += [
+            "",
+            f"Planning: GreedyOneStep.act {planning['median_s'] * 1e3:.3f} ms per move "
+            f"(median of {planning['moves']} moves; mean {planning['mean_s'] * 1e3:.3f} ms, "
+            f"p90 {planning['p90_s'] * 1e3:.3f} ms).",
+        ]
+    lines += ["", "Targets:"]
+    lines.extend("  " + format_target(target) for target in results["targets"])
+    lines.append("")
+    lines.append(
+        f"{results['settings']['seconds']:g} s per measurement; % CartPole uses the reference "
+        "measured closest in time ((ref)), % CartPole@start the first one."
+    )
+    if "ppo" in results:
+        lines.append(
+            "PPO: env steps per wall-second of model.learn() after a warm-up learn() "
+            "(process start-up and torch init excluded); the median of "
+            f"{results['settings'].get('ppo_rounds', 1)} interleaved rounds per kind."
+        )
+    return lines
+
+
+def format_table(results: dict[str, Any]) -> str:
+    """The results as a plain-text table, the CartPole references and the targets."""
+    rows = table_rows(results)
+    widths = column_widths([TABLE_HEADER, *rows])
+
+    def line(cells: Sequence[str]) -> str:
+        return "  ".join(
+            cell.rjust(width) if index in NUMERIC_COLUMNS else cell.ljust(width)
+            for index, (cell, width) in enumerate(zip(cells, widths, strict=True))
+        ).rstrip()
+
+    lines = [references_line(results), line(TABLE_HEADER), line(["-" * w for w in widths])]
+    previous = None
+    for row in rows:
+        if previous is not None and row[0] != previous:
+            lines.append("")
+        lines.append(line(row))
+        previous = row[0]
+    return "\n".join([*lines, *table_notes(results)])
+
+
+def format_target(target: dict[str, Any]) -> str:
+    if target["met"] is None:
+        status = "NOT MEASURED"
+    else:
+        status = "MET" if target["met"] else "NOT MET"
+    value = target["value"]
+    if value is None:
+        shown = "-"
+    elif target["id"] in ("a", "b", "e"):
+        shown = f"{value:.2%} (need {target['threshold']:.0%})"
+    elif target["id"] == "c":
+        shown = f"{value:.3f} (need {target['threshold']:.4f})"
+    elif target["id"] == "f":
+        shown = f"{value:.2f} s (need <= {target['threshold']:g} s)"
+    elif target["id"] == "g":
+        shown = f"{value * 1e3:.3f} ms (need <= {target['threshold'] * 1e3:g} ms)"
+    else:
+        shown = f"{value:.2f}x (need {target['threshold']:.0f}x)"
+    note = f"  [{target['note']}]" if target["note"] else ""
+    return f"({target['id']}) {target['description']}: {shown} -> {status}{note}"
+
+
+def print_table(results: dict[str, Any]) -> None:
+    """A rich table when stdout is a terminal wide enough for it, else plain text."""
+    rows = table_rows(results)
+    if sys.stdout.isatty():
+        try:
+            from rich.console import Console
+            from rich.table import Table
+        except ImportError:
+            pass
+        else:
+            console = Console()
+            needed = sum(column_widths([TABLE_HEADER, *rows])) + 3 * len(TABLE_HEADER) + 1
+            if console.width >= needed:
+                table = Table(title=references_line(results))
+                for index, name in enumerate(TABLE_HEADER):
+                    justify = "right" if index in NUMERIC_COLUMNS else "left"
+                    table.add_column(name, justify=justify, no_wrap=True)
+                for row in rows:
+                    table.add_row(*row)
+                console.print(table)
+                for text in table_notes(results):
+                    console.print(text, markup=False, highlight=False)
+                return
+    print(format_table(results))
+
+

@@ -1,0 +1,619 @@
+"""The timing of ``bearing-env bench``: every measured figure of BearingSLAM-v0 (single
+env, batched vector env, world model, compiled start-up, planning, PPO training) and the
+CartPole-v1 reference each figure is divided by. What each section measures is in
+:mod:`bearing_env.benchmarks.bench_env`'s docstring.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import cProfile
+import os
+import pstats
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from bearing_env.benchmarks.bench_slam import cartpole_steps_per_second
+from bearing_env.train.cli_values import json_safe
+from gymnasium.vector import AutoresetMode
+
+ENV_ID = "BearingSLAM-v0"
+SECTIONS: tuple[str, ...] = ("single", "vector", "slam", "startup", "planning", "ppo")
+PPO_KINDS: tuple[str, ...] = ("batched", "subproc", "dummy")
+DEFAULT_NUM_ENVS: tuple[int, ...] = (1, 4, 16, 64, 256)
+DEFAULT_SINGLE_LANDMARKS: tuple[int, ...] = (4, 16, 64)
+DEFAULT_SECONDS = 2.0
+DEFAULT_PPO_ENVS = 16
+DEFAULT_PPO_STEPS = 4096
+#: Interleaved timed rounds per PPO kind (see :func:`bench_ppo`).
+DEFAULT_PPO_ROUNDS = 3
+#: Hyperparameter overrides of the ``--quick`` PPO runs: tiny rollouts, one epoch, and
+#: (set where the number of envs is known) one minibatch of the whole rollout.
+QUICK_PPO_OVERRIDES: dict[str, Any] = {"n_steps": 8, "n_epochs": 1}
+#: Episodes of the planning section (Khepera, 20 moves each; --quick: 2).
+PLANNING_EPISODES = 20
+#: Fresh processes timed with a warm cache (the median counts).
+STARTUP_WARM_RUNS = 3
+def log(message: str) -> None:
+    """Progress lines go to stderr, so stdout holds only the table."""
+    print(message, file=sys.stderr, flush=True)
+
+
+# --------------------------------------------------------------------------------------
+# The CartPole reference
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Reference:
+    label: str
+    steps_per_s: float
+    #: Middle of the measurement, seconds since the bench started.
+    time_s: float
+
+
+@dataclass
+class Bench:
+    """The run's clock, its CartPole references and the reference measurement time."""
+
+    seconds: float
+    start: float = field(default_factory=time.perf_counter)
+    references: list[Reference] = field(default_factory=list)
+
+    def now(self) -> float:
+        return time.perf_counter() - self.start
+
+    def measure_reference(self, label: str) -> Reference:
+        begin = self.now()
+        rate = cartpole_steps_per_second(self.seconds)
+        reference = Reference(label, rate, 0.5 * (begin + self.now()))
+        self.references.append(reference)
+        log(f"  CartPole-v1 reference ({label}): {rate:,.0f} steps/s")
+        return reference
+
+    def nearest(self, time_s: float) -> Reference:
+        return min(self.references, key=lambda ref: abs(ref.time_s - time_s))
+
+    def ratios(self, rate: float, time_s: float) -> dict[str, Any]:
+        """The ratio fields of a figure measured around ``time_s``."""
+        nearest = self.nearest(time_s)
+        start = self.references[0]
+        return {
+            "cartpole_reference": nearest.label,
+            "cartpole_steps_per_s": nearest.steps_per_s,
+            "ratio_to_cartpole": rate / nearest.steps_per_s,
+            "ratio_to_cartpole_start": rate / start.steps_per_s,
+        }
+
+
+def timed_figure(bench: Bench, run: Callable[[], tuple[int, float]]) -> dict[str, Any]:
+    """Run ``run() -> (steps, seconds)`` and return its rate with the CartPole ratios."""
+    begin = bench.now()
+    steps, elapsed = run()
+    rate = steps / elapsed
+    figure = {"steps": int(steps), "seconds": elapsed, "steps_per_s": rate}
+    figure.update(bench.ratios(rate, 0.5 * (begin + bench.now())))
+    return figure
+
+
+# --------------------------------------------------------------------------------------
+# Single env
+# --------------------------------------------------------------------------------------
+
+
+def single_env_cases(landmarks: Sequence[int]) -> list[tuple[str, dict[str, Any], bool]]:
+    """(name, env kwargs, unwrapped) of the single-env rows."""
+    cases = [("khepera", {"scenario": "khepera"}, True)]
+    for n in landmarks:
+        cases.append(
+            (f"random_{n}", {"scenario": "random", "n_landmarks": n, "max_landmarks": n}, True)
+        )
+    cases.append(("khepera_wrapped", {"scenario": "khepera"}, False))
+    return cases
+
+
+def make_single_env(env_kwargs: dict[str, Any], unwrapped: bool = True) -> gym.Env[Any, Any]:
+    env = gym.make(ENV_ID, **env_kwargs)
+    return env.unwrapped if unwrapped else env
+
+
+def run_single_env(
+    env: gym.Env[Any, Any], seconds: float, seed: int = 0, min_steps: int = 2
+) -> tuple[int, float, int]:
+    """Step ``env`` with seeded random actions for ``seconds``: (steps, seconds, resets)."""
+    rng = np.random.default_rng(seed)
+    low = env.action_space.low
+    high = env.action_space.high
+    env.reset(seed=seed)
+    env.step(rng.uniform(low, high).astype(np.float32))  # warm-up, not timed
+    env.reset(seed=seed)
+    steps = resets = 0
+    block = rng.uniform(low, high, size=(256, *low.shape)).astype(np.float32)
+    start = time.perf_counter()
+    while True:
+        action = block[steps % len(block)]
+        _, _, terminated, truncated, _ = env.step(action)
+        steps += 1
+        if terminated or truncated:
+            env.reset()
+            resets += 1
+        if steps % len(block) == 0:
+            block = rng.uniform(low, high, size=block.shape).astype(np.float32)
+        if steps >= min_steps and time.perf_counter() - start >= seconds:
+            break
+    return steps, time.perf_counter() - start, resets
+
+
+def bench_single(bench: Bench, landmarks: Sequence[int]) -> list[dict[str, Any]]:
+    bench.measure_reference("single")
+    rows: list[dict[str, Any]] = []
+    for name, env_kwargs, unwrapped in single_env_cases(landmarks):
+        env = make_single_env(env_kwargs, unwrapped)
+        resets = 0
+
+        def run(env: gym.Env[Any, Any] = env) -> tuple[int, float]:
+            nonlocal resets
+            steps, elapsed, resets = run_single_env(env, bench.seconds)
+            return steps, elapsed
+
+        figure = timed_figure(bench, run)
+        n_landmarks = int(env.unwrapped.n_landmarks)  # type: ignore[attr-defined]
+        env.close()
+        row = {
+            "name": name,
+            "env_kwargs": env_kwargs,
+            "unwrapped": unwrapped,
+            "n_landmarks": n_landmarks,
+            "resets": resets,
+            **figure,
+        }
+        rows.append(row)
+        log(f"  single {name:<16} {row['steps_per_s']:10,.0f} steps/s")
+    base = next((row for row in rows if row["name"] == "random_4"), None)
+    for row in rows:
+        row["ratio_to_4_landmarks"] = (
+            row["steps_per_s"] / base["steps_per_s"]
+            if base is not None and row["name"].startswith("random_")
+            else None
+        )
+    return rows
+
+
+# --------------------------------------------------------------------------------------
+# The world model alone, and the compiled core's start-up
+# --------------------------------------------------------------------------------------
+
+
+def bench_slam_updates(bench: Bench) -> list[dict[str, Any]]:
+    from bearing_env.benchmarks.bench_slam import updates_per_second
+
+    bench.measure_reference("slam")
+    rows: list[dict[str, Any]] = []
+    for transfer in ("conservative", "paper"):
+        for n_landmarks in (4, 64):
+            begin = bench.now()
+            rate = updates_per_second(n_landmarks, transfer, bench.seconds)
+            row = {"transfer": transfer, "n_landmarks": n_landmarks, "steps_per_s": rate}
+            row.update(bench.ratios(rate, 0.5 * (begin + bench.now())))
+            rows.append(row)
+            log(f"  update() {transfer:>12} {n_landmarks:3d} landmarks {rate:10,.0f} /s")
+    return rows
+
+
+#: Run in a fresh interpreter: seconds from its start to the end of the first env step.
+FIRST_STEP_SCRIPT = """
+import time
+start = time.perf_counter()
+import gymnasium as gym
+import bearing_env  # noqa: F401
+env = gym.make("BearingSLAM-v0", scenario="khepera")
+env.reset(seed=0)
+env.step(env.action_space.sample())
+print(time.perf_counter() - start)
+"""
+
+
+def first_step_seconds(cache_dir: str) -> float:
+    environment = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
+    done = subprocess.run(
+        [sys.executable, "-c", FIRST_STEP_SCRIPT],
+        capture_output=True,
+        text=True,
+        env=environment,
+        check=True,
+        timeout=900,
+    )
+    return float(done.stdout.strip().splitlines()[-1])
+
+
+def bench_startup() -> dict[str, Any]:
+    """Compile from an empty cache once, then time fresh processes with it warm."""
+    with tempfile.TemporaryDirectory(prefix="bearing-env-numba-") as cache_dir:
+        log("  compiling from an empty numba cache (a fresh process) ...")
+        cold = first_step_seconds(cache_dir)
+        warm = [first_step_seconds(cache_dir) for _ in range(STARTUP_WARM_RUNS)]
+    log(f"  first step: {cold:.2f} s with an empty cache, {np.median(warm):.2f} s warm")
+    return {
+        "cold_first_step_s": cold,
+        "warm_first_step_s": float(np.median(warm)),
+        "warm_runs_s": warm,
+    }
+
+
+def bench_planning(episodes: int) -> dict[str, Any]:
+    """GreedyOneStep's act() time per move, Khepera, seeded episodes."""
+    from bearing_env.agents import GreedyOneStep
+
+    env = gym.make(ENV_ID, scenario="khepera")
+    policy = GreedyOneStep(env)
+    times: list[float] = []
+    for episode in range(episodes + 1):  # the first episode warms up, untimed
+        observation, info = env.reset(seed=episode)
+        policy.reset(seed=episode)
+        done = False
+        while not done:
+            start = time.perf_counter()
+            action = policy.act(observation, info)
+            if episode:
+                times.append(time.perf_counter() - start)
+            observation, _, terminated, truncated, info = env.step(action)
+            done = terminated or truncated
+    env.close()
+    median = float(np.median(times))
+    log(f"  GreedyOneStep: {median * 1e3:.3f} ms per move (median of {len(times)})")
+    return {
+        "moves": len(times),
+        "median_s": median,
+        "mean_s": float(np.mean(times)),
+        "p90_s": float(np.percentile(times, 90)),
+    }
+
+
+# --------------------------------------------------------------------------------------
+# Vector env
+# --------------------------------------------------------------------------------------
+
+
+def has_vector_entry_point(env_id: str = ENV_ID) -> bool:
+    return gym.spec(env_id).vector_entry_point is not None
+
+
+def make_vector_env(num_envs: int, mode: str, env_kwargs: dict[str, Any]) -> gym.vector.VectorEnv:
+    return gym.make_vec(ENV_ID, num_envs=num_envs, vectorization_mode=mode, **env_kwargs)
+
+
+def autoreset_mode(venv: gym.vector.VectorEnv) -> AutoresetMode:
+    """The vector env's autoreset mode (Gymnasium's default, NEXT_STEP, if it declares none)."""
+    mode = venv.metadata.get("autoreset_mode", AutoresetMode.NEXT_STEP)
+    return mode if isinstance(mode, AutoresetMode) else AutoresetMode(mode)
+
+
+def run_vector_env(
+    venv: gym.vector.VectorEnv, seconds: float, seed: int = 0, min_calls: int = 2
+) -> tuple[int, float, int]:
+    """Step ``venv`` with seeded random actions: (env transitions, seconds, step() calls).
+
+    In NEXT_STEP autoreset mode, a sub-env whose episode ended resets on the next call
+    and ignores its action; those sub-steps are not counted as transitions. With autoreset
+    disabled, ended sub-envs are reset through ``reset(options={"reset_mask": ...})``."""
+    rng = np.random.default_rng(seed)
+    num_envs = venv.num_envs
+    space = getattr(venv, "single_action_space", None)
+    if space is not None:
+        low, high = space.low, space.high
+    else:
+        low, high = venv.action_space.low[0], venv.action_space.high[0]
+    shape = (num_envs, *low.shape)
+    mode = autoreset_mode(venv)
+    venv.reset(seed=seed)
+    venv.step(rng.uniform(low, high, size=shape).astype(np.float32))  # warm-up, not timed
+    venv.reset(seed=seed)
+    pending = np.zeros(num_envs, dtype=bool)  # sub-envs whose next call is a reset
+    transitions = calls = 0
+    start = time.perf_counter()
+    while True:
+        actions = rng.uniform(low, high, size=shape).astype(np.float32)
+        _, _, terminated, truncated, _ = venv.step(actions)
+        calls += 1
+        done = np.logical_or(terminated, truncated)
+        if mode == AutoresetMode.NEXT_STEP:
+            transitions += num_envs - int(pending.sum())
+            pending = done
+        else:
+            transitions += num_envs
+            if mode == AutoresetMode.DISABLED and done.any():
+                venv.reset(options={"reset_mask": done})
+        if calls >= min_calls and time.perf_counter() - start >= seconds:
+            break
+    return transitions, time.perf_counter() - start, calls
+
+
+def bench_vector(
+    bench: Bench, num_envs_list: Sequence[int], env_kwargs: dict[str, Any]
+) -> list[dict[str, Any]]:
+    bench.measure_reference("vector")
+    batched_mode = "vector_entry_point" if has_vector_entry_point() else "sync"
+    fallback = batched_mode != "vector_entry_point"
+    if fallback:
+        log(f"  {ENV_ID} has no vector_entry_point: the batched rows use sync (fallback)")
+    rows: list[dict[str, Any]] = []
+    for kind, mode in (("batched", batched_mode), ("sync", "sync")):
+        for num_envs in num_envs_list:
+            build_start = time.perf_counter()
+            venv = make_vector_env(num_envs, mode, env_kwargs)
+            build_seconds = time.perf_counter() - build_start
+            calls = 0
+
+            def run(venv: gym.vector.VectorEnv = venv) -> tuple[int, float]:
+                nonlocal calls
+                steps, elapsed, calls = run_vector_env(venv, bench.seconds)
+                return steps, elapsed
+
+            figure = timed_figure(bench, run)
+            venv.close()
+            row = {
+                "kind": kind,
+                "vectorization_mode": mode,
+                "fallback": kind == "batched" and fallback,
+                "num_envs": num_envs,
+                "env_kwargs": env_kwargs,
+                "step_calls": calls,
+                "autoreset_mode": autoreset_mode(venv).value,
+                "build_seconds": build_seconds,
+                **figure,
+            }
+            rows.append(row)
+            label = vector_label(row)
+            log(f"  vector {label:<24} {num_envs:4d} envs {row['steps_per_s']:10,.0f} steps/s")
+    sync_rates = {row["num_envs"]: row["steps_per_s"] for row in rows if row["kind"] == "sync"}
+    for row in rows:
+        row["ratio_to_sync"] = (
+            row["steps_per_s"] / sync_rates[row["num_envs"]] if row["kind"] == "batched" else None
+        )
+    return rows
+
+
+def vector_label(row: dict[str, Any]) -> str:
+    if row["kind"] == "sync":
+        return "sync (baseline)"
+    return "sync (fallback)" if row["fallback"] else "batched"
+
+
+# --------------------------------------------------------------------------------------
+# PPO
+# --------------------------------------------------------------------------------------
+
+
+def available_vec_env_kinds() -> tuple[str, ...]:
+    from bearing_env.train.training_envs import VEC_ENV_KINDS
+
+    return tuple(VEC_ENV_KINDS)
+
+
+def ppo_settings(
+    env_kwargs: dict[str, Any], overrides: dict[str, Any]
+) -> tuple[dict[str, Any], dict[str, Any] | None, dict[str, Any]]:
+    """(PPO constructor kwargs, VecNormalize kwargs or None, env kwargs) from ppo.yml."""
+    from bearing_env.train.zoo import parse_hyperparameters, read_hyperparameters
+
+    raw = read_hyperparameters("ppo", ENV_ID)
+    raw.update(overrides)
+    raw["env_kwargs"] = {**(raw.get("env_kwargs") or {}), **env_kwargs}
+    hyperparams = parse_hyperparameters(raw, "ppo")
+    return dict(hyperparams.algorithm_kwargs), hyperparams.normalize, hyperparams.env_kwargs
+
+
+@contextlib.contextmanager
+def torch_threads(n: int) -> Iterator[None]:
+    import torch
+
+    previous = torch.get_num_threads()
+    torch.set_num_threads(n)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(previous)
+
+
+@dataclass
+class PPORun:
+    """One vec env kind's PPO model, built and warmed up, ready for timed rounds."""
+
+    kind: str
+    measured_with: str
+    model: Any
+    venv: Any
+    n_envs: int
+    total_steps: int
+    algorithm_kwargs: dict[str, Any]
+    normalize: dict[str, Any] | None
+    make_kwargs: dict[str, Any]
+    build_seconds: float
+    rounds: list[dict[str, Any]] = field(default_factory=list)
+
+    def timed_round(self, bench: Bench) -> dict[str, Any]:
+        before = int(self.model.num_timesteps)
+
+        def run() -> tuple[int, float]:
+            start = time.perf_counter()
+            self.model.learn(total_timesteps=self.total_steps, reset_num_timesteps=False)
+            return int(self.model.num_timesteps) - before, time.perf_counter() - start
+
+        figure = timed_figure(bench, run)
+        self.rounds.append(figure)
+        return figure
+
+    def close(self) -> None:
+        with contextlib.suppress(EOFError, BrokenPipeError, ConnectionError, OSError):
+            self.venv.close()
+
+    def row(self, bench: Bench) -> dict[str, Any]:
+        """The kind's figure: the median round (rates drift on a shared machine)."""
+        rates = [figure["steps_per_s"] for figure in self.rounds]
+        middle = self.rounds[len(self.rounds) // 2]
+        rate = float(np.median(rates))
+        return {
+            "kind": self.kind,
+            "measured_with": self.measured_with,
+            "fallback": self.measured_with != self.kind,
+            "n_envs": self.n_envs,
+            "rollout_steps": int(self.algorithm_kwargs.get("n_steps", 2048)) * self.n_envs,
+            "requested_steps": self.total_steps,
+            "normalize": self.normalize is not None,
+            "hyperparams": json_safe(self.algorithm_kwargs),
+            "env_kwargs": self.make_kwargs,
+            "setup_and_warmup_seconds": self.build_seconds,
+            "steps": int(sum(figure["steps"] for figure in self.rounds)),
+            "seconds": float(sum(figure["seconds"] for figure in self.rounds)),
+            "steps_per_s": rate,
+            "cartpole_reference": middle["cartpole_reference"],
+            "cartpole_steps_per_s": middle["cartpole_steps_per_s"],
+            "ratio_to_cartpole": float(
+                np.median([figure["ratio_to_cartpole"] for figure in self.rounds])
+            ),
+            "ratio_to_cartpole_start": rate / bench.references[0].steps_per_s,
+            "rounds": self.rounds,
+        }
+
+
+def build_ppo_run(
+    bench: Bench,
+    kind: str,
+    n_envs: int,
+    total_steps: int,
+    env_kwargs: dict[str, Any],
+    overrides: dict[str, Any],
+) -> PPORun:
+    """Build PPO on one vec env kind and warm it up (one rollout and one update)."""
+    from bearing_env.train.training_envs import make_training_env
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    available = available_vec_env_kinds()
+    measured_with = kind if kind in available else "dummy"
+    algorithm_kwargs, normalize, make_kwargs = ppo_settings(env_kwargs, overrides)
+    build_start = time.perf_counter()
+    venv = make_training_env(ENV_ID, make_kwargs, n_envs, measured_with, None)
+    try:
+        if normalize is not None:
+            venv = VecNormalize(venv, **normalize)
+        model = PPO(env=venv, seed=0, device="cpu", verbose=0, **algorithm_kwargs)
+        model.learn(total_timesteps=1)  # warm-up, not timed
+    except BaseException:
+        with contextlib.suppress(EOFError, BrokenPipeError, ConnectionError, OSError):
+            venv.close()
+        raise
+    run = PPORun(
+        kind,
+        measured_with,
+        model,
+        venv,
+        n_envs,
+        total_steps,
+        algorithm_kwargs,
+        normalize,
+        make_kwargs,
+        time.perf_counter() - build_start,
+    )
+    bench.measure_reference(f"ppo/{kind}")
+    return run
+
+
+def bench_ppo(
+    bench: Bench,
+    kinds: Sequence[str],
+    n_envs: int,
+    total_steps: int,
+    env_kwargs: dict[str, Any],
+    overrides: dict[str, Any],
+    rounds: int = DEFAULT_PPO_ROUNDS,
+) -> list[dict[str, Any]]:
+    """PPO throughput per vec env kind, in interleaved rounds.
+
+    Every kind is built and warmed up first; then each round times every kind once, in
+    turn, so that a drifting machine speed affects all kinds alike. A kind's rate is its
+    median round, and its ratio to SubprocVecEnv is the median of the per-round ratios.
+    """
+    if "batched" in kinds and "batched" not in available_vec_env_kinds():
+        log(
+            "  bearing_env.train.training_envs.VEC_ENV_KINDS has no 'batched':"
+            " that row uses dummy (fallback)"
+        )
+    runs: list[PPORun] = []
+    try:
+        with torch_threads(1):  # as bearing-env train (--torch-threads 1)
+            for kind in kinds:
+                log(f"  ppo {kind}: building {n_envs} envs and warming up ...")
+                runs.append(build_ppo_run(bench, kind, n_envs, total_steps, env_kwargs, overrides))
+            for number in range(1, rounds + 1):
+                if number > 1:
+                    bench.measure_reference(f"ppo/round {number}")
+                for run in runs:
+                    figure = run.timed_round(bench)
+                    log(
+                        f"  ppo {run.kind:<8} round {number}/{rounds}: "
+                        f"{figure['steps_per_s']:10,.0f} env steps/s"
+                    )
+        rows = [run.row(bench) for run in runs]
+    finally:
+        for run in runs:
+            run.close()
+    subproc = next((run for run in runs if run.kind == "subproc"), None)
+    for run, row in zip(runs, rows, strict=True):
+        row["ratio_to_subproc"] = (
+            float(
+                np.median(
+                    [
+                        mine["steps_per_s"] / theirs["steps_per_s"]
+                        for mine, theirs in zip(run.rounds, subproc.rounds, strict=True)
+                    ]
+                )
+            )
+            if subproc is not None
+            else None
+        )
+        log(f"  ppo {ppo_label(row):<24} {row['steps_per_s']:10,.0f} env steps/s (median)")
+    return rows
+
+
+def ppo_label(row: dict[str, Any]) -> str:
+    if row["fallback"]:
+        return f"{row['measured_with']} (fallback for {row['kind']})"
+    return row["kind"] + (" (spawn)" if row["kind"] == "subproc" else "")
+
+
+# --------------------------------------------------------------------------------------
+# Profiling
+# --------------------------------------------------------------------------------------
+
+
+def profile(section: str, seconds: float, num_envs: int, env_kwargs: dict[str, Any]) -> None:
+    """cProfile the single-env (Khepera) or vector-env loop; print the top 25 by tottime."""
+    if section == "single":
+        env: Any = make_single_env({"scenario": "khepera"})
+        what = "single env, khepera (unwrapped)"
+
+        def loop() -> None:
+            run_single_env(env, seconds)
+    else:
+        mode = "vector_entry_point" if has_vector_entry_point() else "sync"
+        env = make_vector_env(num_envs, mode, env_kwargs)
+        what = f"vector env ({mode}), {num_envs} envs, {env_kwargs}"
+
+        def loop() -> None:
+            run_vector_env(env, seconds)
+
+    print(f"cProfile: {what}, {seconds:g} s")
+    profiler = cProfile.Profile()
+    profiler.runcall(loop)
+    env.close()
+    pstats.Stats(profiler, stream=sys.stdout).sort_stats("tottime").print_stats(25)
+
+

@@ -1,0 +1,299 @@
+"""The wheel and the sdist, each installed without extras into a fresh venv, work as a library.
+
+Both distributions are built from this checkout and installed (``pip install DIST``, no
+extras, versions from ``constraints.txt``) into two new venvs, which are set up at the
+same time. Every command runs in a folder outside the checkout, so nothing is imported
+from the repository's folders. Checked:
+
+- each install adds one top-level import name, ``bearing_env`` (the installed RECORDs,
+  and the wheel's own RECORD);
+- the sdist installs the very files of the wheel (same paths, same sha256);
+- ``import bearing_env; gym.make("BearingSLAM-v0")`` works in both; with the wheel it
+  also resets and steps;
+- with the wheel, ``bearing-env compare --quick`` (3 episodes) runs the three heuristics,
+  says it skipped the shipped models, and writes its report below the working directory,
+  and ``bearing-env demo`` names the ``render`` extra and shows no traceback (the files
+  being the same, the sdist's install would run them alike);
+- the sdist's tests (copied out of the unpacked sdist, away from its sources) collect
+  with only pytest and hypothesis added: every module but the four that import the
+  ``train`` extra (``tests/conftest.py`` leaves those out without it).
+
+The numba core compiles once per venv (its cache is keyed by the installed source path,
+so two venvs cannot share it), about half of this test's cost: it compiles in the
+wheel's venv only. ``NUMBA_CACHE_DIR`` points at a folder of the test's, so nothing is
+written into the installed package and the commands after the first step reuse the
+compiled kernels.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tarfile
+import zipfile
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+CONSTRAINTS = ROOT / "constraints.txt"
+KINDS = ("wheel", "sdist")
+#: Installed with the sdist, to collect its tests (pinned by constraints.txt).
+TEST_REQUIREMENTS = ("pytest", "hypothesis")
+COMPARE_EPISODES = 3
+
+# A Python program that prints the installed distribution's RECORD: path -> sha256.
+INSTALLED_RECORD = """
+import json, importlib.metadata as m
+files = m.distribution("bearing_env").files
+print(json.dumps({str(f): f.hash.value if f.hash else None for f in files}))
+"""
+
+GYM_MAKE = """
+import importlib.util, json
+import gymnasium as gym
+import bearing_env
+import sys
+env = gym.make("BearingSLAM-v0")
+report = {"observation_space": str(env.observation_space)}
+if "--step" in sys.argv:  # compiles the numba core
+    observation, info = env.reset(seed=3)
+    step = env.step(env.action_space.sample())
+    report["in_space"] = bool(env.observation_space.contains(step[0]))
+print(json.dumps({
+    **report,
+    "module": bearing_env.__file__,
+    "extras": [n for n in ("stable_baselines3", "torch", "pygame", "matplotlib")
+               if importlib.util.find_spec(n) is not None],
+}))
+"""
+
+
+@dataclass
+class InstalledRun:
+    """One distribution installed into a fresh venv, and what each check's command gave."""
+
+    kind: str
+    venv: Path
+    work: Path
+    results: dict[str, subprocess.CompletedProcess[str]] = field(default_factory=dict)
+
+
+def _run(
+    command: list[str], cwd: Path, env: dict[str, str], timeout: float = 600
+) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        command, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout
+    )
+
+
+def _checked(result: subprocess.CompletedProcess[str]) -> subprocess.CompletedProcess[str]:
+    assert result.returncode == 0, (
+        f"{result.args}\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
+    )
+    return result
+
+
+def _build(out: Path) -> dict[str, Path]:
+    """The wheel and the sdist of this checkout (setuptools' backend, in the checkout).
+
+    One process each: a ``build_sdist`` after ``build_wheel`` in the same process writes
+    the archive where the wheel's command options point, not into ``out``.
+    """
+    built = {}
+    for kind, hook in (("wheel", "build_wheel"), ("sdist", "build_sdist")):
+        program = (
+            f"import sys\nfrom setuptools import build_meta\nprint(build_meta.{hook}(sys.argv[1]))"
+        )
+        result = _checked(
+            subprocess.run(
+                [sys.executable, "-c", program, str(out)],
+                cwd=ROOT,
+                capture_output=True,
+                text=True,
+                timeout=300,
+            )
+        )
+        built[kind] = out / result.stdout.strip().splitlines()[-1]
+    return built
+
+
+def _install_and_check(kind: str, dist: Path, base: Path, numba_cache: Path) -> InstalledRun:
+    venv, work = base / f"venv-{kind}", base / f"work-{kind}"
+    work.mkdir()
+    env = {
+        key: value
+        for key, value in os.environ.items()
+        if key not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME", "NUMBA_CACHE_DIR")
+    }
+    env.update(
+        PATH=f"{venv / 'bin'}{os.pathsep}{env.get('PATH', '')}",
+        NUMBA_CACHE_DIR=str(numba_cache),
+        SDL_VIDEODRIVER="dummy",
+        PIP_DISABLE_PIP_VERSION_CHECK="1",
+    )
+    run = InstalledRun(kind, venv, work)
+    # No pip in the venv (ensurepip costs seconds); this interpreter's pip installs into it.
+    _checked(_run([sys.executable, "-m", "venv", "--without-pip", str(venv)], work, env))
+    python = str(venv / "bin" / "python")
+    pip = [sys.executable, "-m", "pip", "--python", python, "install", "--quiet"]
+    pip += ["-c", str(CONSTRAINTS)]
+    _checked(_run([*pip, str(dist)], work, env))
+    run.results["record"] = _run([python, "-c", INSTALLED_RECORD], work, env)
+    if kind == "sdist":
+        # The sdist installs the wheel's files (checked by hash), so the commands below,
+        # which compile the numba core in each new venv, run once, with the wheel.
+        run.results["gym_make"] = _run([python, "-c", GYM_MAKE], work, env)
+    else:
+        run.results["gym_make"] = _run([python, "-c", GYM_MAKE, "--step"], work, env)
+        return _run_commands(run, env)
+    _checked(_run([*pip, *TEST_REQUIREMENTS], work, env))
+    tests = work / "sdist_tests"
+    with tarfile.open(dist) as archive:
+        prefix = archive.getnames()[0].split("/")[0]
+        members = [
+            member
+            for member in archive.getmembers()
+            if member.name.startswith((f"{prefix}/tests/", f"{prefix}/pyproject.toml"))
+        ]
+        archive.extractall(work, members=members, filter="data")
+    (work / prefix).rename(tests)
+    run.results["collect"] = _run(
+        [python, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", "tests"],
+        tests,
+        env,
+    )
+    return run
+
+
+def _run_commands(run: InstalledRun, env: dict[str, str]) -> InstalledRun:
+    work = run.work
+    bearing_env_command = str(run.venv / "bin" / "bearing-env")
+    run.results["compare"] = _run(
+        [bearing_env_command, "compare", "--quick", "--episodes", str(COMPARE_EPISODES),
+         "--no-progress"],
+        work,
+        env,
+    )  # fmt: skip
+    run.results["demo"] = _run([bearing_env_command, "demo", "--episodes", "1"], work, env)
+    return run
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    return _build(tmp_path_factory.mktemp("dist"))
+
+
+@pytest.fixture(scope="module")
+def installed(
+    built: dict[str, Path], tmp_path_factory: pytest.TempPathFactory
+) -> dict[str, InstalledRun]:
+    base = tmp_path_factory.mktemp("installed")
+    numba_cache = base / "numba_cache"
+    with ThreadPoolExecutor(max_workers=len(KINDS)) as pool:
+        futures = {
+            kind: pool.submit(_install_and_check, kind, built[kind], base, numba_cache)
+            for kind in KINDS
+        }
+        return {kind: future.result() for kind, future in futures.items()}
+
+
+def test_the_wheel_record_names_only_the_bearing_env_package(built: dict[str, Path]) -> None:
+    with zipfile.ZipFile(built["wheel"]) as archive:
+        (record,) = [n for n in archive.namelist() if n.endswith(".dist-info/RECORD")]
+        paths = [line.split(",")[0] for line in archive.read(record).decode().splitlines()]
+    tops = {path.split("/")[0] for path in paths if path}
+    assert {top for top in tops if not top.endswith(".dist-info")} == {"bearing_env"}
+    for subpackage in ("agents", "train", "benchmarks"):
+        assert f"bearing_env/{subpackage}/__init__.py" in paths
+    assert "bearing_env/train/hyperparams/ppo.yml" in paths
+    assert "bearing_env/agents/pretrained/ppo_khepera.zip" in paths
+
+
+def _installed_record(run: InstalledRun) -> dict[str, str | None]:
+    return dict(json.loads(_checked(run.results["record"]).stdout))
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_the_install_adds_only_the_bearing_env_import_name(
+    installed: dict[str, InstalledRun], kind: str
+) -> None:
+    tops = {path.split("/")[0] for path in _installed_record(installed[kind])}
+    # ".." holds the bearing-env script (bin/); the .dist-info folder is metadata.
+    assert {top for top in tops if top != ".." and not top.endswith(".dist-info")} == {
+        "bearing_env"
+    }
+
+
+def test_the_sdist_installs_the_same_files_as_the_wheel(
+    installed: dict[str, InstalledRun],
+) -> None:
+    def package_files(kind: str) -> dict[str, str | None]:
+        record = _installed_record(installed[kind])
+        return {path: digest for path, digest in record.items() if path.startswith("bearing_env/")}
+
+    wheel, sdist = package_files("wheel"), package_files("sdist")
+    assert len(wheel) > 50
+    assert sdist == wheel
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_gym_make_works_without_extras(installed: dict[str, InstalledRun], kind: str) -> None:
+    run = installed[kind]
+    report = json.loads(_checked(run.results["gym_make"]).stdout.strip().splitlines()[-1])
+    assert report["observation_space"].startswith("Box(")
+    assert Path(report["module"]).is_relative_to(run.venv)  # not the checkout
+    assert report["extras"] == []  # really a plain install
+    if kind == "wheel":
+        assert report["in_space"] is True  # it reset and stepped
+
+
+def test_compare_quick_runs_the_heuristics_and_skips_the_shipped_models(
+    installed: dict[str, InstalledRun],
+) -> None:
+    run = installed["wheel"]
+    result = _checked(run.results["compare"])
+    for label in ("random_polygonal", "parallax", "greedy_one_step"):
+        assert label in result.stdout
+    assert "ppo_khepera" not in result.stdout
+    assert "skipped the shipped models (ppo_khepera)" in result.stderr
+    assert 'pip install "bearing_env[train]"' in result.stderr
+    assert "Traceback" not in result.stderr
+    # The default output folder is below the working directory, not in the package.
+    summary = json.loads((run.work / "outputs/compare_quick/summary.json").read_text())
+    assert sorted(summary["policies"]) == ["greedy_one_step", "parallax", "random_polygonal"]
+    assert all(p["episodes"] == COMPARE_EPISODES for p in summary["policies"].values())
+
+
+def test_demo_names_the_render_extra_without_a_traceback(
+    installed: dict[str, InstalledRun],
+) -> None:
+    result = installed["wheel"].results["demo"]
+    assert result.returncode == 0, result.stderr
+    assert 'pip install "bearing_env[render]"' in result.stderr
+    assert "Traceback" not in result.stdout + result.stderr
+    assert "median total area" in result.stdout
+
+
+def test_the_sdist_tests_import_against_the_installed_package(
+    installed: dict[str, InstalledRun],
+) -> None:
+    from tests.conftest import NEEDS_TRAIN_EXTRA
+
+    result = installed["sdist"].results["collect"]
+    assert result.returncode == 0, result.stdout[-5000:] + result.stderr[-2000:]
+    assert " collected in " in result.stdout.splitlines()[-1]
+    assert "error" not in result.stdout.splitlines()[-1].lower()
+    # Every other test module of the repository imports, and its tests are collected.
+    collected = {
+        line.split("::")[0].removeprefix("tests/")
+        for line in result.stdout.splitlines()
+        if "::" in line
+    }
+    repository_tests = {p.name for p in (ROOT / "tests").glob("test_*.py")}
+    assert collected == repository_tests - set(NEEDS_TRAIN_EXTRA)
+    assert len(result.stdout.splitlines()) > 400
