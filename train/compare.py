@@ -17,6 +17,10 @@ Outputs (in ``--out``):
 - ``area_vs_moves.png``, ``error_vs_moves.png``;
 - ``timing.json``: policy time per decision (the only output that is not reproducible).
 
+With ``--executor ray`` (the ``ray`` extra) the episodes run as Ray tasks, on a local Ray
+instance or, with ``--ray-address ADDRESS``, on a running cluster, with the same seeds,
+log, ``--resume`` and summary (``bearing_env.train.ray_executor``).
+
 With ``--workers N`` the episodes run in a pool of spawned processes that exit with the
 command: if it is killed (SIGKILL, out of memory), the kernel ends them on Linux
 (``prctl(PR_SET_PDEATHSIG)``) and elsewhere they notice their parent is gone within half
@@ -42,6 +46,7 @@ and path length (metres per episode, mean).
 
     bearing-env compare --env-kwargs scenario=khepera --episodes 200 --workers 2
     bearing-env compare --quick                   # 20 short episodes of the heuristics
+    bearing-env compare --episodes 2000 --executor ray --ray-address HEAD_IP:6379
 """
 
 from __future__ import annotations
@@ -73,6 +78,7 @@ from bearing_env.train.errors import (
     available,
     fail,
     missing_extra,
+    require,
     with_path,
     write_error_message,
 )
@@ -97,6 +103,8 @@ DEFAULT_BOOTSTRAP_SEED = 20050101
 LOG_NAME = "episodes.jsonl"
 CONFIG_NAME = "config.json"
 FORMAT_VERSION = 1
+#: Where the episodes run: ``local`` (this process or ``--workers`` processes), ``ray``.
+EXECUTORS = ("local", "ray")
 
 
 # --------------------------------------------------------------------------------------
@@ -969,8 +977,21 @@ def _exit_with_parent(parent_pid: int) -> None:
 
 
 def _run_pending(
-    tasks: Sequence[EpisodeTask], workers: int, log: EpisodeLog, bar: Any
+    tasks: Sequence[EpisodeTask],
+    workers: int,
+    log: EpisodeLog,
+    bar: Any,
+    executor: str = "local",
+    ray_address: str | None = None,
 ) -> Iterator[dict[str, Any]]:
+    if executor == "ray":  # Ray tasks on this machine or a cluster (train/ray_executor.py)
+        from bearing_env.train.ray_executor import run_on_ray
+
+        for record in run_on_ray(tasks, address=ray_address):
+            log.append(record)
+            bar.update()
+            yield record
+        return
     if workers <= 1:
         for task in tasks:
             record = run_task(task)
@@ -1016,6 +1037,8 @@ def run_comparison(
     progress: bool = True,
     plots: bool = True,
     command: str | None = None,
+    executor: str = "local",
+    ray_address: str | None = None,
 ) -> CompareResult:
     """Run (or finish) a comparison and write every output file.
 
@@ -1030,7 +1053,13 @@ def run_comparison(
         progress: show a progress bar.
         plots: write the PNG plots.
         command: the command line to quote in the report.
+        executor: ``"local"`` (``workers`` processes) or ``"ray"`` (Ray tasks, see
+            ``bearing_env.train.ray_executor``; ``workers`` is not used).
+        ray_address: with ``executor="ray"``, the cluster to join (default: this
+            process's Ray instance, or a new local one).
     """
+    if executor not in EXECUTORS:
+        raise ValueError(f"executor must be one of {EXECUTORS}, got {executor!r}")
     out = Path(out)
     log = EpisodeLog(out / LOG_NAME)
     config_path = out / CONFIG_NAME
@@ -1059,7 +1088,7 @@ def run_comparison(
         tasks = tasks[: max(0, stop_after)]
     n_total = len(config.seeds) * len(config.policies)
     with _progress(n_total, n_total - len(_pending_tasks(config, done)), progress) as bar:
-        for record in _run_pending(tasks, workers, log, bar):
+        for record in _run_pending(tasks, workers, log, bar, executor, ray_address):
             records.append(record)
 
     summary = summarise(records, config)
@@ -1149,6 +1178,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--workers", type=int, default=1, help="processes to run episodes in (default %(default)s)"
+    )
+    parser.add_argument(
+        "--executor",
+        choices=EXECUTORS,
+        default="local",
+        help="local: this process, or --workers processes (default); ray: Ray tasks on a "
+        "local Ray instance or the cluster of --ray-address (the ray extra)",
+    )
+    parser.add_argument(
+        "--ray-address",
+        default=None,
+        metavar="ADDRESS",
+        help="with --executor ray: the running cluster to join (HOST:PORT, or auto)",
     )
     parser.add_argument(
         "--out",
@@ -1256,7 +1298,7 @@ def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
 #: Options that change how a run proceeds but not its results: left out of the command
 #: the report quotes (a resumed run regenerates with the plain command).
 _PROCESS_ONLY_FLAGS = ("--resume", "--overwrite", "--no-progress")
-_PROCESS_ONLY_OPTIONS = ("--stop-after",)
+_PROCESS_ONLY_OPTIONS = ("--stop-after", "--executor", "--ray-address")
 
 
 def reproducing_command(argv: Sequence[str]) -> str:
@@ -1278,7 +1320,14 @@ def reproducing_command(argv: Sequence[str]) -> str:
 def main(argv: Sequence[str] | None = None) -> None:
     parser = build_parser()
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    if args.executor != "ray" and args.ray_address is not None:
+        parser.error("--ray-address needs --executor ray")
+    if args.executor == "ray" and args.workers != 1:
+        parser.error("--workers is for --executor local; Ray runs as many episodes as the "
+                     "cluster has CPUs")
     try:
+        if args.executor == "ray":
+            require("ray", "--executor ray", extra="ray")
         config, out = config_from_args(args)
         # Fail fast on a bad env or policy spec, before any worker starts.
         from bearing_env.agents.registry import make_policy
@@ -1306,6 +1355,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             progress=not args.no_progress,
             plots=not args.no_plots,
             command=command,
+            executor=args.executor,
+            ray_address=args.ray_address,
         )
     except FileExistsError as error:
         if error.errno is None:  # raised above: the folder holds a comparison already
