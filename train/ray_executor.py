@@ -19,9 +19,10 @@ through Ray's object store, not the file system: the bytes of each file
 writes them into a folder of its own temporary directory named by their digest, and
 builds the policy from those copies (:func:`bearing_env.agents.registry.with_files`).
 
-**Interruption.** Ctrl-C (or an exception) cancels the episodes not yet finished; every
-record already yielded has been logged by the caller, so a rerun with ``--resume`` runs
-only the rest.
+**Interruption.** Every record already yielded has been logged by the caller, so after
+Ctrl-C a rerun with ``--resume`` runs only the rest. Ctrl-C ends the command, and Ray
+ends its tasks with it (or with the local instance it started); a failed episode, or a
+caller that stops reading, cancels the episodes not yet finished.
 """
 
 from __future__ import annotations
@@ -145,6 +146,11 @@ def run_on_ray(
             while pending:
                 ready, pending = ray.wait(pending, num_returns=1)
                 yield ray.get(ready[0])
-        finally:
-            for ref in pending:  # interrupted or failed: stop what has not finished
-                ray.cancel(ref, force=True)
+        except KeyboardInterrupt:
+            # The command is ending: Ray ends this driver's tasks with it (cancelling them
+            # here while their replies are under way has crashed Ray's core worker).
+            raise
+        except BaseException:
+            for ref in pending:  # failed, or the caller stopped early: drop the rest
+                ray.cancel(ref)
+            raise

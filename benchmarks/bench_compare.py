@@ -1,0 +1,144 @@
+"""``bearing-env compare`` on Ray against local worker processes: speed-up and overhead.
+
+    python -m bearing_env.benchmarks.bench_compare                  # 200 episodes, 2 repeats
+    python -m bearing_env.benchmarks.bench_compare --episodes 50 --repeats 1
+
+Runs one comparison (``--policies``, ``--episodes`` each, the Khepera scenario) in these
+ways, each ``--repeats`` times, and prints the wall times (min-max over the repeats):
+
+- ``local, 1 process``: ``--workers 1`` (the baseline of every speed-up);
+- ``local, 2 processes``: ``--workers 2``;
+- ``ray, new instance``: ``--executor ray`` as a user runs it on one machine: the wall
+  time includes starting a local Ray instance (all cores) and its workers;
+- ``ray, running instance``: the same on a Ray instance started beforehand (its workers
+  new: each builds its env and policies);
+- ``ray, warm workers``: that instance's second run (workers already built them);
+- ``ray, 1 CPU, warm``: a 1-CPU instance's second run. Its time less ``local, 1
+  process``, divided by the episodes, is the overhead of Ray per episode (scheduling,
+  serialising the task and its record, the object store), as one CPU runs both.
+
+Every run must give the same ``summary.json`` (checked). The JSON (``--json``, default
+``outputs/bench_compare.json``) holds every time. The machine is shared: quote ranges.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+from bearing_env.train.compare import CompareConfig, policies_from_specs, run_comparison
+
+from bearing_env.extras import require
+
+DEFAULT_POLICIES = ("random", "parallax", "greedy")
+
+
+def _timed(run: Callable[[], Any]) -> float:
+    started = time.perf_counter()
+    run()
+    return time.perf_counter() - started
+
+
+def bench(
+    config: CompareConfig, repeats: int, work: Path, progress: bool = False
+) -> dict[str, list[float]]:
+    """Wall seconds per way of running (see the module doc), ``repeats`` each."""
+    ray = require("ray", "the Ray benchmark", extra="ray")
+    times: dict[str, list[float]] = {}
+    summaries: set[str] = set()
+    counter = iter(range(1_000_000))
+
+    def compare(name: str, **kwargs: Any) -> None:
+        out = work / f"run{next(counter)}"
+        seconds = _timed(
+            lambda: run_comparison(config, out, progress=progress, plots=False, **kwargs)
+        )
+        times.setdefault(name, []).append(seconds)
+        summaries.add((out / "summary.json").read_text())
+        print(f"  {name:<24} {seconds:7.2f} s", flush=True)
+
+    for repeat in range(repeats):
+        print(f"repeat {repeat + 1} of {repeats}", flush=True)
+        compare("local, 1 process", workers=1)
+        compare("local, 2 processes", workers=2)
+        compare("ray, new instance", executor="ray")
+        started = time.perf_counter()
+        ray.init(include_dashboard=False, log_to_driver=False)
+        times.setdefault("ray start-up (ray.init)", []).append(time.perf_counter() - started)
+        try:
+            compare("ray, running instance", executor="ray")
+            compare("ray, warm workers", executor="ray")
+        finally:
+            ray.shutdown()
+        ray.init(num_cpus=1, include_dashboard=False, log_to_driver=False)
+        try:
+            compare("ray, 1 CPU", executor="ray")
+            compare("ray, 1 CPU, warm", executor="ray")
+        finally:
+            ray.shutdown()
+    if len(summaries) != 1:
+        raise AssertionError("the runs gave different summaries")
+    return times
+
+
+def report(times: dict[str, list[float]], episodes: int) -> list[str]:
+    """The table: each way's time range, speed-up over one process, and Ray's overhead."""
+    base = min(times["local, 1 process"])
+    lines = [f"{'run':<26} {'wall s (min-max)':>18} {'speed-up vs 1 process':>22}"]
+    for name, values in times.items():
+        low, high = min(values), max(values)
+        speed = "" if name.startswith("ray start") else f"{base / high:.2f}-{base / low:.2f}x"
+        lines.append(f"{name:<26} {f'{low:.2f}-{high:.2f}':>18} {speed:>22}")
+    warm = times["ray, 1 CPU, warm"]
+    local = times["local, 1 process"]
+    per_episode = sorted(1000.0 * (w - l) / episodes for w in warm for l in local)
+    lines.append(
+        f"Ray's overhead per episode (1 CPU, warm, less 1 local process): "
+        f"{per_episode[0]:.2f} to {per_episode[-1]:.2f} ms over {len(per_episode)} pairs; "
+        f"an episode takes {1000.0 * min(local) / episodes:.2f}-"
+        f"{1000.0 * max(local) / episodes:.2f} ms in one local process"
+    )
+    return lines
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(
+        prog="bench_compare", description=__doc__.splitlines()[0] if __doc__ else None
+    )
+    parser.add_argument("--episodes", type=int, default=200, help="per policy (%(default)s)")
+    parser.add_argument("--policies", nargs="+", default=list(DEFAULT_POLICIES))
+    parser.add_argument("--repeats", type=int, default=2, help="(default %(default)s)")
+    parser.add_argument("--json", type=Path, default=Path("outputs/bench_compare.json"))
+    args = parser.parse_args(argv)
+    if args.episodes < 1 or args.repeats < 1:
+        parser.error("--episodes and --repeats must be >= 1")
+    config = CompareConfig(
+        policies=policies_from_specs(args.policies),
+        env_kwargs={"scenario": "khepera"},
+        episodes=args.episodes,
+        bootstrap=200,
+    )
+    total = args.episodes * len(config.policies)
+    print(f"{total} episodes ({args.episodes} x {', '.join(config.policies)}), Khepera")
+    with tempfile.TemporaryDirectory() as work:
+        times = bench(config, args.repeats, Path(work))
+    lines = report(times, total)
+    print("\n".join(lines))
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(
+        json.dumps(
+            {"episodes": total, "policies": config.policies, "seconds": times, "report": lines},
+            indent=1,
+        )
+        + "\n"
+    )
+    print(f"wrote {args.json}")
+
+
+if __name__ == "__main__":
+    main()
