@@ -6,16 +6,25 @@
 Runs one comparison (``--policies``, ``--episodes`` each, the Khepera scenario) in these
 ways, each ``--repeats`` times, and prints the wall times (min-max over the repeats):
 
-- ``local, 1 process``: ``--workers 1`` (the baseline of every speed-up);
-- ``local, 2 processes``: ``--workers 2``;
+- ``local, 1 process``: ``--workers 1``, in this process after an untimed first run
+  (so its env and policies are built: the episodes alone); the baseline of every
+  speed-up;
+- ``local, 2 processes``: ``--workers 2`` (new worker processes each time, as a user
+  runs it);
 - ``ray, new instance``: ``--executor ray`` as a user runs it on one machine: the wall
   time includes starting a local Ray instance (all cores) and its workers;
 - ``ray, running instance``: the same on a Ray instance started beforehand (its workers
   new: each builds its env and policies);
 - ``ray, warm workers``: that instance's second run (workers already built them);
-- ``ray, 1 CPU, warm``: a 1-CPU instance's second run. Its time less ``local, 1
-  process``, divided by the episodes, is the overhead of Ray per episode (scheduling,
-  serialising the task and its record, the object store), as one CPU runs both.
+- ``ray, 1 CPU, warm``: a 1-CPU instance's second run;
+- ``ray, 1 CPU, empty tasks``: as many tasks as episodes, submitted and collected as
+  ``--executor ray`` does, each sending an episode's task and returning a real
+  episode's record without playing it. Its time divided by the episodes is Ray's
+  overhead per episode (scheduling, serialising the task and the record, the object
+  store) on this machine.
+
+Speed-ups and the overhead are computed within each repeat (the machine's load drifts
+between repeats) and given as min-max over the repeats.
 
 Every run must give the same ``summary.json`` (checked). The JSON (``--json``, default
 ``outputs/bench_compare.json``) holds every time. The machine is shared: quote ranges.
@@ -31,11 +40,24 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.compare import CompareConfig, policies_from_specs, run_comparison
+from bearing_env.train.compare import (
+    LOG_NAME,
+    CompareConfig,
+    EpisodeLog,
+    EpisodeTask,
+    _pending_tasks,
+    policies_from_specs,
+    run_comparison,
+)
 
 from bearing_env.extras import require
 
 DEFAULT_POLICIES = ("random", "parallax", "greedy")
+
+
+def _echo(task: EpisodeTask, record: dict[str, Any]) -> dict[str, Any]:
+    """A Ray task that returns an episode's record without playing it."""
+    return {**record, "policy": task.label, "seed": task.seed}
 
 
 def _timed(run: Callable[[], Any]) -> float:
@@ -62,6 +84,11 @@ def bench(
         summaries.add((out / "summary.json").read_text())
         print(f"  {name:<24} {seconds:7.2f} s", flush=True)
 
+    # This process builds its env and policies once and keeps them (as a Ray worker
+    # does): an untimed first run, so that "local, 1 process" times the episodes alone.
+    run_comparison(config, work / "warm-up", progress=False, plots=False)
+    record = EpisodeLog(work / "warm-up" / LOG_NAME).load()[-1]
+    tasks = _pending_tasks(config, set())
     for repeat in range(repeats):
         print(f"repeat {repeat + 1} of {repeats}", flush=True)
         compare("local, 1 process", workers=1)
@@ -79,6 +106,17 @@ def bench(
         try:
             compare("ray, 1 CPU", executor="ray")
             compare("ray, 1 CPU, warm", executor="ray")
+            echo = ray.remote(num_cpus=1, max_retries=0)(_echo)
+
+            def empty_tasks(echo: Any = echo) -> None:
+                pending = [echo.remote(task, record) for task in tasks]
+                while pending:
+                    ready, pending = ray.wait(pending, num_returns=1)
+                    ray.get(ready[0])
+
+            seconds = _timed(empty_tasks)
+            times.setdefault("ray, 1 CPU, empty tasks", []).append(seconds)
+            print(f"  {'ray, 1 CPU, empty tasks':<24} {seconds:7.2f} s", flush=True)
         finally:
             ray.shutdown()
     if len(summaries) != 1:
@@ -87,21 +125,22 @@ def bench(
 
 
 def report(times: dict[str, list[float]], episodes: int) -> list[str]:
-    """The table: each way's time range, speed-up over one process, and Ray's overhead."""
-    base = min(times["local, 1 process"])
+    """The table: each way's time range and its speed-up over one local process in the
+    same repeat (min-max over the repeats), then Ray's overhead per episode."""
+    base = times["local, 1 process"]
     lines = [f"{'run':<26} {'wall s (min-max)':>18} {'speed-up vs 1 process':>22}"]
     for name, values in times.items():
         low, high = min(values), max(values)
-        speed = "" if name.startswith("ray start") else f"{base / high:.2f}-{base / low:.2f}x"
+        speed = ""
+        if not name.startswith("ray start") and "empty" not in name:
+            ratios = [one / value for one, value in zip(base, values, strict=True)]
+            speed = f"{min(ratios):.2f}-{max(ratios):.2f}x"
         lines.append(f"{name:<26} {f'{low:.2f}-{high:.2f}':>18} {speed:>22}")
-    warm = times["ray, 1 CPU, warm"]
-    local = times["local, 1 process"]
-    per_episode = sorted(1000.0 * (w - l) / episodes for w in warm for l in local)
+    empty = [1000.0 * value / episodes for value in times["ray, 1 CPU, empty tasks"]]
+    local = [1000.0 * value / episodes for value in base]
     lines.append(
-        f"Ray's overhead per episode (1 CPU, warm, less 1 local process): "
-        f"{per_episode[0]:.2f} to {per_episode[-1]:.2f} ms over {len(per_episode)} pairs; "
-        f"an episode takes {1000.0 * min(local) / episodes:.2f}-"
-        f"{1000.0 * max(local) / episodes:.2f} ms in one local process"
+        f"Ray's overhead per episode (1 CPU, empty tasks): {min(empty):.2f}-{max(empty):.2f} "
+        f"ms; an episode takes {min(local):.2f}-{max(local):.2f} ms in one local process"
     )
     return lines
 

@@ -360,3 +360,20 @@ def test_without_ray_the_commands_say_to_install_the_ray_extra(
     line = error_line(result, prog)
     assert "'ray'" in line and RAY in line
     assert not any(tmp_path.iterdir())  # nothing was written
+
+
+def test_the_ray_benchmark_reports_speed_ups_and_the_overhead_per_episode() -> None:
+    from bearing_env.benchmarks.bench_compare import report
+
+    times = {
+        "local, 1 process": [10.0, 12.0],
+        "local, 2 processes": [5.0, 8.0],
+        "ray start-up (ray.init)": [3.0, 4.0],
+        "ray, 1 CPU, empty tasks": [0.1, 0.3],
+    }
+    lines = report(times, episodes=100)
+    assert lines[1].split()[-2:] == ["10.00-12.00", "1.00-1.00x"]
+    assert lines[2].split()[-2:] == ["5.00-8.00", "1.50-2.00x"]  # 12/8 and 10/5, by repeat
+    assert lines[3].split()[-1] == "3.00-4.00"  # start-up: no speed-up column
+    assert "(1 CPU, empty tasks): 1.00-3.00 ms" in lines[-1]
+    assert "100.00-120.00 ms in one local process" in lines[-1]
