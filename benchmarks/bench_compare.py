@@ -128,14 +128,20 @@ def report(times: dict[str, list[float]], episodes: int) -> list[str]:
     """The table: each way's time range and its speed-up over one local process in the
     same repeat (min-max over the repeats), then Ray's overhead per episode."""
     base = times["local, 1 process"]
-    lines = [f"{'run':<26} {'wall s (min-max)':>18} {'speed-up vs 1 process':>22}"]
+    lines = [f"{'run':<26} {'wall s (min-max)':>18} {'vs 1 process':>14} {'vs 2 processes':>16}"]
+
+    def speed_up(name: str, over: str) -> str:
+        if over not in times or name.startswith("ray start") or "empty" in name:
+            return ""
+        ratios = [ref / value for ref, value in zip(times[over], times[name], strict=True)]
+        return f"{min(ratios):.2f}-{max(ratios):.2f}x"
+
     for name, values in times.items():
         low, high = min(values), max(values)
-        speed = ""
-        if not name.startswith("ray start") and "empty" not in name:
-            ratios = [one / value for one, value in zip(base, values, strict=True)]
-            speed = f"{min(ratios):.2f}-{max(ratios):.2f}x"
-        lines.append(f"{name:<26} {f'{low:.2f}-{high:.2f}':>18} {speed:>22}")
+        lines.append(
+            f"{name:<26} {f'{low:.2f}-{high:.2f}':>18} "
+            f"{speed_up(name, 'local, 1 process'):>14} {speed_up(name, 'local, 2 processes'):>16}"
+        )
     empty = [1000.0 * value / episodes for value in times["ray, 1 CPU, empty tasks"]]
     local = [1000.0 * value / episodes for value in base]
     lines.append(
