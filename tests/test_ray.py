@@ -29,6 +29,7 @@ from bearing_env.train.compare import (
     EpisodeLog,
     main,
     policies_from_specs,
+    reproducing_command,
     run_comparison,
 )
 from bearing_env.train.ray_executor import materialise, read_bundle, run_on_ray
@@ -224,6 +225,9 @@ def test_executor_options_are_checked(tmp_path: Path, capsys: pytest.CaptureFixt
         assert message in capsys.readouterr().err
     with pytest.raises(ValueError, match="executor must be one of"):
         compare(tmp_path, executor="dask")
+    # Where episodes run does not change the results: the report's command leaves it out.
+    argv = ["--executor", "ray", "--ray-address=HOST:6379", "--episodes", "3"]
+    assert reproducing_command(argv) == "bearing-env compare --episodes 3"
 
 
 def test_a_policy_files_travel_as_bytes_and_act_alike(tmp_path: Path) -> None:
