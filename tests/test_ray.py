@@ -291,6 +291,13 @@ def test_an_rllib_run_resumes_from_its_checkpoint(cluster: Any, tmp_path: Path) 
     assert second.complete and second.iterations == 2 and second.env_steps == 128
     lines = (tmp_path / PROGRESS_NAME).read_text().splitlines()
     assert [json.loads(line)["iteration"] for line in lines] == [1, 2]
+    segments = json.loads((tmp_path / "run.json").read_text())["segments"]
+    # the resumed segment's env runners start from other seeds than the first one's
+    assert segments == [
+        {"start_iteration": 0, "seed": settings.seed},
+        {"start_iteration": 1, "seed": settings.segment_seed(1)},
+    ]
+    assert settings.segment_seed(1) >= settings.seed + settings.seed_span
 
 
 def test_rllib_settings_name_bad_values() -> None:

@@ -11,10 +11,13 @@ of the id's batched vector env, ``gym.make_vec(..., vectorization_mode=
 "vector_entry_point")``). ``--env-kwargs`` go to the env; the hyperparameters not
 exposed as options keep RLlib's defaults.
 
-**Seeds.** ``--seed s`` seeds RLlib (``config.debugging(seed=s)``): env runner ``w``
-(1, 2, ...) first resets its sub-env ``i`` with seed ``s + w + i`` and runs on from there,
-so every training seed stays below ``bearing_env.train.compare.TRAINING_SEED_LIMIT``
-(the evaluation episodes of ``bearing-env compare`` start there).
+**Seeds.** ``--seed s`` seeds RLlib (``config.debugging(seed=...)``): env runner ``w``
+(1, 2, ...; 0 samples in the driver) first resets its sub-env ``i`` with seed
+``s' + w + i`` and runs on from there, where ``s' = s`` for a new run and
+``s' = segment_seed(s, k)`` for a run resumed at iteration ``k`` (so a resumed run does
+not replay the episodes it started with). Every training seed stays below
+``bearing_env.train.compare.TRAINING_SEED_LIMIT`` (the evaluation episodes of
+``bearing-env compare`` start there); ``run.json`` lists each segment's seed.
 
 **Run folder** (``--output``, default ``runs/rllib_ppo_<env>_seed<seed>``)::
 
@@ -112,6 +115,16 @@ class RLlibSettings:
             )
 
     @property
+    def seed_span(self) -> int:
+        """How many consecutive env seeds one seeding of the env runners uses."""
+        return self.num_env_runners + self.envs_per_runner + 1
+
+    def segment_seed(self, iteration: int) -> int:
+        """RLlib's seed for the segment that starts after ``iteration`` iterations."""
+        limit = TRAINING_SEED_LIMIT - self.seed_span
+        return (self.seed + iteration * self.seed_span) % limit
+
+    @property
     def gym_id(self) -> str:
         """The id as env runners make it: ``bearing_env:<id>`` imports the package there."""
         return f"bearing_env:{self.env_id.split(':')[-1]}"
@@ -121,8 +134,9 @@ class RLlibSettings:
         return {**plain, "env_id": self.gym_id}
 
 
-def ppo_config(settings: RLlibSettings) -> Any:
-    """The RLlib ``PPOConfig`` of a run (MissingExtraError without the ``ray`` extra)."""
+def ppo_config(settings: RLlibSettings, seed: int | None = None) -> Any:
+    """The RLlib ``PPOConfig`` of a run, seeded with ``seed`` (default the settings')
+    (MissingExtraError without the ``ray`` extra)."""
     ppo = require("ray.rllib.algorithms.ppo", "RLlib training", extra="ray")
     return (
         ppo.PPOConfig()
@@ -140,7 +154,7 @@ def ppo_config(settings: RLlibSettings) -> Any:
             lr=settings.lr,
             gamma=settings.gamma,
         )
-        .debugging(seed=settings.seed)
+        .debugging(seed=settings.seed if seed is None else seed)
     )
 
 
@@ -261,12 +275,14 @@ def train_rllib(
         record["status"] = status
         atomic_write_text(run_path, json.dumps(record, indent=1) + "\n")
 
+    segment_seed = settings.segment_seed(done)
+    record.setdefault("segments", []).append({"start_iteration": done, "seed": segment_seed})
     write_record("running")
     target = settings.iterations
     if stop_after is not None:
         target = min(target, done + max(0, stop_after))
     with ray_session(address) as _ray:
-        algo = ppo_config(settings).build_algo()
+        algo = ppo_config(settings, segment_seed).build_algo()
         try:
             if resume and checkpoint is not None:
                 algo.restore_from_path(str(checkpoint.resolve()))
