@@ -11,7 +11,7 @@ $(STAMP): pyproject.toml constraints.txt
 	$(PY) -m pip install --quiet --upgrade pip
 	# torch first, from the pin, so nothing later resolves a CUDA build
 	$(PY) -m pip install --quiet -c constraints.txt torch==2.13.0
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[render,train,dev]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[render,train,dev,ray]"
 	touch $(STAMP)
 
 test: $(STAMP)

@@ -18,7 +18,9 @@ Values are Python literals when they parse as one (``16``, ``0.25``, ``(0.1, 0.2
 from __future__ import annotations
 
 import ast
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
@@ -26,7 +28,13 @@ import gymnasium as gym
 from .base import Policy
 from .heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
 from .lookahead import Lookahead, LookaheadOracle
-from .sb3 import SB3Policy
+from .sb3 import (
+    PRETRAINED_DIR,
+    SB3Policy,
+    find_vecnormalize,
+    pretrained_names,
+    resolve_model_path,
+)
 
 
 def pretrained_policy(env: gym.Env, name: str, **options: Any) -> SB3Policy:
@@ -160,3 +168,69 @@ def make_policy(spec: str | PolicySpec, env: gym.Env) -> Policy:
         raise ValueError(f"bad options for policy {parsed.kind!r}: {error}") from error
     policy.name = parsed.display_name()
     return policy
+
+
+#: The options of a file-reading spec that name its files (see :func:`spec_files`).
+FILE_OPTIONS = ("path", "vecnormalize")
+
+
+def spec_files(spec: str | PolicySpec) -> dict[str, Path]:
+    """The files a policy spec reads, by the ``sb3`` option that names each: ``path``
+    (the model ``.zip``) and ``vecnormalize`` (its statistics, when it uses any). A
+    ``pretrained:NAME`` spec reads the shipped model's files; the heuristics read none.
+
+    With :func:`with_files` this lets a policy run where those paths do not exist (a
+    Ray worker on another machine): send the files' bytes, write them there, and build
+    the policy from the spec that names the copies.
+
+    Raises:
+        FileNotFoundError: the model, or an explicitly given statistics file, is missing.
+        ValueError: no shipped model has the ``pretrained`` name.
+    """
+    parsed = parse_policy_spec(spec) if isinstance(spec, str) else spec
+    if parsed.kind == "pretrained":
+        name = str(parsed.options["name"])
+        model = PRETRAINED_DIR / f"{name}.zip"
+        if not model.is_file():
+            raise ValueError(f"no pretrained model named {name!r}; available: {pretrained_names()}")
+        vecnormalize: Any = parsed.options.get("vecnormalize", "auto")
+    elif parsed.kind == "sb3":
+        model = resolve_model_path(parsed.options["path"])
+        vecnormalize = parsed.options.get("vecnormalize", "auto")
+    else:
+        return {}
+    files = {"path": model}
+    if vecnormalize == "auto":
+        found = find_vecnormalize(model)
+        if found is not None:
+            files["vecnormalize"] = found
+    elif vecnormalize is not None:
+        explicit = Path(str(vecnormalize)).expanduser()
+        if not explicit.is_file():
+            raise FileNotFoundError(f"VecNormalize statistics not found: {explicit}")
+        files["vecnormalize"] = explicit
+    return files
+
+
+def with_files(spec: str | PolicySpec, files: Mapping[str, str | Path]) -> PolicySpec:
+    """The spec of the same policy reading ``files`` (option -> path, as
+    :func:`spec_files` gives them) instead of its own: an ``sb3`` spec (a
+    ``pretrained:NAME`` spec becomes the ``sb3`` spec of copies of the shipped files, with
+    the same ``name``), whose ``vecnormalize`` is None when ``files`` holds none.
+
+    Raises:
+        ValueError: the spec reads no files, or ``files`` lacks the model (``path``) or
+            names an option other than :data:`FILE_OPTIONS`.
+    """
+    parsed = parse_policy_spec(spec) if isinstance(spec, str) else spec
+    if parsed.kind not in ("sb3", "pretrained"):
+        raise ValueError(f"policy {parsed.kind!r} reads no files, so none can replace them")
+    unknown = sorted(set(files) - set(FILE_OPTIONS))
+    if "path" not in files or unknown:
+        raise ValueError(
+            f"files must name the model ('path') and may name 'vecnormalize', got {sorted(files)}"
+        )
+    options = dict(parsed.options)  # a pretrained spec's name stays SB3Policy's name
+    options["path"] = str(files["path"])
+    options["vecnormalize"] = str(files["vecnormalize"]) if "vecnormalize" in files else None
+    return PolicySpec(kind="sb3", options=options, label=parsed.label or parsed.display_name())

@@ -2,7 +2,8 @@
 
 A plain ``pip install bearing_env`` gives the environments and the world model. Rendering
 needs the ``render`` extra (pygame); training, the shipped models, plots and rich tables
-need the ``train`` extra (stable-baselines3, torch, matplotlib, ...). A call that needs a
+need the ``train`` extra (stable-baselines3, torch, matplotlib, ...); running on a Ray
+cluster and RLlib training need the ``ray`` extra. A call that needs a
 missing extra raises :class:`MissingExtraError`, an ``ImportError`` whose message names
 the extra and the ``pip install`` line.
 """
@@ -27,6 +28,7 @@ MODULE_EXTRAS: dict[str, str] = {
     "tensorboard": "train",
     "yaml": "train",
     "rl_zoo3": "train",
+    "ray": "ray",
 }
 #: The pip distribution of a module, where its name differs.
 DISTRIBUTIONS: dict[str, str] = {

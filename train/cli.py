@@ -9,12 +9,14 @@
     bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
     bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (shipped rl-zoo3 files)
     bearing-env hyperparams ALGO  the path of a shipped rl-zoo3 hyperparameter file
+    bearing-env rllib [...]       PPO with RLlib, locally or on a Ray cluster (train/rllib.py)
+    bearing-env sweep [...]       a Ray Tune grid of RLlib PPO runs (train/sweep.py)
 
 Each subcommand forwards its remaining arguments to the module that implements it, so
 ``bearing-env demo --help`` shows that module's options. A subcommand that needs an
 optional extra that is not installed (``train``: stable-baselines3, torch, matplotlib, ...;
-``render``: pygame) says which one to install, ``pip install "bearing_env[train]"``, and
-exits with status 2.
+``render``: pygame; ``ray``: ray, RLlib, Ray Tune) says which one to install,
+``pip install "bearing_env[train]"``, and exits with status 2.
 """
 
 from __future__ import annotations
@@ -49,6 +51,14 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "compare": (
         "bearing_env.train.compare",
         "compare exploration policies on fixed evaluation episodes",
+    ),
+    "rllib": (
+        "bearing_env.train.rllib",
+        "train PPO with RLlib on this machine or a Ray cluster (the ray extra)",
+    ),
+    "sweep": (
+        "bearing_env.train.sweep",
+        "a Ray Tune grid of RLlib PPO runs over hyperparameters or env kwargs",
     ),
     "figures": (
         "bearing_env.train.figures",

@@ -74,12 +74,13 @@ from bearing_env.train.compare_config import (
 )
 from bearing_env.train.compare_log import LOG_NAME, CorruptLogError
 from bearing_env.train.compare_report import print_tables
-from bearing_env.train.compare_runner import make_env
+from bearing_env.train.compare_runner import EXECUTORS, executor_named, make_env
 from bearing_env.train.comparison import RunMismatchError, run_comparison
 from bearing_env.train.errors import (
     available,
     fail,
     missing_extra,
+    require,
     write_error_message,
 )
 from bearing_env.train.seeds import EVAL_SEED_START
@@ -135,6 +136,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--workers", type=int, default=1, help="processes to run episodes in (default %(default)s)"
+    )
+    parser.add_argument(
+        "--executor",
+        choices=EXECUTORS,
+        default="local",
+        help="local: this process, or --workers processes (default); ray: Ray tasks on a "
+        "local Ray instance or the cluster of --ray-address (the ray extra)",
+    )
+    parser.add_argument(
+        "--ray-address",
+        default=None,
+        metavar="ADDRESS",
+        help="with --executor ray: the running cluster to join (HOST:PORT, or auto)",
     )
     parser.add_argument(
         "--out",
@@ -242,7 +256,7 @@ def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
 #: the report quotes (a resumed run regenerates with the plain command).
 _PROCESS_ONLY_FLAGS = ("--resume", "--overwrite", "--no-progress")
 
-_PROCESS_ONLY_OPTIONS = ("--stop-after",)
+_PROCESS_ONLY_OPTIONS = ("--stop-after", "--executor", "--ray-address")
 
 
 def reproducing_command(argv: Sequence[str]) -> str:
@@ -264,7 +278,16 @@ def reproducing_command(argv: Sequence[str]) -> str:
 def main(argv: Sequence[str] | None = None) -> None:
     parser = build_parser()
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    if args.executor != "ray" and args.ray_address is not None:
+        parser.error("--ray-address needs --executor ray")
+    if args.executor == "ray" and args.workers != 1:
+        parser.error(
+            "--workers is for --executor local; Ray runs as many episodes as the cluster "
+            "has CPUs"
+        )
     try:
+        if args.executor == "ray":
+            require("ray", "--executor ray", extra="ray")
         config, out = config_from_args(args)
         # Fail fast on a bad env or policy spec, before any worker starts.
         from bearing_env.agents.registry import make_policy
@@ -292,6 +315,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             progress=not args.no_progress,
             plots=not args.no_plots,
             command=command,
+            executor=executor_named(args.executor, args.ray_address),
         )
     except FileExistsError as error:
         if error.errno is None:  # raised above: the folder holds a comparison already

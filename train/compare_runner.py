@@ -4,9 +4,11 @@ spawned worker processes.
 
 The boundary an executor keeps (:data:`EpisodeExecutor`): tasks in (already filtered to
 the ones not yet in the log, so a run resumes by passing the rest), finished records
-out, in task order (seed-major, as :func:`episode_tasks` orders them), so the log and
-every output are the same whatever runs them. :func:`run_locally` is that executor with
-``workers`` processes. It keeps at most ``2 * workers`` tasks in flight; records that
+out, in any order: the comparison sorts the records into task order (seed-major, as
+:func:`episode_tasks` orders them) before it writes its outputs, so they are the same
+whatever runs them. The Ray executor (:func:`executor_named`) yields each record as its
+episode finishes. :func:`run_locally` is the executor with ``workers`` processes. It
+keeps at most ``2 * workers`` tasks in flight and yields in task order; records that
 finish before an earlier one are held until it does, so an interruption loses at most
 ``2 * workers - 1`` finished episodes, which ``--resume`` runs again.
 
@@ -174,6 +176,28 @@ def _exit_with_parent(parent_pid: int) -> None:
 
 #: Runs tasks and yields their records in task order (see the module doc).
 EpisodeExecutor = Callable[[Sequence[EpisodeTask], int], Iterator[dict[str, Any]]]
+
+
+#: Where the episodes run: ``local`` (this process, or ``--workers`` processes) or ``ray``
+#: (Ray tasks, on a local Ray instance or a cluster; ``bearing_env.train.ray_executor``).
+EXECUTORS: tuple[str, ...] = ("local", "ray")
+
+
+def executor_named(name: str, ray_address: str | None = None) -> EpisodeExecutor:
+    """The :data:`EpisodeExecutor` of an :data:`EXECUTORS` name (``ray_address``: the Ray
+    cluster to join; default this process's Ray instance, or a new local one)."""
+    if name not in EXECUTORS:
+        raise ValueError(f"executor must be one of {EXECUTORS}, got {name!r}")
+    if name == "local":
+        if ray_address is not None:
+            raise ValueError("a Ray address needs the ray executor")
+        return run_locally
+    from bearing_env.train.ray_executor import run_on_ray
+
+    def on_ray(tasks: Sequence[EpisodeTask], workers: int) -> Iterator[dict[str, Any]]:
+        return run_on_ray(tasks, address=ray_address)  # Ray sizes itself: no workers
+
+    return on_ray
 
 
 def episode_tasks(config: CompareConfig, done: set[tuple[str, int]]) -> list[EpisodeTask]:

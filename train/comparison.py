@@ -108,7 +108,8 @@ def run_comparison(
         plots: write the PNG plots.
         command: the command line to quote in the report.
         executor: what runs the episodes (``compare_runner.EpisodeExecutor``): the local
-            worker pool by default, given ``workers``.
+            worker pool by default, given ``workers``; ``compare_runner.executor_named``
+            gives the Ray one.
     """
     out = Path(out)
     log = EpisodeLog(out / LOG_NAME)
@@ -141,6 +142,9 @@ def run_comparison(
             log.append(record)  # fsynced before the next one: a kill loses no logged episode
             records.append(record)
             bar.update()
+    # Task order (seed-major), whatever order the executor finished them in.
+    position = {(task.label, task.seed): i for i, task in enumerate(episode_tasks(config, set()))}
+    records.sort(key=lambda r: position.get((r["policy"], int(r["seed"])), len(position)))
 
     summary = summarise(records, config)
     wanted = {(label, seed) for label in config.policies for seed in config.seeds}

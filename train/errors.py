@@ -4,7 +4,8 @@
   file, a read-only file system) ends the command with ``<prog>: error: <path>: <reason>``
   and exit status :data:`EXIT_ERROR`.
 - A command or call that needs an optional extra that is not installed
-  (``render``: pygame; ``train``: stable-baselines3, torch, matplotlib, ...) raises
+  (``render``: pygame; ``train``: stable-baselines3, torch, matplotlib, ...; ``ray``:
+  Ray, RLlib, Ray Tune) raises
   :class:`~bearing_env.extras.MissingExtraError`, which names the extra and the
   ``pip install`` line; the command line prints it and exits with :data:`EXIT_ERROR`.
 """
