@@ -20,14 +20,24 @@ NEEDS_TRAIN_EXTRA = (
     "test_vec_env.py",
 )
 TRAIN_EXTRA_INSTALLED = available("stable_baselines3", "torch")
+#: Test modules that import the ``ray`` extra at the top.
+NEEDS_RAY_EXTRA = ("test_ray.py",)
+RAY_EXTRA_INSTALLED = available("ray")
 
-collect_ignore = [] if TRAIN_EXTRA_INSTALLED else list(NEEDS_TRAIN_EXTRA)
+collect_ignore = [
+    *([] if TRAIN_EXTRA_INSTALLED else NEEDS_TRAIN_EXTRA),
+    *([] if RAY_EXTRA_INSTALLED else NEEDS_RAY_EXTRA),
+]
 
 
 def pytest_report_header(config: pytest.Config) -> str | None:
-    if TRAIN_EXTRA_INSTALLED:
-        return None
-    return (
-        f"not collected, they need the train extra ({install_command('train')}): "
-        + " ".join(NEEDS_TRAIN_EXTRA)
-    )
+    lines = [
+        f"not collected, they need the {extra} extra ({install_command(extra)}): "
+        + " ".join(modules)
+        for extra, modules, installed in (
+            ("train", NEEDS_TRAIN_EXTRA, TRAIN_EXTRA_INSTALLED),
+            ("ray", NEEDS_RAY_EXTRA, RAY_EXTRA_INSTALLED),
+        )
+        if not installed
+    ]
+    return "\n".join(lines) or None

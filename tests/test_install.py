@@ -282,7 +282,7 @@ def test_demo_names_the_render_extra_without_a_traceback(
 def test_the_sdist_tests_import_against_the_installed_package(
     installed: dict[str, InstalledRun],
 ) -> None:
-    from tests.conftest import NEEDS_TRAIN_EXTRA
+    from tests.conftest import NEEDS_RAY_EXTRA, NEEDS_TRAIN_EXTRA
 
     result = installed["sdist"].results["collect"]
     assert result.returncode == 0, result.stdout[-5000:] + result.stderr[-2000:]
@@ -295,5 +295,5 @@ def test_the_sdist_tests_import_against_the_installed_package(
         if "::" in line
     }
     repository_tests = {p.name for p in (ROOT / "tests").glob("test_*.py")}
-    assert collected == repository_tests - set(NEEDS_TRAIN_EXTRA)
+    assert collected == repository_tests - set(NEEDS_TRAIN_EXTRA) - set(NEEDS_RAY_EXTRA)
     assert len(result.stdout.splitlines()) > 400

@@ -14,6 +14,8 @@ How each kind is checked, cheaply:
   not run (these are the long runs: 200-episode comparisons, 600k-step training);
 - ``run``: the command runs for real, with the extra arguments given (a smaller budget);
 - ``make``: ``make -n TARGET`` (a dry run) knows the target;
+- ``help``: the program's ``--help`` (with its subcommand) runs: Ray's own CLI, and the
+  long benchmark;
 - ``copy``: a ``cp`` of a comparison plot, whose destination folder is in the repository
   and whose source is written by a README ``compare`` command.
 """
@@ -98,6 +100,24 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env compare --policies greedy oracle lookahead lookahead_oracle --episodes 200 "
     "--workers 2 --out outputs/compare_lookahead": ("parse", ()),
     "bearing-env figures --only robust --out docs/figures": ("parse", ()),
+    "bearing-env compare --episodes 200 --executor ray": ("parse", ()),
+    "bearing-env compare --episodes 2000 --executor ray --ray-address auto "
+    "--out outputs/compare_2000": ("parse", ()),
+    "bearing-env rllib": ("parse", ()),
+    "bearing-env rllib --env BearingSLAM-v0 --iterations 50 --output runs/rllib_ppo": (
+        "parse",
+        (),
+    ),
+    "bearing-env rllib --num-env-runners 3 --iterations 100 --ray-address auto "
+    "--output runs/rllib_2node": ("parse", ()),
+    "bearing-env sweep": ("parse", ()),
+    "bearing-env sweep --grid lr=0.0001,0.0003 --env-grid scenario=khepera,random "
+    "--num-env-runners 0 --iterations 20 --out runs/sweep": ("parse", ()),
+    "python -m bearing_env.benchmarks.bench_compare": ("help", ()),
+    "ray start --head --port=6379": ("help", ()),
+    "ray start --address=A_IP:6379": ("help", ()),
+    "ray status": ("help", ()),
+    "ray stop": ("help", ()),
 }
 
 
@@ -187,6 +207,14 @@ def _parse(argv: list[str]) -> None:
 
         parser = bench_env.build_parser()
         bench_env.settings_from_args(parser.parse_args(arguments), parser)
+    elif command == "rllib":
+        from bearing_env.train import rllib
+
+        rllib.settings_from_args(rllib.build_parser().parse_args(arguments))
+    elif command == "sweep":
+        from bearing_env.train import sweep
+
+        sweep.build_parser().parse_args(arguments)
     else:
         pytest.fail(f"no parser check for bearing-env {command}")
 
@@ -209,6 +237,17 @@ def test_readme_command_runs_or_parses(command: str, tmp_path: Path) -> None:
         assert producers, f"no README compare command writes {source}"
     elif kind == "parse":
         _parse(argv + list(extra))
+    elif kind == "help":
+        # A command of another program (Ray's CLI) or a long benchmark: its --help runs,
+        # so the program and the subcommand exist.
+        if argv[0] == "python":
+            program = [sys.executable, *argv[1:3]]
+        else:
+            program = [str(BIN / argv[0]), argv[1]]
+        result = subprocess.run(
+            [*program, "--help"], capture_output=True, text=True, timeout=120
+        )
+        assert result.returncode == 0, result.stderr[-3000:]
     else:
         assert kind == "run"
         program = [str(BIN / "bearing-env")] if argv[0] == "bearing-env" else [sys.executable]
