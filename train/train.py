@@ -93,6 +93,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import torch
+from bearing_env.agents.sb3 import load_model, load_vecnormalize
 from bearing_env.train.callbacks import (
     Checkpoint,
     CheckpointStore,
@@ -128,8 +129,6 @@ from bearing_env.train.zoo import (
     DEFAULT_ENV_IDS,
     algorithm_class_for,
     hyperparams_key,
-    load_model,
-    load_vecnormalize,
     parse_hyperparameters,
     read_hyperparameters,
 )
