@@ -12,7 +12,13 @@ import pytest
 from bearing_env.extras import available, install_command
 
 #: Test modules that import the ``train`` extra (torch, stable-baselines3) at the top.
-NEEDS_TRAIN_EXTRA = ("test_bench.py", "test_lost_work.py", "test_train.py", "test_vec_env.py")
+NEEDS_TRAIN_EXTRA = (
+    "test_bench.py",
+    "test_extractors.py",
+    "test_lost_work.py",
+    "test_train.py",
+    "test_vec_env.py",
+)
 TRAIN_EXTRA_INSTALLED = available("stable_baselines3", "torch")
 
 collect_ignore = [] if TRAIN_EXTRA_INSTALLED else list(NEEDS_TRAIN_EXTRA)
