@@ -30,6 +30,7 @@ import torch
 import yaml
 from bearing_env.agents import SB3Policy
 from bearing_env.agents.sb3 import ModelLoadError, load_model, load_vecnormalize
+from bearing_env.train import train_cli
 from bearing_env.train.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
 from bearing_env.train.cli_values import parse_key_values
 from bearing_env.train.export import export_run
@@ -40,11 +41,11 @@ from bearing_env.train.seeds import (
     training_seed_start,
 )
 from bearing_env.train.train import (
-    EXIT_INTERRUPTED,
     TrainResult,
     TrainSettings,
     train,
 )
+from bearing_env.train.train_cli import EXIT_INTERRUPTED
 from bearing_env.train.training_envs import EnvFactory, EpisodeSeedCycle, make_validation_env
 from bearing_env.train.zoo import (
     DEFAULT_ENV_IDS,
@@ -367,7 +368,7 @@ def test_cli_reports_errors_without_a_traceback(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     with pytest.raises(SystemExit) as exit_info:
-        train_module.main(["--algo", "ppo", "--output", str(tmp_path / "none"), "--resume"])
+        train_cli.main(["--algo", "ppo", "--output", str(tmp_path / "none"), "--resume"])
     assert exit_info.value.code == 2
     assert "no run to resume" in capsys.readouterr().err
 
@@ -380,7 +381,7 @@ def test_an_export_that_cannot_be_written_fails_in_one_line(
     destination = blocker / "pretrained" / "ppo_tiny"
     run = tiny_runs["ppo"].run_dir
     with pytest.raises(SystemExit) as exit_info:
-        train_module.main(
+        train_cli.main(
             ["--algo", "ppo", "--output", str(run), "--export", str(destination), "--export-only"]
         )
     assert exit_info.value.code == 2
@@ -655,7 +656,7 @@ def test_env_factory_raises_the_time_limit_with_max_moves() -> None:
 def test_train_is_a_bearing_env_subcommand() -> None:
     from bearing_env.train.cli import SUBCOMMANDS
 
-    assert SUBCOMMANDS["train"][0] == "bearing_env.train.train"
+    assert SUBCOMMANDS["train"][0] == "bearing_env.train.train_cli"
 
 
 def test_checkpoints_keep_sb3_checkpoint_callback_names(tmp_path: Path) -> None:
