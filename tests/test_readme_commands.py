@@ -84,6 +84,20 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--episodes 50": ("parse", ()),
     "python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 "
     '--conf-file "$(bearing-env hyperparams ppo)"': ("parse", ()),
+    "python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 "
+    '--conf-file "$(bearing-env hyperparams ppo_entities)"': ("parse", ()),
+    'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_entities)" '
+    "--output runs/ppo_entities": ("parse", ()),
+    'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_entities)" '
+    "--timesteps 300000 --seed 0 --output runs/ppo_entities_pilot --eval-freq 25000 "
+    "--eval-episodes 50": ("parse", ()),
+    "bearing-env compare --policies greedy "
+    "sb3:path=runs/ppo_entities_pilot/best/best_model.zip --env-kwargs scenario=random "
+    "n_landmarks=8 max_landmarks=16 observation=entities --episodes 60 "
+    "--out outputs/compare_entities8": ("parse", ()),
+    "bearing-env compare --policies greedy oracle lookahead lookahead_oracle --episodes 200 "
+    "--workers 2 --out outputs/compare_lookahead": ("parse", ()),
+    "bearing-env figures --only robust --out docs/figures": ("parse", ()),
 }
 
 
@@ -136,10 +150,11 @@ def _parse(argv: list[str]) -> None:
 
         assert callable(rl_zoo3_module("rl_zoo3.train").train)
         conf = rest.index("--conf-file") + 1
-        assert rest[conf] == "$(bearing-env hyperparams ppo)"
+        shipped = re.fullmatch(r"\$\(bearing-env hyperparams (\w+)\)", rest[conf])
+        assert shipped is not None, rest[conf]
         from bearing_env.train.conf_files import default_conf_file
 
-        assert default_conf_file("ppo").is_file()
+        assert default_conf_file(shipped.group(1)).is_file()
         return
     if program == "python":
         assert rest[:2] == ["-m", "bearing_env.train.generalisation"]
