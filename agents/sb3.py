@@ -1,8 +1,12 @@
-"""Trained stable-baselines3 agents as policies.
+"""Trained stable-baselines3 agents as policies, and the one place saved models and
+VecNormalize statistics are loaded.
 
 :class:`SB3Policy` loads a saved model (``model.save(path)``, a ``.zip``) and, if there is
 one, the ``VecNormalize`` statistics saved beside it, and applies them to observations
 exactly as training did (``training=False``: the statistics are frozen).
+:func:`load_model` and :func:`load_vecnormalize` are what it loads them with, and what
+``bearing-env train`` (resume, export) uses too: a missing file is a
+``FileNotFoundError``, an unusable one a :class:`ModelLoadError`, each naming the path.
 """
 
 from __future__ import annotations
@@ -133,7 +137,8 @@ def infer_algorithm(model_path: Path) -> str:
     )
 
 
-def _algorithm_class(name: str) -> Any:
+def _algorithm_class(name: str) -> tuple[str, Any]:
+    """The canonical name (``"PPO"``) and the class of an algorithm, by any-case name."""
     key = {k.lower(): k for k in _ALGORITHM_MODULES}.get(name.lower())
     if key is None:
         raise ValueError(
@@ -142,7 +147,77 @@ def _algorithm_class(name: str) -> Any:
     module_name = _ALGORITHM_MODULES[key]
     extra = "train" if module_name == "stable_baselines3" else None  # sb3_contrib: no extra
     module = require(module_name, f"a {key} model", extra=extra)
-    return getattr(module, key)
+    return key, getattr(module, key)
+
+
+def load_model(
+    path: str | Path,
+    algo: str | None = None,
+    env: Any = None,
+    device: str = "cpu",
+    **kwargs: Any,
+) -> Any:
+    """Load a saved SB3 model (``<Algorithm>.load``; ``kwargs`` go to it).
+
+    Args:
+        path: as :func:`resolve_model_path` takes it (``.zip`` optional, or a directory).
+        algo: ``"PPO"``, ``"ppo"``, ``"SAC"``, ...; default inferred from the archive.
+        env: the (vector) env to attach, as SB3's ``load`` takes it.
+
+    Raises:
+        FileNotFoundError: nothing to load at ``path``.
+        ModelLoadError (a ValueError): the file is not a loadable ``algo`` model (corrupt,
+            truncated, another algorithm, or spaces that do not fit ``env``); the message
+            names the path.
+    """
+    model_path = resolve_model_path(path)
+    if not zipfile.is_zipfile(model_path):
+        raise ModelLoadError(f"{model_path} is not a stable-baselines3 model archive (no zip)")
+    name, algorithm_class = _algorithm_class(
+        algo if algo is not None else infer_algorithm(model_path)
+    )
+    try:
+        return algorithm_class.load(str(model_path), env=env, device=device, **kwargs)
+    except Exception as error:  # SB3 raises many kinds on damaged or foreign archives
+        raise ModelLoadError(
+            f"could not load {name} model {model_path}: {type(error).__name__}: {error}"
+        ) from error
+
+
+def load_vecnormalize(path: str | Path, venv: Any = None) -> Any:
+    """Saved ``VecNormalize`` statistics, as ``VecNormalize.load(path, venv)`` gives them.
+
+    With ``venv`` the statistics wrap it and keep their saved ``training`` flags (to go on
+    training); without, they are frozen (``training=False``, ``norm_reward=False``) for
+    :meth:`~VecNormalize.normalize_obs` alone.
+
+    Raises:
+        FileNotFoundError: no file at ``path``.
+        ModelLoadError (a ValueError): the file is not VecNormalize statistics (truncated,
+            foreign pickle); the message names the path.
+    """
+    stats_path = Path(path).expanduser()
+    if not stats_path.is_file():
+        raise FileNotFoundError(f"VecNormalize statistics not found: {stats_path}")
+    vec_env = require("stable_baselines3.common.vec_env", "VecNormalize statistics", "train")
+    try:
+        with open(stats_path, "rb") as handle:
+            normalizer = pickle.load(handle)
+    except Exception as error:  # a truncated or foreign pickle raises many kinds
+        raise ModelLoadError(
+            f"could not load VecNormalize statistics {stats_path}: "
+            f"{type(error).__name__}: {error}"
+        ) from error
+    if not isinstance(normalizer, vec_env.VecNormalize):
+        raise ModelLoadError(
+            f"{stats_path} holds a {type(normalizer).__name__}, not VecNormalize statistics"
+        )
+    if venv is None:
+        normalizer.training = False
+        normalizer.norm_reward = False
+    else:
+        normalizer.set_venv(venv)
+    return normalizer
 
 
 def _spaces_match(model_space: spaces.Space[Any], env_space: spaces.Space[Any]) -> bool:
@@ -188,15 +263,10 @@ class SB3Policy:
         name: str | None = None,
     ) -> None:
         self.model_path = resolve_model_path(path)
-        self.algo = algo if algo is not None else infer_algorithm(self.model_path)
-        algorithm_class = _algorithm_class(self.algo)
-        try:
-            self.model = algorithm_class.load(str(self.model_path), device=device)
-        except Exception as error:  # SB3 raises many kinds on a damaged archive.
-            raise ModelLoadError(
-                f"could not load {self.algo} model {self.model_path}: "
-                f"{type(error).__name__}: {error}"
-            ) from error
+        self.algo, _ = _algorithm_class(
+            algo if algo is not None else infer_algorithm(self.model_path)
+        )
+        self.model = load_model(self.model_path, self.algo, device=device)
         if not _spaces_match(self.model.observation_space, env.observation_space):
             raise ModelLoadError(
                 f"model {self.model_path} expects observations {self.model.observation_space}, "
@@ -209,7 +279,7 @@ class SB3Policy:
             )
         self.vecnormalize_path = self._resolve_vecnormalize(vecnormalize)
         self.obs_normalizer = (
-            None if self.vecnormalize_path is None else _load_vecnormalize(self.vecnormalize_path)
+            None if self.vecnormalize_path is None else load_vecnormalize(self.vecnormalize_path)
         )
         self.deterministic = bool(deterministic)
         self.discrete = isinstance(env.action_space, spaces.Discrete)
@@ -236,10 +306,7 @@ class SB3Policy:
             return None
         if isinstance(vecnormalize, str) and vecnormalize == "auto":
             return find_vecnormalize(self.model_path)
-        explicit = Path(vecnormalize).expanduser()
-        if not explicit.is_file():
-            raise FileNotFoundError(f"VecNormalize statistics not found: {explicit}")
-        return explicit
+        return Path(vecnormalize).expanduser()  # load_vecnormalize: it must exist
 
     def reset(self, seed: int | None = None) -> None:
         if seed is not None:
@@ -266,23 +333,3 @@ class SB3Policy:
     def __repr__(self) -> str:
         return f"SB3Policy(name={self.name!r}, path={str(self.model_path)!r})"
 
-
-def _load_vecnormalize(path: Path) -> Any:
-    """Unpickle VecNormalize statistics (as ``VecNormalize.load`` does, without a venv)."""
-    vec_env = require("stable_baselines3.common.vec_env", "VecNormalize statistics", "train")
-    VecNormalize = vec_env.VecNormalize
-
-    try:
-        with open(path, "rb") as handle:
-            normalizer = pickle.load(handle)
-    except Exception as error:  # a truncated or foreign pickle raises many kinds
-        raise ModelLoadError(
-            f"could not load VecNormalize statistics {path}: {type(error).__name__}: {error}"
-        ) from error
-    if not isinstance(normalizer, VecNormalize):
-        raise ModelLoadError(
-            f"{path} holds a {type(normalizer).__name__}, not VecNormalize statistics"
-        )
-    normalizer.training = False
-    normalizer.norm_reward = False
-    return normalizer

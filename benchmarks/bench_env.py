@@ -48,10 +48,6 @@ Sections:
   SubprocVecEnv the median of the per-round ratios, so that a machine whose speed drifts
   during the run favours no kind.
 
-When the batched pieces are missing (no ``vector_entry_point`` on the spec, or no
-``"batched"`` in ``bearing_env.train.training_envs.VEC_ENV_KINDS``), the rows fall back
-to ``sync`` and ``dummy`` and are labelled as fallbacks; the targets that depend on them say so.
-
 Targets (printed as met / not met and stored in the JSON):
 
 a. single env, Khepera scenario: >= 10% of CartPole-v1's step rate;
@@ -100,7 +96,6 @@ from bearing_env.benchmarks.bench_timing import (
     bench_slam_updates,
     bench_startup,
     bench_vector,
-    has_vector_entry_point,
     log,
     profile,
 )
@@ -331,7 +326,6 @@ def run(settings: Settings) -> dict[str, Any]:
             "ppo_kinds": list(settings.ppo_kinds),
             "ppo_overrides": json_safe(settings.ppo_overrides),
             "quick": settings.quick,
-            "vector_entry_point": has_vector_entry_point(),
         },
         "cartpole_references": [
             {"label": ref.label, "steps_per_s": ref.steps_per_s, "time_s": ref.time_s}

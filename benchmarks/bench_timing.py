@@ -281,10 +281,6 @@ def bench_planning(episodes: int) -> dict[str, Any]:
 # --------------------------------------------------------------------------------------
 
 
-def has_vector_entry_point(env_id: str = ENV_ID) -> bool:
-    return gym.spec(env_id).vector_entry_point is not None
-
-
 def make_vector_env(num_envs: int, mode: str, env_kwargs: dict[str, Any]) -> gym.vector.VectorEnv:
     return gym.make_vec(ENV_ID, num_envs=num_envs, vectorization_mode=mode, **env_kwargs)
 
@@ -339,12 +335,8 @@ def bench_vector(
     bench: Bench, num_envs_list: Sequence[int], env_kwargs: dict[str, Any]
 ) -> list[dict[str, Any]]:
     bench.measure_reference("vector")
-    batched_mode = "vector_entry_point" if has_vector_entry_point() else "sync"
-    fallback = batched_mode != "vector_entry_point"
-    if fallback:
-        log(f"  {ENV_ID} has no vector_entry_point: the batched rows use sync (fallback)")
     rows: list[dict[str, Any]] = []
-    for kind, mode in (("batched", batched_mode), ("sync", "sync")):
+    for kind, mode in (("batched", "vector_entry_point"), ("sync", "sync")):
         for num_envs in num_envs_list:
             build_start = time.perf_counter()
             venv = make_vector_env(num_envs, mode, env_kwargs)
@@ -361,7 +353,6 @@ def bench_vector(
             row = {
                 "kind": kind,
                 "vectorization_mode": mode,
-                "fallback": kind == "batched" and fallback,
                 "num_envs": num_envs,
                 "env_kwargs": env_kwargs,
                 "step_calls": calls,
@@ -381,20 +372,12 @@ def bench_vector(
 
 
 def vector_label(row: dict[str, Any]) -> str:
-    if row["kind"] == "sync":
-        return "sync (baseline)"
-    return "sync (fallback)" if row["fallback"] else "batched"
+    return "sync (baseline)" if row["kind"] == "sync" else "batched"
 
 
 # --------------------------------------------------------------------------------------
 # PPO
 # --------------------------------------------------------------------------------------
-
-
-def available_vec_env_kinds() -> tuple[str, ...]:
-    from bearing_env.train.training_envs import VEC_ENV_KINDS
-
-    return tuple(VEC_ENV_KINDS)
 
 
 def ppo_settings(
@@ -427,7 +410,6 @@ class PPORun:
     """One vec env kind's PPO model, built and warmed up, ready for timed rounds."""
 
     kind: str
-    measured_with: str
     model: Any
     venv: Any
     n_envs: int
@@ -461,8 +443,6 @@ class PPORun:
         rate = float(np.median(rates))
         return {
             "kind": self.kind,
-            "measured_with": self.measured_with,
-            "fallback": self.measured_with != self.kind,
             "n_envs": self.n_envs,
             "rollout_steps": int(self.algorithm_kwargs.get("n_steps", 2048)) * self.n_envs,
             "requested_steps": self.total_steps,
@@ -496,11 +476,9 @@ def build_ppo_run(
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
 
-    available = available_vec_env_kinds()
-    measured_with = kind if kind in available else "dummy"
     algorithm_kwargs, normalize, make_kwargs = ppo_settings(env_kwargs, overrides)
     build_start = time.perf_counter()
-    venv = make_training_env(ENV_ID, make_kwargs, n_envs, measured_with, None)
+    venv = make_training_env(ENV_ID, make_kwargs, n_envs, kind, None)
     try:
         if normalize is not None:
             venv = VecNormalize(venv, **normalize)
@@ -512,7 +490,6 @@ def build_ppo_run(
         raise
     run = PPORun(
         kind,
-        measured_with,
         model,
         venv,
         n_envs,
@@ -541,11 +518,6 @@ def bench_ppo(
     turn, so that a drifting machine speed affects all kinds alike. A kind's rate is its
     median round, and its ratio to SubprocVecEnv is the median of the per-round ratios.
     """
-    if "batched" in kinds and "batched" not in available_vec_env_kinds():
-        log(
-            "  bearing_env.train.training_envs.VEC_ENV_KINDS has no 'batched':"
-            " that row uses dummy (fallback)"
-        )
     runs: list[PPORun] = []
     try:
         with torch_threads(1):  # as bearing-env train (--torch-threads 1)
@@ -584,8 +556,6 @@ def bench_ppo(
 
 
 def ppo_label(row: dict[str, Any]) -> str:
-    if row["fallback"]:
-        return f"{row['measured_with']} (fallback for {row['kind']})"
     return row["kind"] + (" (spawn)" if row["kind"] == "subproc" else "")
 
 
@@ -603,9 +573,8 @@ def profile(section: str, seconds: float, num_envs: int, env_kwargs: dict[str, A
         def loop() -> None:
             run_single_env(env, seconds)
     else:
-        mode = "vector_entry_point" if has_vector_entry_point() else "sync"
-        env = make_vector_env(num_envs, mode, env_kwargs)
-        what = f"vector env ({mode}), {num_envs} envs, {env_kwargs}"
+        env = make_vector_env(num_envs, "vector_entry_point", env_kwargs)
+        what = f"vector env (batched), {num_envs} envs, {env_kwargs}"
 
         def loop() -> None:
             run_vector_env(env, seconds)

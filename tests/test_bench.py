@@ -9,8 +9,6 @@ import sys
 from pathlib import Path
 from typing import Any
 
-import bearing_env.train.train
-import bearing_env.train.training_envs
 import gymnasium as gym
 import pytest
 from bearing_env.benchmarks import bench_env, bench_report, bench_timing
@@ -85,9 +83,11 @@ def test_quick_single_and_vector(tmp_path: Path, capsys: pytest.CaptureFixture[s
         assert row["step_calls"] >= 2
         if row["kind"] == "batched":
             assert positive_finite(row["ratio_to_sync"])
-            expected = "vector_entry_point" if row["fallback"] is False else "sync"
-            assert row["vectorization_mode"] == expected
+            assert row["vectorization_mode"] == "vector_entry_point"
     targets = {target["id"]: target for target in results["targets"]}
+    # The batched env always exists: no row or target says what it fell back to.
+    for row in [*vector, *results["single"], *results["targets"]]:
+        assert "fallback" not in row and "measured_with" not in row
     assert targets["a"]["met"] is not None and targets["c"]["met"] is not None
     assert targets["b"]["met"] is None  # --quick measures 1 and 4 envs, not 64
     assert targets["d"]["met"] is None
@@ -120,7 +120,7 @@ def test_quick_ppo_subproc(tmp_path: Path) -> None:
         tmp_path, "--sections", "ppo", "--ppo-kinds", "subproc", "--ppo-envs", "1"
     )
     (row,) = results["ppo"]
-    assert row["kind"] == row["measured_with"] == "subproc"
+    assert row["kind"] == "subproc" and "fallback" not in row
     check_figure(row, {ref["label"] for ref in results["cartpole_references"]})
     assert row["ratio_to_subproc"] == pytest.approx(1.0)
 
@@ -131,34 +131,17 @@ def stand_in_vector_env(num_envs: int, max_episode_steps: int, **env_kwargs: Any
     return gym.vector.SyncVectorEnv(factories, autoreset_mode=AutoresetMode.SAME_STEP)
 
 
-def test_batched_rows_are_not_fallbacks_when_available(
+def test_batched_rows_in_same_step_mode_count_every_sub_step(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """With a vector entry point and a "batched" vec env kind, nothing is labelled fallback."""
+    """The vector rows count transitions by the env's autoreset mode."""
     monkeypatch.setattr(gym.spec(bench_timing.ENV_ID), "vector_entry_point", stand_in_vector_env)
-    kinds = tuple(dict.fromkeys((*bearing_env.train.training_envs.VEC_ENV_KINDS, "batched")))
-    monkeypatch.setattr(bearing_env.train.training_envs, "VEC_ENV_KINDS", kinds)
-    make_training_env = bearing_env.train.training_envs.make_training_env
-
-    def make_with_batched(
-        env_id: str, env_kwargs: dict[str, Any], n_envs: int, kind: str, monitor_dir: Path | None
-    ) -> Any:
-        return make_training_env(
-            env_id, env_kwargs, n_envs, "dummy" if kind == "batched" else kind, monitor_dir
-        )
-
-    monkeypatch.setattr(bearing_env.train.training_envs, "make_training_env", make_with_batched)
-    results, _ = run_quick(
-        tmp_path, "--sections", "vector,ppo", "--num-envs", "2", "--ppo-kinds", "batched"
-    )
+    results, _ = run_quick(tmp_path, "--sections", "vector", "--num-envs", "2")
     (batched, sync) = results["vector"]
     assert batched["kind"] == "batched" and batched["vectorization_mode"] == "vector_entry_point"
-    assert batched["fallback"] is False and batched["autoreset_mode"] == "SameStep"
+    assert batched["autoreset_mode"] == "SameStep"
     assert sync["autoreset_mode"] == "NextStep"
     assert batched["steps"] == 2 * batched["step_calls"]  # SAME_STEP: every sub-step counts
-    (ppo,) = results["ppo"]
-    assert ppo["measured_with"] == "batched" and ppo["fallback"] is False
-    assert results["settings"]["vector_entry_point"] is True
 
 
 def fake_figure(rate: float, **extra: Any) -> dict[str, Any]:
@@ -172,18 +155,14 @@ def test_targets_from_results() -> None:
             fake_figure(400.0, name="random_4"),
             fake_figure(20.0, name="random_64"),
         ],
-        "vector": [fake_figure(1500.0, kind="batched", num_envs=64, fallback=False)],
-        "ppo": [
-            fake_figure(300.0, kind="batched", fallback=True),
-            fake_figure(100.0, kind="subproc", fallback=False),
-        ],
+        "vector": [fake_figure(1500.0, kind="batched", num_envs=64)],
+        "ppo": [fake_figure(300.0, kind="batched"), fake_figure(100.0, kind="subproc")],
     }
     targets = {target["id"]: target for target in bench_report.evaluate_targets(results)}
     assert targets["a"]["met"] is True and targets["a"]["value"] == pytest.approx(0.2)
-    assert targets["b"]["met"] is True and targets["b"]["fallback"] is False
+    assert targets["b"]["met"] is True and targets["b"]["note"] is None
     assert targets["c"]["met"] is False and targets["c"]["value"] == pytest.approx(0.05)
-    assert targets["d"]["met"] is True and targets["d"]["fallback"] is True
-    assert "fallback" in targets["d"]["note"]
+    assert targets["d"]["met"] is True and targets["d"]["value"] == pytest.approx(3.0)
     assert all(target["met"] is None for target in bench_report.evaluate_targets({}))
 
 

@@ -216,7 +216,7 @@ def test_train_on_a_full_disk_names_the_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     pytest.importorskip("stable_baselines3")
-    from bearing_env.train import train as train_module
+    from bearing_env.train import train_cli
 
     def disk_full(fd: int) -> None:  # the atomic writers fsync their temporary files
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
@@ -224,7 +224,7 @@ def test_train_on_a_full_disk_names_the_file(
     monkeypatch.setattr(os, "fsync", disk_full)
     run = tmp_path / "run"
     with pytest.raises(SystemExit) as exit_info:
-        train_module.main([*TRAIN_ARGS, "--output", str(run)])
+        train_cli.main([*TRAIN_ARGS, "--output", str(run)])
     assert exit_info.value.code == EXIT_ERROR
     line = one_line_error(capsys.readouterr().err, "bearing-env train")
     assert str(run / "run.json") in line and "No space left on device" in line

@@ -20,8 +20,11 @@ from typing import Any
 
 import bearing_env.train.train as train_module
 import pytest
+from bearing_env.agents.sb3 import load_model
+from bearing_env.train import train_cli
 from bearing_env.train.callbacks import CheckpointStore, StopOnRequestCallback
-from bearing_env.train.train import TrainSettings, load_model, train
+from bearing_env.train.run_record import segments_after_a_kill
+from bearing_env.train.train import TrainSettings, train
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 PYTHON = sys.executable
@@ -120,7 +123,7 @@ def test_sigkill_then_resume_gives_the_uninterrupted_counts(
     assert left["num_timesteps"] in (last.timesteps, last.timesteps - CHECKPOINT_FREQ)
     assert left["segments"][-1]["status"] == "running"
 
-    train_module.main(["train", *cli_arguments(run, "--resume")][1:])
+    train_cli.main(["train", *cli_arguments(run, "--resume")][1:])
 
     assert counts(run / "model.zip") == uninterrupted == (63, 1008)
     record = json.loads((run / "run.json").read_text())
@@ -164,12 +167,12 @@ def test_an_old_record_left_running_gets_its_killed_segment() -> None:
 
     old = {"status": "running", "n_envs": 2, "vec_env": "dummy", "segments": []}
     at = Checkpoint(48, Path("m"), Path("v"), Path("r"))
-    segments = train_module._segments_after_a_kill(old, at)
+    segments = segments_after_a_kill(old, at)
     assert segments == [
         {"start_timesteps": 0, "end_timesteps": 48, "n_envs": 2, "vec_env": "dummy",
          "status": "killed"}
     ]  # fmt: skip
-    assert train_module._segments_after_a_kill({**old, "status": "finished"}, at) == []
+    assert segments_after_a_kill({**old, "status": "finished"}, at) == []
 
 
 DQN_HYPERPARAMS = {

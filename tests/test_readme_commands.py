@@ -195,9 +195,9 @@ def _parse(argv: list[str]) -> None:
 
         compare.config_from_args(compare.build_parser().parse_args(arguments))
     elif command == "train":
-        from bearing_env.train import train
+        from bearing_env.train import train_cli
 
-        train.settings_from_args(train.build_parser().parse_args(arguments))
+        train_cli.settings_from_args(train_cli.build_parser().parse_args(arguments))
     elif command == "figures":
         from bearing_env.train import figures
 

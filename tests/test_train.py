@@ -29,6 +29,8 @@ import pytest
 import torch
 import yaml
 from bearing_env.agents import SB3Policy
+from bearing_env.agents.sb3 import ModelLoadError, load_model, load_vecnormalize
+from bearing_env.train import train_cli
 from bearing_env.train.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
 from bearing_env.train.cli_values import parse_key_values
 from bearing_env.train.export import export_run
@@ -39,17 +41,15 @@ from bearing_env.train.seeds import (
     training_seed_start,
 )
 from bearing_env.train.train import (
-    EXIT_INTERRUPTED,
     TrainResult,
     TrainSettings,
     train,
 )
+from bearing_env.train.train_cli import EXIT_INTERRUPTED
 from bearing_env.train.training_envs import EnvFactory, EpisodeSeedCycle, make_validation_env
 from bearing_env.train.zoo import (
     DEFAULT_ENV_IDS,
     algorithm_class_for,
-    load_model,
-    load_vecnormalize,
     parse_hyperparameters,
     read_hyperparameters,
     rl_zoo3_module,
@@ -172,6 +172,10 @@ def test_saved_model_and_statistics_predict_like_the_trained_model(
     loaded_normalizer = load_vecnormalize(result.run_dir / "vecnormalize.pkl", eval_venv)
     actual, _ = loaded.predict(loaded_normalizer.normalize_obs(raw), deterministic=True)
     eval_venv.close()
+    # Without a venv (as SB3Policy loads them) the same statistics, frozen.
+    frozen = load_vecnormalize(result.run_dir / "vecnormalize.pkl")
+    assert not frozen.training and not frozen.norm_reward
+    np.testing.assert_array_equal(frozen.normalize_obs(raw), loaded_normalizer.normalize_obs(raw))
     np.testing.assert_array_equal(actual, expected)
     assert loaded.num_timesteps == TINY_TIMESTEPS
 
@@ -334,7 +338,8 @@ def test_corrupt_model_file_names_the_path(
     else:
         with zipfile.ZipFile(path, "w") as archive:
             archive.writestr("hello.txt", "a zip, but not a stable-baselines3 model")
-    with pytest.raises(ValueError, match=re.escape(str(path))):
+    # The loader SB3Policy uses: the same named error for training and acting.
+    with pytest.raises(ModelLoadError, match=re.escape(str(path))):
         load_model(path, "ppo")
 
 
@@ -344,7 +349,7 @@ def test_corrupt_statistics_and_checkpoint_name_the_path(
     stats = tmp_path / "vecnormalize.pkl"
     stats.write_bytes(b"\x80\x04 truncated pickle")
     venv = make_validation_env("BearingSLAM-v0", {"scenario": "khepera"}, 1)
-    with pytest.raises(ValueError, match=re.escape(str(stats))):
+    with pytest.raises(ModelLoadError, match=re.escape(str(stats))):
         load_vecnormalize(stats, venv)
     with pytest.raises(FileNotFoundError, match=re.escape("missing.pkl")):
         load_vecnormalize(tmp_path / "missing.pkl", venv)
@@ -363,7 +368,7 @@ def test_cli_reports_errors_without_a_traceback(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     with pytest.raises(SystemExit) as exit_info:
-        train_module.main(["--algo", "ppo", "--output", str(tmp_path / "none"), "--resume"])
+        train_cli.main(["--algo", "ppo", "--output", str(tmp_path / "none"), "--resume"])
     assert exit_info.value.code == 2
     assert "no run to resume" in capsys.readouterr().err
 
@@ -376,7 +381,7 @@ def test_an_export_that_cannot_be_written_fails_in_one_line(
     destination = blocker / "pretrained" / "ppo_tiny"
     run = tiny_runs["ppo"].run_dir
     with pytest.raises(SystemExit) as exit_info:
-        train_module.main(
+        train_cli.main(
             ["--algo", "ppo", "--output", str(run), "--export", str(destination), "--export-only"]
         )
     assert exit_info.value.code == 2
@@ -651,7 +656,7 @@ def test_env_factory_raises_the_time_limit_with_max_moves() -> None:
 def test_train_is_a_bearing_env_subcommand() -> None:
     from bearing_env.train.cli import SUBCOMMANDS
 
-    assert SUBCOMMANDS["train"][0] == "bearing_env.train.train"
+    assert SUBCOMMANDS["train"][0] == "bearing_env.train.train_cli"
 
 
 def test_checkpoints_keep_sb3_checkpoint_callback_names(tmp_path: Path) -> None:

@@ -15,10 +15,11 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-import bearing_env.train.train as train_module
 import gymnasium as gym
 import numpy as np
 import pytest
+from bearing_env.train import train_cli
+from bearing_env.train.cli_values import parse_key_values
 from bearing_env.train.train import TrainSettings, train
 from bearing_env.train.training_envs import EnvFactory, resolve_vec_env_kind
 from bearing_env.train.vec_env import GymnasiumVecEnv, gym_make_kwargs, make_batched_vec_env
@@ -391,11 +392,11 @@ def test_auto_is_batched_only_with_a_vector_entry_point(
     with pytest.raises(ValueError, match="auto"):
         resolve_vec_env_kind("threads", "BearingSLAM-v0")
     assert TrainSettings("ppo", "BearingSLAM-v0", Path("x")).vec_env == "auto"
-    assert train_module.build_parser().parse_args(["--algo", "ppo"]).vec_env == "auto"
+    assert train_cli.build_parser().parse_args(["--algo", "ppo"]).vec_env == "auto"
 
 
 def run_cli(output: Path, timesteps: int, *extra: str) -> dict[str, Any]:
-    train_module.main(
+    train_cli.main(
         [
             "--algo", "ppo", "--output", str(output), "--n-envs", "2", "--seed", "4",
             "--timesteps", str(timesteps), "--hyperparams", *TINY_PPO,
@@ -449,7 +450,7 @@ def test_batched_and_dummy_train_the_same_model(tmp_path: Path) -> None:
         algo="ppo",
         env_id="BearingSLAM-v0",
         output=tmp_path / "dummy",
-        hyperparam_overrides=train_module.parse_key_values(TINY_PPO, "--hyperparams"),
+        hyperparam_overrides=parse_key_values(TINY_PPO, "--hyperparams"),
         timesteps=64,
         seed=9,
         n_envs=2,

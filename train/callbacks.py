@@ -291,8 +291,9 @@ class FixedSeedEvalCallback(EvalCallback):
     """``EvalCallback`` on fixed validation episodes, with area metrics and resumable history.
 
     The eval env's sub-envs must expose ``rewind_episode_seeds()`` (see
-    ``bearing_env.train.train.EpisodeSeedCycle``): it is called before every evaluation, so every
-    evaluation plays the same episodes and the best model is chosen on a fixed set.
+    ``bearing_env.train.training_envs.EpisodeSeedCycle``): it is called before every
+    evaluation, so every evaluation plays the same episodes and the best model is chosen
+    on a fixed set.
 
     Besides SB3's ``eval/mean_reward``, it logs ``eval/median_total_area_10`` (total area
     of landmarks L3, L4, ..., each capped at ``area_cap``, after 10 moves; an episode that

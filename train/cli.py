@@ -41,7 +41,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "world-model update() throughput vs CartPole-v1",
     ),
     "train": (
-        "bearing_env.train.train",
+        "bearing_env.train.train_cli",
         "train PPO/SAC/DQN agents with stable-baselines3 (rl-zoo3 hyperparameter files)",
     ),
     "hyperparams": (

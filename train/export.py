@@ -11,6 +11,7 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
+from bearing_env.agents.sb3 import load_model
 from bearing_env.train.callbacks import (
     BEST_MODEL_NAME,
     BEST_SUMMARY_NAME,
@@ -18,7 +19,6 @@ from bearing_env.train.callbacks import (
 )
 from bearing_env.train.files import atomic_path, write_json_atomically
 from bearing_env.train.run_folder import RunFiles, read_run_record
-from bearing_env.train.zoo import load_model
 
 EXPORT_VECNORMALIZE_SUFFIX = "_vecnormalize.pkl"
 

@@ -67,6 +67,8 @@ PAPER_FINAL_ERRORS = {"L3": 0.10, "L4": 0.15}
 KHEPERA_MOVE_LENGTH = 0.25
 #: Moves of about one FL unit in the paper's simulated world (L1-L2 = 0.5 m).
 PAPER_SIM_MOVE_LENGTH = 0.5
+#: The move length of each scenario the paper's figures use.
+FIGURE_MOVE_LENGTHS = {"khepera": KHEPERA_MOVE_LENGTH, "paper_sim": PAPER_SIM_MOVE_LENGTH}
 DEFAULT_SEEDS = 200
 QUICK_SEEDS = 12
 FIGURE_DPI = 100
@@ -86,6 +88,16 @@ class Trace:
     contains: NDArray[np.bool_]  # (moves + 1, n - 2): the region holds the true landmark
     truth_fl: NDArray[np.float64]  # (n, 2) true landmark positions in FL
     trajectory_fl: NDArray[np.float64]  # (moves + 1, 2) true robot positions in FL
+
+
+def figure_env_kwargs(scenario: str, transfer: str, epsilon_deg: float) -> dict[str, Any]:
+    """The env kwargs of Figs. 7, 10 and 11's runs: ``scenario`` with its paper move length."""
+    return {
+        "scenario": scenario,
+        "transfer": transfer,
+        "epsilon_deg": float(epsilon_deg),
+        "move_length": FIGURE_MOVE_LENGTHS[scenario],
+    }
 
 
 def random_polygonal_trace(
@@ -161,6 +173,17 @@ def power_fit(x: NDArray[np.float64], y: NDArray[np.float64]) -> dict[str, float
     }
 
 
+def save_and_close(
+    figure: Any, path: Path, rect: tuple[float, float, float, float] | None = None
+) -> Path:
+    """Lay out a finished figure (``tight_layout`` within ``rect``), write it to ``path``
+    atomically and free it."""
+    figure.tight_layout(rect=rect)
+    atomic_save_figure(figure, path)
+    _plt().close(figure)
+    return path
+
+
 def _plt() -> Any:
     import matplotlib
 
@@ -191,12 +214,7 @@ def figure7(
     max_tries: int = 200,
 ) -> tuple[Path, dict[str, Any]]:
     """The regions of L3 and L4 after 1, 3, 6 and 9 movements of one run (4 panels)."""
-    env_kwargs = {
-        "scenario": "paper_sim",
-        "transfer": transfer,
-        "epsilon_deg": epsilon_deg,
-        "move_length": PAPER_SIM_MOVE_LENGTH,
-    }
+    env_kwargs = figure_env_kwargs("paper_sim", transfer, epsilon_deg)
     moves = max(FIG7_MOVEMENTS)
     for seed in range(first_seed, first_seed + max_tries):
         trace = random_polygonal_trace(env_kwargs, seed, moves, keep_polygons=True)
@@ -268,10 +286,7 @@ def figure7(
         f"{transfer} transfer, FL frame (L1 = 0, L2 = 1)",
         fontsize=10,
     )
-    figure.tight_layout(rect=(0, 0.04, 1, 0.94))
-    path = out / "fig7_polygons.png"
-    atomic_save_figure(figure, path)
-    plt.close(figure)
+    path = save_and_close(figure, out / "fig7_polygons.png", rect=(0, 0.04, 1, 0.94))
     data = {
         "seed": seed,
         "runs_skipped": seed - first_seed,
@@ -321,12 +336,7 @@ def figure10(
     moves: int = 10,
 ) -> tuple[Path, dict[str, Any]]:
     """Area and error of L3 and L4 against movements, Khepera, median over ``seeds``."""
-    env_kwargs = {
-        "scenario": "khepera",
-        "transfer": transfer,
-        "epsilon_deg": epsilon_deg,
-        "move_length": KHEPERA_MOVE_LENGTH,
-    }
+    env_kwargs = figure_env_kwargs("khepera", transfer, epsilon_deg)
     traces = [random_polygonal_trace(env_kwargs, seed, moves) for seed in seeds]
     areas = np.stack([t.areas[: moves + 1] for t in traces])  # (seeds, moves+1, 2)
     errors = np.stack([t.errors[: moves + 1] for t in traces])
@@ -371,11 +381,7 @@ def figure10(
         f"median, band: interquartile range; {transfer} transfer; 1 unit = 20 cm",
         fontsize=9,
     )
-    figure.tight_layout()
-    path = out / "fig10_khepera.png"
-    atomic_save_figure(figure, path)
-    plt.close(figure)
-    return path, data
+    return save_and_close(figure, out / "fig10_khepera.png"), data
 
 
 # --------------------------------------------------------------------------------------
@@ -398,12 +404,7 @@ def figure11(
     per_epsilon: dict[float, dict[str, NDArray[np.float64]]] = {}
     reference_bearings: list[NDArray[np.float64]] | None = None
     for epsilon in epsilons:
-        env_kwargs: dict[str, Any] = {
-            "scenario": "khepera",
-            "transfer": transfer,
-            "epsilon_deg": float(epsilon),
-            "move_length": KHEPERA_MOVE_LENGTH,
-        }
+        env_kwargs = figure_env_kwargs("khepera", transfer, epsilon)
         if noise_mode == "same":
             env_kwargs["noise"] = {"kind": "uniform", "bound_deg": PAPER_NOISE_DEG}
         traces = [random_polygonal_trace(env_kwargs, seed, moves) for seed in seeds]
@@ -498,10 +499,7 @@ def figure11(
         "median over runs",
         fontsize=10,
     )
-    figure.tight_layout(rect=(0, 0, 1, 0.94))
-    path = out / "fig11_epsilon.png"
-    atomic_save_figure(figure, path)
-    plt.close(figure)
+    path = save_and_close(figure, out / "fig11_epsilon.png", rect=(0, 0, 1, 0.94))
     data = {
         "noise_mode": noise_mode,
         "transfer": transfer,
@@ -593,11 +591,7 @@ def figure_robustness(
         f"of {moves} moves; conservative transfer",
         fontsize=9,
     )
-    figure.tight_layout()
-    path = out / "fig_robust.png"
-    atomic_save_figure(figure, path)
-    plt.close(figure)
-    return path, data
+    return save_and_close(figure, out / "fig_robust.png"), data
 
 
 def _json_float(value: float) -> float | None:

@@ -1,4 +1,7 @@
-"""``bearing-env train``: train PPO, SAC or DQN agents with stable-baselines3.
+"""The training loop of ``bearing-env train``: :func:`train` trains (or resumes) PPO, SAC or
+DQN with stable-baselines3 as :class:`TrainSettings` say. Its command line is
+:mod:`bearing_env.train.train_cli`, ``run.json`` and resuming
+:mod:`bearing_env.train.run_record`.
 
     bearing-env train --algo ppo                                   # PPO, Khepera scenario
     bearing-env train --algo sac --env BearingSLAM-v0 --timesteps 200000
@@ -78,21 +81,19 @@ resumes from. Each segment's ``status`` is ``finished``, ``interrupted`` or ``ki
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import math
 import signal
 import sys
 import threading
 import time
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import gymnasium as gym
-import numpy as np
 import torch
+from bearing_env.agents.sb3 import load_model, load_vecnormalize
 from bearing_env.train.callbacks import (
     Checkpoint,
     CheckpointStore,
@@ -105,33 +106,28 @@ from bearing_env.train.callbacks import (
     save_model_atomically,
     save_vecnormalize_atomically,
 )
-from bearing_env.train.cli_values import json_safe, parse_key_values
-from bearing_env.train.errors import fail, write_error_message
-from bearing_env.train.export import ExportedModel, export_run
 from bearing_env.train.files import write_json_atomically
 from bearing_env.train.run_folder import (
     RunFiles,
     read_run_record,
 )
+from bearing_env.train.run_record import (
+    new_run_record,
+    resolve_run,
+    running_segment,
+    segments_after_a_kill,
+)
 from bearing_env.train.seeds import (
-    TRAINING_SEED_LIMIT,
-    VALIDATION_SEED_START,
     training_seed_start,
 )
 from bearing_env.train.training_envs import (
-    VEC_ENV_CHOICES,
     make_training_env,
     make_validation_env,
     resolve_vec_env_kind,
 )
 from bearing_env.train.zoo import (
-    DEFAULT_ENV_IDS,
     algorithm_class_for,
-    hyperparams_key,
-    load_model,
-    load_vecnormalize,
     parse_hyperparameters,
-    read_hyperparameters,
 )
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback
@@ -141,21 +137,11 @@ from stable_baselines3.common.vec_env import (
     VecNormalize,
 )
 
-import bearing_env
-
 DEFAULT_EVAL_FREQ = 25_000
 DEFAULT_EVAL_EPISODES = 50
 DEFAULT_CHECKPOINT_FREQ = 50_000
 DEFAULT_KEEP_CHECKPOINTS = 3
 DEFAULT_RUNS_DIR = Path("runs")
-
-RUN_FORMAT_VERSION = 1
-EXIT_INTERRUPTED = 130
-
-
-# --------------------------------------------------------------------------------------
-# Training
-# --------------------------------------------------------------------------------------
 
 
 @dataclass
@@ -199,19 +185,6 @@ class TrainResult:
     wall_seconds: float
 
 
-def _versions() -> dict[str, str]:
-    import stable_baselines3
-
-    return {
-        "bearing_env": bearing_env.__version__,
-        "stable_baselines3": stable_baselines3.__version__,
-        "torch": torch.__version__,
-        "gymnasium": gym.__version__,
-        "numpy": np.__version__,
-        "python": sys.version.split()[0],
-    }
-
-
 @contextlib.contextmanager
 def stop_on_signals(request: StopRequest) -> Iterator[None]:
     """While active, Ctrl-C and SIGTERM set ``request`` (the trainer stops at the next step);
@@ -244,90 +217,10 @@ def _close_quietly(venv: VecEnv) -> None:
         venv.close()
 
 
-def _changed_settings(given: Mapping[str, Any], saved: Mapping[str, Any]) -> dict[str, Any]:
-    """The entries of ``given`` that differ from ``saved`` once both are JSON (a tuple
-    given on the command line equals the list run.json read back)."""
-    return {
-        key: value for key, value in given.items() if json_safe(saved.get(key)) != json_safe(value)
-    }
-
-
-def _resolve_run(settings: TrainSettings) -> tuple[dict[str, Any], Checkpoint | None]:
-    """The raw hyperparameter entry and, when resuming, the checkpoint to start from."""
-    files = RunFiles(settings.output)
-    if not settings.resume:
-        if files.record.exists():
-            record = read_run_record(settings.output)
-            raise FileExistsError(
-                f"{settings.output} already holds a run ({record.get('num_timesteps', 0)} "
-                "timesteps): pass --resume to continue it, or choose another --output"
-            )
-        raw = read_hyperparameters(settings.algo, settings.env_id, settings.conf_file)
-        raw.update(settings.hyperparam_overrides)
-        raw["env_kwargs"] = {**(raw.get("env_kwargs") or {}), **settings.env_kwargs}
-        return raw, None
-
-    record = read_run_record(settings.output)
-    for key, given in (("algo", settings.algo), ("env_id", settings.env_id)):
-        if record.get(key) != given:
-            raise ValueError(
-                f"cannot resume {settings.output}: it was trained with {key}={record.get(key)!r}, "
-                f"not {given!r}"
-            )
-    raw = dict(record["hyperparams"])
-    saved_env_kwargs = raw.get("env_kwargs") or {}
-    changed = _changed_settings(settings.env_kwargs, saved_env_kwargs)
-    if changed:
-        raise ValueError(
-            f"cannot resume {settings.output} with different env kwargs {changed}; "
-            f"it was trained with {saved_env_kwargs}"
-        )
-    different = _changed_settings(settings.hyperparam_overrides, raw)
-    if different:
-        raise ValueError(
-            f"cannot resume {settings.output} with different hyperparameters {different}; "
-            "a resumed run keeps its own"
-        )
-    checkpoint = CheckpointStore(files.checkpoints).latest()
-    if checkpoint is None:
-        print(f"{settings.output}: no checkpoint yet, starting the run from scratch")
-    return raw, checkpoint
-
-
-def _segments_after_a_kill(
-    previous_record: dict[str, Any], checkpoint: Checkpoint | None
-) -> list[dict[str, Any]]:
-    """The segments of the run being resumed, the one a killed process left "running"
-    marked "killed" at the timesteps of the checkpoint the run resumes from.
-
-    A record that still says "running" was left by a process that died without finishing
-    (SIGKILL, power loss, out of memory). Older records did not list the running segment;
-    it is added.
-    """
-    segments = [dict(item) for item in previous_record.get("segments", [])]
-    if previous_record.get("status") != "running":
-        return segments
-    resumed_at = checkpoint.timesteps if checkpoint is not None else 0
-    if segments and segments[-1].get("status") == "running":
-        killed = segments[-1]
-    else:
-        start = int(segments[-1]["end_timesteps"]) if segments else 0
-        killed = {
-            "start_timesteps": start,
-            "n_envs": previous_record.get("n_envs"),
-            "vec_env": previous_record.get("vec_env"),
-        }
-        segments.append(killed)
-    killed["status"] = "killed"
-    # The steps after its last checkpoint are lost; none of them is counted.
-    killed["end_timesteps"] = max(resumed_at, int(killed["start_timesteps"]))
-    return segments
-
-
 def train(settings: TrainSettings) -> TrainResult:
     """Train (or resume) a run; see the module docstring for the files it writes."""
     algorithm_class = algorithm_class_for(settings.algo)
-    raw, checkpoint = _resolve_run(settings)
+    raw, checkpoint = resolve_run(settings)
     hyperparams = parse_hyperparameters(raw, settings.algo)
     env_kwargs = hyperparams.env_kwargs
     n_envs = settings.n_envs if settings.n_envs is not None else hyperparams.n_envs
@@ -399,43 +292,23 @@ def train(settings: TrainSettings) -> TrainResult:
         model.set_random_seed(seed_start)  # torch/numpy/action space, and env i: seed_start + i
 
         raw = {**raw, "n_envs": n_envs, "n_timesteps": target}  # the entry actually used
-        record = {
-            "format": RUN_FORMAT_VERSION,
-            "algo": settings.algo,
-            "env_id": settings.env_id,
-            "env_kwargs": json_safe(env_kwargs),
-            "hyperparams": json_safe(raw),
-            "n_envs": n_envs,
-            "seed": settings.seed,
-            "vec_env": vec_env_kind,
-            "target_timesteps": target,
-            "num_timesteps": int(model.num_timesteps),
-            "status": "running",
-            "seeds": {
-                "training_first_reset": "env i of a segment starting at timestep t: "
-                f"(seed + t) mod {TRAINING_SEED_LIMIT - n_envs} + i",
-                "validation": [
-                    VALIDATION_SEED_START,
-                    VALIDATION_SEED_START + settings.eval_episodes,
-                ],
-            },
-            "segments": _segments_after_a_kill(previous_record, checkpoint),
-            "versions": _versions(),
-        }
+        record = new_run_record(
+            settings,
+            hyperparams=raw,
+            env_kwargs=env_kwargs,
+            n_envs=n_envs,
+            vec_env_kind=vec_env_kind,
+            target_timesteps=target,
+            num_timesteps=int(model.num_timesteps),
+            segments=segments_after_a_kill(previous_record, checkpoint),
+        )
         learn_start = time.perf_counter()
         remaining = target - int(model.num_timesteps)
         segment: dict[str, Any] | None = None
         if remaining > 0:
             # Written now and at every checkpoint, so a killed process leaves its segment
             # (marked "killed" on --resume) with the timesteps of its last checkpoint.
-            segment = {
-                "start_timesteps": start_timesteps,
-                "end_timesteps": start_timesteps,
-                "n_envs": n_envs,
-                "vec_env": vec_env_kind,
-                "status": "running",
-                "wall_seconds": 0.0,
-            }
+            segment = running_segment(start_timesteps, n_envs, vec_env_kind)
             record["segments"].append(segment)
         write_json_atomically(files.record, record)
 
@@ -525,153 +398,3 @@ def train(settings: TrainSettings) -> TrainResult:
         steps_per_second=steps_per_second,
         wall_seconds=wall_seconds,
     )
-
-
-# --------------------------------------------------------------------------------------
-# Command line
-# --------------------------------------------------------------------------------------
-
-
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="bearing-env train",
-        description="Train PPO/SAC (BearingSLAM-v0) or DQN (BearingSLAMDiscrete-v0) with "
-        "stable-baselines3; hyperparameters from the shipped <algo>.yml (rl-zoo3 format; "
-        "bearing-env hyperparams ALGO prints its path). "
-        "Ctrl-C saves a checkpoint; --resume continues from it.",
-    )
-    add = parser.add_argument
-    add("--algo", required=True, choices=sorted(DEFAULT_ENV_IDS))
-    add("--env", help="env id (default BearingSLAM-v0; for dqn BearingSLAMDiscrete-v0)")
-    add("--env-kwargs", nargs="*", default=[], metavar="K=V", help="merged over the YAML's")
-    add("--hyperparams", nargs="*", default=[], metavar="K=V", help="override YAML entries")
-    add("--conf-file", type=Path, help="hyperparameter file (default: the shipped <algo>.yml)")
-    add("--timesteps", type=int, help="total env steps of the run (default the YAML's n_timesteps)")
-    add("--seed", type=int, default=0, help="default %(default)s")
-    add("--n-envs", type=int, help="parallel envs (default the YAML's n_envs)")
-    add(
-        "--vec-env",
-        choices=VEC_ENV_CHOICES,
-        default="auto",
-        help="batched: one Gymnasium vector env in this process (the id's batched "
-        "vector_entry_point, else a SyncVectorEnv); subproc: a process per env (spawn); "
-        "dummy: all in this process; auto (default): batched when the id registers a "
-        "batched vector env, else subproc",
-    )
-    add("--output", type=Path, help="run folder (default runs/<algo>_<env>_seed<seed>)")
-    add("--resume", action="store_true", help="continue the run in --output from its checkpoint")
-    add(
-        "--eval-freq", type=int, default=DEFAULT_EVAL_FREQ, help="env steps (0: never; %(default)s)"
-    )
-    add("--eval-episodes", type=int, default=DEFAULT_EVAL_EPISODES, help="default %(default)s")
-    add(
-        "--checkpoint-freq",
-        type=int,
-        default=DEFAULT_CHECKPOINT_FREQ,
-        help="env steps (%(default)s)",
-    )
-    add(
-        "--keep-checkpoints", type=int, default=DEFAULT_KEEP_CHECKPOINTS, help="default %(default)s"
-    )
-    add("--no-progress", action="store_true", help="no progress bar")
-    add("--no-tensorboard", action="store_true", help="no TensorBoard logs")
-    add("--device", default="cpu", help="torch device (default %(default)s)")
-    add("--torch-threads", type=int, default=1, help="0: torch's default (default %(default)s)")
-    add("--verbose", type=int, default=0, help="1: SB3 training tables; -1: no evaluation lines")
-    add(
-        "--export",
-        type=Path,
-        metavar="DIR/NAME",
-        help="after training, copy the best model to DIR/NAME.zip (+ _vecnormalize.pkl, .json)",
-    )
-    add("--export-only", action="store_true", help="export the run in --output without training")
-    return parser
-
-
-def default_output(algo: str, env_id: str, seed: int) -> Path:
-    return DEFAULT_RUNS_DIR / f"{algo}_{hyperparams_key(env_id)}_seed{seed}"
-
-
-def settings_from_args(args: argparse.Namespace) -> TrainSettings:
-    env_id = args.env or DEFAULT_ENV_IDS[args.algo]
-    return TrainSettings(
-        algo=args.algo,
-        env_id=env_id,
-        output=args.output or default_output(args.algo, env_id, args.seed),
-        env_kwargs=parse_key_values(args.env_kwargs, "--env-kwargs"),
-        hyperparam_overrides=parse_key_values(args.hyperparams, "--hyperparams"),
-        conf_file=args.conf_file,
-        timesteps=args.timesteps,
-        seed=args.seed,
-        n_envs=args.n_envs,
-        vec_env=args.vec_env,
-        resume=args.resume,
-        eval_freq=args.eval_freq,
-        eval_episodes=args.eval_episodes,
-        checkpoint_freq=args.checkpoint_freq,
-        keep_checkpoints=args.keep_checkpoints,
-        progress_bar=not args.no_progress,
-        tensorboard=not args.no_tensorboard,
-        device=args.device,
-        torch_threads=args.torch_threads or None,
-        verbose=args.verbose,
-    )
-
-
-def _output_of(args: argparse.Namespace) -> Path:
-    """The run folder the arguments name (``--output`` or its default)."""
-    env_id = args.env or DEFAULT_ENV_IDS[args.algo]
-    return Path(args.output or default_output(args.algo, env_id, args.seed))
-
-
-def _print_export(exported: ExportedModel) -> None:
-    print(f"exported the {exported.source} model to {exported.model_path}")
-    if exported.vecnormalize_path is not None:
-        print(f"  VecNormalize statistics: {exported.vecnormalize_path}")
-    print(f"  description: {exported.metadata_path}")
-
-
-def main(argv: Sequence[str] | None = None) -> None:
-    parser = build_parser()
-    args = parser.parse_args(sys.argv[1:] if argv is None else list(argv))
-    if args.export_only and args.export is None:
-        parser.error("--export-only needs --export DIR/NAME")
-    with _clear_errors(args):
-        settings = settings_from_args(args)
-        if args.export_only:
-            _print_export(export_run(settings.output, args.export))
-            return
-        result = train(settings)
-    speed = (
-        f", {result.steps_per_second:.0f} env steps/s over {result.wall_seconds:.1f} s"
-        if math.isfinite(result.steps_per_second) and result.wall_seconds > 0.01
-        else ""
-    )
-    print(f"{result.run_dir}: {result.num_timesteps}/{result.target_timesteps} timesteps{speed}")
-    if result.interrupted:
-        where = result.checkpoint.model_path if result.checkpoint is not None else "?"
-        print(f"interrupted: checkpoint {where}; continue with --resume", file=sys.stderr)
-        raise SystemExit(EXIT_INTERRUPTED)
-    if args.export is not None:
-        with _clear_errors(args):
-            _print_export(export_run(settings.output, args.export))
-
-
-@contextlib.contextmanager
-def _clear_errors(args: argparse.Namespace) -> Iterator[None]:
-    """Bad settings and files, and OSErrors while writing (disk full, no permission, a
-    parent that is a file), end the command with one line and exit status 2."""
-    try:
-        yield
-    except (FileNotFoundError, FileExistsError, ValueError, TypeError) as error:
-        print(f"bearing-env train: error: {error}", file=sys.stderr)
-        raise SystemExit(2) from error
-    except OSError as error:
-        output = _output_of(args)
-        in_run = str(error.filename or output).startswith(str(output))
-        option = "--export" if args.export is not None and not in_run else "--output"
-        fail("bearing-env train", write_error_message(error, output, option))
-
-
-if __name__ == "__main__":
-    main()

@@ -1,6 +1,6 @@
 """The stable-baselines3 / rl-zoo3 glue of ``bearing-env train``: hyperparameter entries
-read and preprocessed by rl-zoo3's own code, the algorithm classes, and saved models and
-VecNormalize statistics loaded with errors that name the file.
+read and preprocessed by rl-zoo3's own code, and the algorithm classes. (Saved models and
+VecNormalize statistics are loaded by :mod:`bearing_env.agents.sb3`.)
 
 A hyperparameter file is rl-zoo3's format, so it means here what it means to
 ``python -m rl_zoo3.train``: :func:`read_hyperparameters` and
@@ -25,7 +25,6 @@ import argparse
 import contextlib
 import importlib
 import io
-import zipfile
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,7 +34,6 @@ from typing import Any
 import numpy as np
 from bearing_env.train.conf_files import default_conf_file
 from stable_baselines3.common.base_class import BaseAlgorithm
-from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
 #: The algorithms ``bearing-env train`` ships hyperparameters for, and the env id each
 #: trains on by default.
@@ -204,46 +202,3 @@ def algorithm_class_for(algo: str) -> type[BaseAlgorithm]:
     algorithms: dict[str, type[BaseAlgorithm]] = rl_zoo3_module("rl_zoo3.utils").ALGOS
     return algorithms[key]
 
-
-def _existing_file(path: Path, what: str) -> Path:
-    if path.is_file():
-        return path
-    if path.suffix != ".zip" and path.with_name(path.name + ".zip").is_file():
-        return path.with_name(path.name + ".zip")
-    raise FileNotFoundError(f"{what} not found: {path}")
-
-def load_model(
-    path: str | Path,
-    algo: str,
-    env: VecEnv | None = None,
-    device: str = "cpu",
-    **kwargs: Any,
-) -> BaseAlgorithm:
-    """Load a saved SB3 model.
-
-    Raises:
-        FileNotFoundError: no file at ``path`` (nor at ``path.zip``).
-        ValueError: the file is not a loadable ``algo`` model (corrupt, truncated, another
-            algorithm, or spaces that do not fit ``env``); the message names the path.
-    """
-    algorithm_class = algorithm_class_for(algo)
-    model_path = _existing_file(Path(path), "model file")
-    if not zipfile.is_zipfile(model_path):
-        raise ValueError(f"model file {model_path} is corrupt: not a zip archive")
-    try:
-        return algorithm_class.load(model_path, env=env, device=device, **kwargs)
-    except Exception as error:  # SB3 raises many kinds on damaged or foreign archives
-        raise ValueError(
-            f"cannot load {algo.upper()} model {model_path}: {type(error).__name__}: {error}"
-        ) from error
-
-def load_vecnormalize(path: str | Path, venv: VecEnv) -> VecNormalize:
-    """``VecNormalize.load`` with errors that name the file (see :func:`load_model`)."""
-    stats_path = _existing_file(Path(path), "VecNormalize statistics")
-    try:
-        normalizer = VecNormalize.load(str(stats_path), venv)
-    except Exception as error:  # a truncated or foreign pickle raises many kinds
-        raise ValueError(
-            f"cannot load VecNormalize statistics {stats_path}: {type(error).__name__}: {error}"
-        ) from error
-    return normalizer

@@ -1,0 +1,180 @@
+"""``bearing-env train``'s command line: the arguments, the run folder they name, the
+:class:`~bearing_env.train.train.TrainSettings` they give, ``--export``/``--export-only``,
+and failures as one line with exit status 2 (130 after an interruption). What training
+does, and the files it writes: :mod:`bearing_env.train.train`.
+
+    bearing-env train --algo ppo [--output runs/ppo_khepera] [--resume] [--export DIR/NAME]
+    python -m bearing_env.train.train_cli ...          # the same
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import math
+import sys
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+
+from bearing_env.train.cli_values import parse_key_values
+from bearing_env.train.errors import fail, write_error_message
+from bearing_env.train.export import ExportedModel, export_run
+from bearing_env.train.train import (
+    DEFAULT_CHECKPOINT_FREQ,
+    DEFAULT_EVAL_EPISODES,
+    DEFAULT_EVAL_FREQ,
+    DEFAULT_KEEP_CHECKPOINTS,
+    DEFAULT_RUNS_DIR,
+    TrainSettings,
+    train,
+)
+from bearing_env.train.training_envs import VEC_ENV_CHOICES
+from bearing_env.train.zoo import DEFAULT_ENV_IDS, hyperparams_key
+
+#: The exit status after Ctrl-C or SIGTERM stopped training (a checkpoint was saved).
+EXIT_INTERRUPTED = 130
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="bearing-env train",
+        description="Train PPO/SAC (BearingSLAM-v0) or DQN (BearingSLAMDiscrete-v0) with "
+        "stable-baselines3; hyperparameters from the shipped <algo>.yml (rl-zoo3 format; "
+        "bearing-env hyperparams ALGO prints its path). "
+        "Ctrl-C saves a checkpoint; --resume continues from it.",
+    )
+    add = parser.add_argument
+    add("--algo", required=True, choices=sorted(DEFAULT_ENV_IDS))
+    add("--env", help="env id (default BearingSLAM-v0; for dqn BearingSLAMDiscrete-v0)")
+    add("--env-kwargs", nargs="*", default=[], metavar="K=V", help="merged over the YAML's")
+    add("--hyperparams", nargs="*", default=[], metavar="K=V", help="override YAML entries")
+    add("--conf-file", type=Path, help="hyperparameter file (default: the shipped <algo>.yml)")
+    add("--timesteps", type=int, help="total env steps of the run (default the YAML's n_timesteps)")
+    add("--seed", type=int, default=0, help="default %(default)s")
+    add("--n-envs", type=int, help="parallel envs (default the YAML's n_envs)")
+    add(
+        "--vec-env",
+        choices=VEC_ENV_CHOICES,
+        default="auto",
+        help="batched: one Gymnasium vector env in this process (the id's batched "
+        "vector_entry_point, else a SyncVectorEnv); subproc: a process per env (spawn); "
+        "dummy: all in this process; auto (default): batched when the id registers a "
+        "batched vector env, else subproc",
+    )
+    add("--output", type=Path, help="run folder (default runs/<algo>_<env>_seed<seed>)")
+    add("--resume", action="store_true", help="continue the run in --output from its checkpoint")
+    add(
+        "--eval-freq", type=int, default=DEFAULT_EVAL_FREQ, help="env steps (0: never; %(default)s)"
+    )
+    add("--eval-episodes", type=int, default=DEFAULT_EVAL_EPISODES, help="default %(default)s")
+    add(
+        "--checkpoint-freq",
+        type=int,
+        default=DEFAULT_CHECKPOINT_FREQ,
+        help="env steps (%(default)s)",
+    )
+    add(
+        "--keep-checkpoints", type=int, default=DEFAULT_KEEP_CHECKPOINTS, help="default %(default)s"
+    )
+    add("--no-progress", action="store_true", help="no progress bar")
+    add("--no-tensorboard", action="store_true", help="no TensorBoard logs")
+    add("--device", default="cpu", help="torch device (default %(default)s)")
+    add("--torch-threads", type=int, default=1, help="0: torch's default (default %(default)s)")
+    add("--verbose", type=int, default=0, help="1: SB3 training tables; -1: no evaluation lines")
+    add(
+        "--export",
+        type=Path,
+        metavar="DIR/NAME",
+        help="after training, copy the best model to DIR/NAME.zip (+ _vecnormalize.pkl, .json)",
+    )
+    add("--export-only", action="store_true", help="export the run in --output without training")
+    return parser
+
+
+def default_output(algo: str, env_id: str, seed: int) -> Path:
+    return DEFAULT_RUNS_DIR / f"{algo}_{hyperparams_key(env_id)}_seed{seed}"
+
+
+def settings_from_args(args: argparse.Namespace) -> TrainSettings:
+    env_id = args.env or DEFAULT_ENV_IDS[args.algo]
+    return TrainSettings(
+        algo=args.algo,
+        env_id=env_id,
+        output=args.output or default_output(args.algo, env_id, args.seed),
+        env_kwargs=parse_key_values(args.env_kwargs, "--env-kwargs"),
+        hyperparam_overrides=parse_key_values(args.hyperparams, "--hyperparams"),
+        conf_file=args.conf_file,
+        timesteps=args.timesteps,
+        seed=args.seed,
+        n_envs=args.n_envs,
+        vec_env=args.vec_env,
+        resume=args.resume,
+        eval_freq=args.eval_freq,
+        eval_episodes=args.eval_episodes,
+        checkpoint_freq=args.checkpoint_freq,
+        keep_checkpoints=args.keep_checkpoints,
+        progress_bar=not args.no_progress,
+        tensorboard=not args.no_tensorboard,
+        device=args.device,
+        torch_threads=args.torch_threads or None,
+        verbose=args.verbose,
+    )
+
+
+def _output_of(args: argparse.Namespace) -> Path:
+    """The run folder the arguments name (``--output`` or its default)."""
+    env_id = args.env or DEFAULT_ENV_IDS[args.algo]
+    return Path(args.output or default_output(args.algo, env_id, args.seed))
+
+
+def _print_export(exported: ExportedModel) -> None:
+    print(f"exported the {exported.source} model to {exported.model_path}")
+    if exported.vecnormalize_path is not None:
+        print(f"  VecNormalize statistics: {exported.vecnormalize_path}")
+    print(f"  description: {exported.metadata_path}")
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    parser = build_parser()
+    args = parser.parse_args(sys.argv[1:] if argv is None else list(argv))
+    if args.export_only and args.export is None:
+        parser.error("--export-only needs --export DIR/NAME")
+    with _clear_errors(args):
+        settings = settings_from_args(args)
+        if args.export_only:
+            _print_export(export_run(settings.output, args.export))
+            return
+        result = train(settings)
+    speed = (
+        f", {result.steps_per_second:.0f} env steps/s over {result.wall_seconds:.1f} s"
+        if math.isfinite(result.steps_per_second) and result.wall_seconds > 0.01
+        else ""
+    )
+    print(f"{result.run_dir}: {result.num_timesteps}/{result.target_timesteps} timesteps{speed}")
+    if result.interrupted:
+        where = result.checkpoint.model_path if result.checkpoint is not None else "?"
+        print(f"interrupted: checkpoint {where}; continue with --resume", file=sys.stderr)
+        raise SystemExit(EXIT_INTERRUPTED)
+    if args.export is not None:
+        with _clear_errors(args):
+            _print_export(export_run(settings.output, args.export))
+
+
+@contextlib.contextmanager
+def _clear_errors(args: argparse.Namespace) -> Iterator[None]:
+    """Bad settings and files, and OSErrors while writing (disk full, no permission, a
+    parent that is a file), end the command with one line and exit status 2."""
+    try:
+        yield
+    except (FileNotFoundError, FileExistsError, ValueError, TypeError) as error:
+        print(f"bearing-env train: error: {error}", file=sys.stderr)
+        raise SystemExit(2) from error
+    except OSError as error:
+        output = _output_of(args)
+        in_run = str(error.filename or output).startswith(str(output))
+        option = "--export" if args.export is not None and not in_run else "--output"
+        fail("bearing-env train", write_error_message(error, output, option))
+
+
+if __name__ == "__main__":
+    main()
