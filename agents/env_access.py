@@ -23,7 +23,7 @@ import numpy as np
 from bearing_env.envs.bearing_slam import BearingSLAMEnv
 from bearing_env.envs.core import ROBOT_MAP_UNKNOWN_AS_INF, WorldView
 from bearing_env.slam import PolygonSLAM
-from bearing_env.slam.batch import LANDMARK_AXES, STATE_ARRAYS
+from bearing_env.slam.batch import LANDMARK_AXES
 
 #: The one key of an info that robot policies read: the robot's own map.
 ROBOT_MAP_KEY = "robot_map"
@@ -72,7 +72,7 @@ class MapReader:
         state = info[ROBOT_MAP_KEY]
         slam = PolygonSLAM(int(n_landmarks), **self.map_settings)
         batch, mapped = slam.batch, int(n_landmarks) - 2
-        for name in STATE_ARRAYS:
+        for name in batch.state_names:
             target = getattr(batch, name)
             values = np.array(state[name])
             if name in LANDMARK_AXES:  # the info's arrays have no map axis

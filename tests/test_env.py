@@ -30,6 +30,7 @@ from bearing_env.envs.bearing_slam import (
     observation_slices,
 )
 from bearing_env.registration import MAX_EPISODE_STEPS, register_envs
+from bearing_env.slam.batch import RELAXED_STATE_ARRAYS, STATE_ARRAYS
 
 ENV_IDS = sorted(
     spec.id
@@ -264,6 +265,8 @@ def test_info_keys_and_shapes() -> None:
         assert 0.0 <= info["path_length"] <= env.move_length[1]
         assert reward == pytest.approx(sum(info["rewards"].values()))
         assert info["robot_map"]["vertices"].shape[:-2] == info["robot_map"]["counts"].shape
+        # The strict map carries no relaxed-fusion window (its info has only what it uses).
+        assert set(info["robot_map"]) == set(STATE_ARRAYS) - set(RELAXED_STATE_ARRAYS)
         # Not initialised <=> infinite area <=> infinite error.
         assert np.array_equal(np.isinf(info["landmark_area"]), np.isinf(info["landmark_error"]))
 

@@ -270,6 +270,7 @@ def test_env_relaxed_passes_the_checkers_and_reports_outliers() -> None:
     for _ in range(20):
         _, _, terminated, truncated, info = env.step(env.action_space.sample())
         assert info["outliers"].shape == (2,) and info["outliers"].dtype == np.int64
+        assert "window_vertices" in info["robot_map"]  # the map's whole state, as data
         total = int(info["outliers"].sum())
         if terminated or truncated:
             break

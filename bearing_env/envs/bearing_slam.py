@@ -236,12 +236,14 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     ## Info
 
     `robot_map` is the robot's own map, as data (no ground truth; what policies may read:
-    see `bearing_env.agents.env_access.MapReader`): a dict of its state arrays
-    (`bearing_env.slam.batch.STATE_ARRAYS`: `vertices` (M - 2, CAPACITY, 2), the FL
+    see `bearing_env.agents.env_access.MapReader`): a dict of the state arrays its fusion
+    uses (`BatchedPolygonSLAM.state_names`: `vertices` (M - 2, CAPACITY, 2), the FL
     region vertices as (x, y), of which the first `counts` are used, `areas`,
     `centroids` (M - 2, 2), the robot's
     `robot_vertices`, `robot_counts`, `robot_area`, `robot_centroid`, `robot_heading`, and
-    the counters `n_updates`, `n_frame_changes`, `n_inconsistent`). The per-landmark
+    the counters `n_updates`, `n_frame_changes`, `n_inconsistent`; with
+    `fusion="relaxed"` also its window and bases, `window_vertices` to `outliers`). The
+    per-landmark
     arrays have `M - 2` slots whatever the episode's landmark count (empty slots: count
     0), so infos batch on the vector env; the count is the observation's present slots.
     Unused vertex slots are 0 and unknown values (a centroid without a region, the

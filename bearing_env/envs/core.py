@@ -36,7 +36,6 @@ from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
     LANDMARK_AXES,
-    STATE_ARRAYS,
     VERTEX_COUNTS,
     BatchedPolygonSLAM,
 )
@@ -709,7 +708,7 @@ ROBOT_MAP_UNKNOWN_AS_INF: tuple[str, ...] = ("centroids", "robot_centroid", "rob
 def robot_map_info(batch: BatchedPolygonSLAM, rows: IntArray, slots: int) -> dict[str, Any]:
     """The robot's own map state of the rows, as data (``info["robot_map"]``).
 
-    One array per state array of the map (``bearing_env.slam.batch.STATE_ARRAYS``),
+    One array per state array the map's fusion uses (``BatchedPolygonSLAM.state_names``),
     restricted to the rows; complex FL points are (x, y) pairs on a last axis of 2. It has
     a canonical form so that equal maps give equal infos:
     vertex slots beyond a region's count are 0, and unknown values are inf (see
@@ -721,7 +720,7 @@ def robot_map_info(batch: BatchedPolygonSLAM, rows: IntArray, slots: int) -> dic
     """
     mapped = batch.n_landmarks - 2
     out: dict[str, Any] = {}
-    for name in STATE_ARRAYS:
+    for name in batch.state_names:
         values = getattr(batch, name)[rows]
         if name in VERTEX_COUNTS:
             used = getattr(batch, VERTEX_COUNTS[name])[rows]
@@ -741,7 +740,7 @@ def robot_map_info(batch: BatchedPolygonSLAM, rows: IntArray, slots: int) -> dic
         if values.dtype.kind == "c":
             # FL points as (x, y) pairs on a last axis: Gymnasium batches real arrays and
             # scalars only (a complex scalar would become an object array).
-            values = np.stack([values.real, values.imag], axis=-1)
+            values = values.view(np.float64).reshape(*values.shape, 2)
         out[name] = values
     return out
 

@@ -326,6 +326,14 @@ class BatchedPolygonSLAM:
             getattr(copies, name)[:] = getattr(self, name)[rows]
         return copies
 
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """The state arrays this batch's fusion uses: :data:`STATE_ARRAYS`, less the relaxed
+        fusion's window and bases under ``"intersect"`` (which never reads them)."""
+        if self.fusion == "relaxed":
+            return STATE_ARRAYS
+        return tuple(name for name in STATE_ARRAYS if name not in RELAXED_STATE_ARRAYS)
+
     def _state_arrays(self) -> tuple[NDArray[Any], ...]:
         """The state in the kernels' argument order (see :data:`STATE_ARRAYS`)."""
         d = self.__dict__
@@ -387,6 +395,9 @@ STATE_ARRAYS = (
     "outliers",
 )
 
+
+#: The part of the state only the relaxed fusion uses (its window and bases).
+RELAXED_STATE_ARRAYS = STATE_ARRAYS[STATE_ARRAYS.index("window_vertices") :]
 
 #: The state arrays with a landmark axis, and which axis it is (the map axis is 0): what
 #: pads or trims a map's state to a number of landmark slots.
