@@ -178,7 +178,6 @@ class BatchedPolygonSLAM:
         self.window_next = np.zeros(n, dtype=np.int64)
         self.base_vertices = np.zeros((n, m, cap if w else 0), dtype=np.complex128)
         self.base_counts = np.zeros((n, m), dtype=np.int64)
-        self.relaxation = np.zeros((n, m), dtype=np.int64)
         self.n_dropped = np.zeros((n, m), dtype=np.int64)
         self.outliers = np.zeros((n, m), dtype=np.int64)
         self.reset()
@@ -224,7 +223,6 @@ class BatchedPolygonSLAM:
         self.window_length[rows] = 0
         self.window_next[rows] = 0
         self.base_counts[rows] = 0
-        self.relaxation[rows] = 0
         self.n_dropped[rows] = 0
         self.outliers[rows] = 0
 
@@ -390,7 +388,6 @@ STATE_ARRAYS = (
     "window_next",
     "base_vertices",
     "base_counts",
-    "relaxation",
     "n_dropped",
     "outliers",
 )
@@ -411,7 +408,6 @@ LANDMARK_AXES: dict[str, int] = {
     "window_inlier": 2,
     "base_vertices": 1,
     "base_counts": 1,
-    "relaxation": 1,
     "n_dropped": 1,
     "outliers": 1,
 }

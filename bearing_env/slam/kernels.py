@@ -973,9 +973,9 @@ def _solve_landmark(
     vertices: np.ndarray, counts: np.ndarray, areas: np.ndarray, centroids: np.ndarray,
     window_vertices: np.ndarray, window_counts: np.ndarray, window_inlier: np.ndarray,
     window_rejected: np.ndarray, window_length: np.ndarray, window_next: np.ndarray,
-    base_vertices: np.ndarray, base_counts: np.ndarray, relaxation: np.ndarray,
-    n_dropped: np.ndarray, slots: np.ndarray, acc: np.ndarray, first: np.ndarray,
-    second: np.ndarray, work: np.ndarray, cloud: np.ndarray, hull: np.ndarray,
+    base_vertices: np.ndarray, base_counts: np.ndarray, n_dropped: np.ndarray,
+    slots: np.ndarray, acc: np.ndarray, first: np.ndarray, second: np.ndarray,
+    work: np.ndarray, cloud: np.ndarray, hull: np.ndarray,
 ) -> None:
     """Landmark ``j``'s region from its base and window, from scratch (see
     :func:`relaxed_movement`)."""
@@ -983,9 +983,9 @@ def _solve_landmark(
     for t in range(k):
         window_inlier[row, slots[t], j] = False
     use_base = base_counts[row, j] > 0
-    n, q = 0, 0
+    n = 0
     if k > 0 or use_base:
-        n, q = relaxed_region(
+        n, _ = relaxed_region(
             row, j, slots, k, use_base, max_outliers, window_vertices, window_counts,
             window_inlier, base_vertices, base_counts, acc, first, second, work, cloud, hull,
         )
@@ -994,7 +994,7 @@ def _solve_landmark(
             # the cap: it is dropped.
             base_counts[row, j] = 0
             n_dropped[row, j] += 1
-            n, q = relaxed_region(
+            n, _ = relaxed_region(
                 row, j, slots, k, False, max_outliers, window_vertices, window_counts,
                 window_inlier, base_vertices, base_counts, acc, first, second, work,
                 cloud, hull,
@@ -1004,13 +1004,10 @@ def _solve_landmark(
         # the old region, or restart from the newest movement's region alone.
         newest = slots[k - 1]
         if keep_on_inconsistency and counts[row, j] > 0:
-            relaxation[row, j] = max_outliers + 1
-            return
+            return  # every window region is left out, so the next update solves again
         n = window_counts[row, newest, j]
         _copy_polygon(window_vertices[row, newest, j], n, acc)
         window_inlier[row, newest, j] = True
-        q = k - 1
-    relaxation[row, j] = q
     _copy_polygon(acc, n, vertices[row, j])
     counts[row, j] = n
     if n > 0:
@@ -1054,13 +1051,33 @@ def _age_out_oldest(
 
 
 @njit(**_JIT)
+def _keeps_every_region(
+    row: int, j: int, window_counts: np.ndarray, window_inlier: np.ndarray,
+    window_rejected: np.ndarray, window_length: np.ndarray, window_next: np.ndarray,
+) -> bool:
+    """Whether landmark ``j``'s region leaves out none of its window regions (of movements
+    not rejected): then it is the intersection of its base and all of them, and a new
+    region is fused by one clip."""
+    size = window_counts.shape[1]
+    for age in range(window_length[row]):
+        slot = (window_next[row] - window_length[row] + age) % size
+        if (
+            window_counts[row, slot, j] > 0
+            and not window_rejected[row, slot]
+            and not window_inlier[row, slot, j]
+        ):
+            return False
+    return True
+
+
+@njit(**_JIT)
 def relaxed_movement(
     row: int, fresh_counts: np.ndarray, max_outliers: int, keep_on_inconsistency: bool,
     vertices: np.ndarray, counts: np.ndarray, areas: np.ndarray, centroids: np.ndarray,
     window_vertices: np.ndarray, window_counts: np.ndarray, window_inlier: np.ndarray,
     window_rejected: np.ndarray, window_length: np.ndarray, window_next: np.ndarray,
-    base_vertices: np.ndarray, base_counts: np.ndarray, relaxation: np.ndarray,
-    n_dropped: np.ndarray, outliers: np.ndarray, landmark_status: np.ndarray, i: int,
+    base_vertices: np.ndarray, base_counts: np.ndarray, n_dropped: np.ndarray,
+    outliers: np.ndarray, landmark_status: np.ndarray, i: int,
     first: np.ndarray, second: np.ndarray, work: np.ndarray, cloud: np.ndarray,
     hull: np.ndarray,
 ) -> bool:
@@ -1087,7 +1104,9 @@ def relaxed_movement(
         if n_new == 0:
             continue
         n_old = counts[row, j]
-        if relaxation[row, j] == 0 and n_old > 0:
+        if n_old > 0 and _keeps_every_region(
+            row, j, window_counts, window_inlier, window_rejected, window_length, window_next
+        ):
             n = clip_convex(
                 vertices[row, j], n_old, window_vertices[row, newest, j], n_new, first, work
             )
@@ -1099,8 +1118,8 @@ def relaxed_movement(
         _solve_landmark(
             row, j, max_outliers, keep_on_inconsistency, vertices, counts, areas, centroids,
             window_vertices, window_counts, window_inlier, window_rejected, window_length,
-            window_next, base_vertices, base_counts, relaxation, n_dropped, slots, acc,
-            first, second, work, cloud, hull,
+            window_next, base_vertices, base_counts, n_dropped, slots, acc, first,
+            second, work, cloud, hull,
         )
     changed = True
     while changed:
@@ -1126,24 +1145,19 @@ def relaxed_movement(
                         row, j, max_outliers, keep_on_inconsistency, vertices, counts,
                         areas, centroids, window_vertices, window_counts, window_inlier,
                         window_rejected, window_length, window_next, base_vertices,
-                        base_counts, relaxation, n_dropped, slots, acc, first, second,
-                        work, cloud, hull,
+                        base_counts, n_dropped, slots, acc, first, second, work, cloud,
+                        hull,
                     )
     rejected = window_rejected[row, newest]
     for j in range(n_mapped):
         left_out = n_dropped[row, j]
-        waiting = 0
         for age in range(window_length[row]):
             slot = (window_next[row] - window_length[row] + age) % size
             if window_counts[row, slot, j] > 0 and (
                 window_rejected[row, slot] or not window_inlier[row, slot, j]
             ):
                 left_out += 1
-                if not window_rejected[row, slot]:
-                    waiting += 1
         outliers[row, j] = left_out
-        if relaxation[row, j] <= max_outliers:
-            relaxation[row, j] = waiting
         if fresh_counts[j] > 0 and (rejected or not window_inlier[row, newest, j]):
             landmark_status[i, j] = LANDMARK_INCONSISTENT
     return rejected
@@ -1187,7 +1201,6 @@ def _update_rows(
     window_next: np.ndarray,
     base_vertices: np.ndarray,
     base_counts: np.ndarray,
-    relaxation: np.ndarray,
     n_dropped: np.ndarray,
     outliers: np.ndarray,
     frame_status: np.ndarray,
@@ -1306,7 +1319,7 @@ def _update_rows(
                 row, fresh_counts, max_outliers, keep_on_inconsistency, vertices, counts,
                 areas, centroids, window_vertices, window_counts, window_inlier,
                 window_rejected, window_length, window_next, base_vertices, base_counts,
-                relaxation, n_dropped, outliers, landmark_status, i, fused, work, fresh,
+                n_dropped, outliers, landmark_status, i, fused, work, fresh,
                 cloud, hull,
             )
             if rejected:
@@ -1379,7 +1392,6 @@ def update_maps(
     window_next: np.ndarray,
     base_vertices: np.ndarray,
     base_counts: np.ndarray,
-    relaxation: np.ndarray,
     n_dropped: np.ndarray,
     outliers: np.ndarray,
     frame_status: np.ndarray,
@@ -1425,7 +1437,6 @@ def update_maps(
         window_next,
         base_vertices,
         base_counts,
-        relaxation,
         n_dropped,
         outliers,
         frame_status,
@@ -1466,7 +1477,6 @@ def update_maps_parallel(
     window_next: np.ndarray,
     base_vertices: np.ndarray,
     base_counts: np.ndarray,
-    relaxation: np.ndarray,
     n_dropped: np.ndarray,
     outliers: np.ndarray,
     frame_status: np.ndarray,
@@ -1512,7 +1522,6 @@ def update_maps_parallel(
             window_next,
             base_vertices,
             base_counts,
-            relaxation,
             n_dropped,
             outliers,
             frame_status,
