@@ -788,3 +788,11 @@ def test_take_copies_maps_by_index_with_repeats() -> None:
     assert np.array_equal(batch.counts[2], copies.counts[2])
     with pytest.raises(ValueError, match="indices"):
         batch.take(np.array([3]))
+
+
+def test_status_names_are_indexed_by_contiguous_kernel_codes() -> None:
+    from bearing_env.slam.batch import _names_by_code
+
+    assert _names_by_code({1: "b", 0: "a"}) == ("a", "b")
+    with pytest.raises(ValueError, match="0..1"):
+        _names_by_code({0: "a", 2: "c"})

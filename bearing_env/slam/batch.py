@@ -29,37 +29,39 @@ from bearing_env.slam.transfer import TRANSFERS
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
+
+def _names_by_code(names: dict[int, str]) -> tuple[str, ...]:
+    """Status names indexed by the kernels' codes, which must be 0, 1, 2, ... exactly."""
+    if sorted(names) != list(range(len(names))):
+        raise ValueError(f"status codes must be 0..{len(names) - 1}, got {sorted(names)}")
+    return tuple(names[code] for code in range(len(names)))
+
+
 #: Frame statuses, as codes (index into this tuple; the kernels' constants) and as the
 #: strings of the public API.
-FRAME_STATUSES: tuple[str, ...] = tuple(
-    name
-    for _, name in sorted(
-        {
-            kernels.FRAME_OK: "ok",
-            kernels.FRAME_L1_UNBOUNDED: "l1_unbounded",
-            kernels.FRAME_L2_UNBOUNDED: "l2_unbounded",
-            kernels.FRAME_L1_L2_OVERLAP: "l1_l2_overlap",
-            kernels.FRAME_L1_L2_TOO_CLOSE: "l1_l2_too_close",
-            kernels.FRAME_L1_MISSING: "l1_missing",
-            kernels.FRAME_L2_MISSING: "l2_missing",
-            kernels.FRAME_REJECTED: "rejected",
-        }.items()
-    )
+FRAME_STATUSES: tuple[str, ...] = _names_by_code(
+    {
+        kernels.FRAME_OK: "ok",
+        kernels.FRAME_L1_UNBOUNDED: "l1_unbounded",
+        kernels.FRAME_L2_UNBOUNDED: "l2_unbounded",
+        kernels.FRAME_L1_L2_OVERLAP: "l1_l2_overlap",
+        kernels.FRAME_L1_L2_TOO_CLOSE: "l1_l2_too_close",
+        kernels.FRAME_L1_MISSING: "l1_missing",
+        kernels.FRAME_L2_MISSING: "l2_missing",
+        kernels.FRAME_REJECTED: "rejected",
+    }
 )
 FRAME_CODE = {name: code for code, name in enumerate(FRAME_STATUSES)}
 
 #: Landmark statuses, as codes and strings.
-LANDMARK_STATUSES: tuple[str, ...] = tuple(
-    name
-    for _, name in sorted(
-        {
-            kernels.LANDMARK_UPDATED: "updated",
-            kernels.LANDMARK_UNBOUNDED: "unbounded",
-            kernels.LANDMARK_INCONSISTENT: "inconsistent",
-            kernels.LANDMARK_SKIPPED: "skipped",
-            kernels.LANDMARK_MISSING: "missing",
-        }.items()
-    )
+LANDMARK_STATUSES: tuple[str, ...] = _names_by_code(
+    {
+        kernels.LANDMARK_UPDATED: "updated",
+        kernels.LANDMARK_UNBOUNDED: "unbounded",
+        kernels.LANDMARK_INCONSISTENT: "inconsistent",
+        kernels.LANDMARK_SKIPPED: "skipped",
+        kernels.LANDMARK_MISSING: "missing",
+    }
 )
 LANDMARK_CODE = {name: code for code, name in enumerate(LANDMARK_STATUSES)}
 
