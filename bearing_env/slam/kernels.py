@@ -1551,15 +1551,6 @@ def check_indices(indices: np.ndarray, size: int, distinct: bool) -> int:
 
 
 @njit(**_JIT)
-def all_finite(values: np.ndarray) -> bool:
-    """Whether every element of a float array is finite (one pass, no temporaries)."""
-    for value in values.ravel():
-        if not np.isfinite(value):
-            return False
-    return True
-
-
-@njit(**_JIT)
 def none_infinite(values: np.ndarray) -> bool:
     """Whether no element of a float array is +-inf (NaN allowed; one pass)."""
     for value in values.ravel():
