@@ -8,8 +8,13 @@ them at the top, so they are left out of collection, and the report header says 
 from __future__ import annotations
 
 import pytest
+from hypothesis import settings
 
 from bearing_env.extras import available, install_command
+
+# Every run draws the same examples, and no example database carries state between runs.
+settings.register_profile("deterministic", derandomize=True, database=None)
+settings.load_profile("deterministic")
 
 #: Test modules that import the ``train`` extra (torch, stable-baselines3) at the top.
 NEEDS_TRAIN_EXTRA = (

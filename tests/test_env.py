@@ -74,6 +74,7 @@ def test_make_by_module_prefixed_id_without_importing_first() -> None:
         "for i in ('BearingSLAM-v0', 'BearingSLAMDiscrete-v0'):\n"
         "    env = gym.make('bearing_env:' + i, n_landmarks=8)\n"
         "    obs, _ = env.reset(seed=0)\n"
+        "    env.action_space.seed(0)\n"
         "    env.step(env.action_space.sample())\n"
         "# Rendering is optional: nothing imported pygame.\n"
         "assert 'pygame' not in sys.modules\n"
@@ -179,6 +180,7 @@ def test_pickle_round_trip_continues_identically(env_id: str) -> None:
 def _make_and_step(env_id: str) -> tuple[int, bool]:
     """Run in a spawned process: import, make, step."""
     env = gym.make(env_id)
+    env.action_space.seed(0)
     observation, _ = env.reset(seed=0)
     observation, *_ = env.step(env.action_space.sample())
     return observation.shape[0], bool(np.all(np.isfinite(observation)))
@@ -372,14 +374,17 @@ def test_return_telescopes(env_id: str, reward: str) -> None:
 
 def test_costs_are_named_parts_of_the_reward() -> None:
     env = BearingSLAMEnv(path_cost=0.5, move_cost=0.1)
+    env.action_space.seed(0)
     env.reset(seed=0)
     for _ in range(5):
-        _, reward, _, _, info = env.step(env.action_space.sample())
+        _, reward, terminated, truncated, info = env.step(env.action_space.sample())
         parts = info["rewards"]
         assert set(parts) == {"uncertainty", "path_cost", "move_cost"}
         assert parts["path_cost"] == pytest.approx(-0.5 * info["path_length"])
         assert parts["move_cost"] == pytest.approx(-0.1)
         assert reward == pytest.approx(sum(parts.values()))
+        if terminated or truncated:
+            env.reset()
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
@@ -400,6 +405,7 @@ def test_success_terminates(env_id: str) -> None:
 
 def test_truncation_after_max_moves() -> None:
     env = BearingSLAMEnv(max_moves=3, target_area=1e-9)
+    env.action_space.seed(0)
     env.reset(seed=0)
     flags = [env.step(env.action_space.sample())[2:4] for _ in range(3)]
     assert flags == [(False, False), (False, False), (False, True)]
@@ -591,6 +597,7 @@ def test_ppo_learns_a_few_hundred_steps(env_id: str) -> None:
 
 def test_a_landmark_count_range_draws_a_count_per_episode() -> None:
     env = gym.make("BearingSLAM-v0", n_landmarks=(4, 8))
+    env.action_space.seed(0)
     assert (
         env.observation_space.shape
         == gym.make("BearingSLAM-v0", n_landmarks=8).observation_space.shape
@@ -652,7 +659,8 @@ def test_continuous_actions_that_are_not_real_numbers_raise(action: Any) -> None
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_stepping_an_ended_episode_without_reset_raises(env_id: str) -> None:
-    env = gym.make(env_id, max_moves=2).unwrapped
+    env = gym.make(env_id, max_moves=2, target_area=1e-9).unwrapped
+    env.action_space.seed(0)
     env.reset(seed=0)
     action = env.action_space.sample()
     env.step(action)
@@ -767,6 +775,7 @@ def test_entity_observation_on_the_vector_env(env_id: str) -> None:
     batched = gym.make_vec(env_id, num_envs=3, **kwargs)
     reference = gym.make_vec(env_id, num_envs=3, vectorization_mode="sync", **kwargs)
     assert batched.observation_space == reference.observation_space
+    batched.action_space.seed(3)
     first, _ = batched.reset(seed=3)
     second, _ = reference.reset(seed=3)
     for _ in range(25):  # through an autoreset

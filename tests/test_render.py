@@ -74,6 +74,7 @@ def test_huge_regions_and_many_landmarks_render() -> None:
 
 def test_human_mode_draws_a_window_and_returns_none() -> None:
     env = gym.make("BearingSLAM-v0", render_mode="human")
+    env.action_space.seed(0)
     env.reset(seed=0)  # human mode renders on reset and step
     env.step(env.action_space.sample())
     assert env.render() is None
@@ -107,6 +108,7 @@ def test_record_video(tmp_path: os.PathLike[str]) -> None:
     env = gym.make("BearingSLAM-v0", scenario="khepera", render_mode="rgb_array")
     folder = os.path.join(tmp_path, "videos")
     env = RecordVideo(env, folder, episode_trigger=lambda episode: episode == 0)
+    env.action_space.seed(0)
     env.reset(seed=0)
     done = False
     while not done:

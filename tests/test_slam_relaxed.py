@@ -65,7 +65,7 @@ def brute_force(polygons: list[np.ndarray], max_outliers: int) -> tuple[float, i
     return 0.0, min(max_outliers, k - 1)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60, deadline=None, derandomize=True)
 @given(
     centers=st.lists(
         st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0)), min_size=1, max_size=6
@@ -95,7 +95,7 @@ def test_matches_a_brute_force_over_every_subset(
     assert shapely_polygon(vertices).area == pytest.approx(area, rel=1e-7)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60, deadline=None, derandomize=True)
 @given(
     truth=st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0)),
     n_consistent=st.integers(2, 5),
@@ -297,6 +297,7 @@ def test_env_fusion_change_gives_a_new_map() -> None:
     from bearing_env.envs import BearingSLAMEnv
 
     env = BearingSLAMEnv(scenario="khepera")
+    env.action_space.seed(0)
     env.reset(seed=0)
     env.step(env.action_space.sample())
     env.fusion = "relaxed"

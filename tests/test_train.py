@@ -115,6 +115,7 @@ def tiny_runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, TrainResult
 
 def _observations(env_id: str, count: int = 16) -> np.ndarray:
     env = gym.make(env_id, scenario="khepera")
+    env.action_space.seed(0)
     observations = []
     obs, _ = env.reset(seed=VALIDATION_SEED_START)
     for _ in range(count):
