@@ -155,17 +155,20 @@ def run_sweep(
     with ray_session(address):
         tune = require("ray.tune", "a Ray Tune sweep", extra="ray")
         param_space = tune_param_space(sweep)
+        # The class, not the name "PPO": resolving a name makes RLlib import every
+        # algorithm, and DreamerV3's module builds a debugging env that warns.
+        ppo = require("ray.rllib.algorithms.ppo", "a Ray Tune sweep", extra="ray").PPO
         if resume:
             if not tune.Tuner.can_restore(str(experiment)):
                 raise ValueError(f"cannot resume: {out} holds no sweep; drop --resume")
             tuner = tune.Tuner.restore(
-                str(experiment), trainable="PPO", param_space=param_space, resume_errored=True
+                str(experiment), trainable=ppo, param_space=param_space, resume_errored=True
             )
         else:
             if experiment.exists():
                 raise FileExistsError(f"{out} already holds a sweep; pass --resume to finish it")
             tuner = tune.Tuner(
-                "PPO",
+                ppo,
                 param_space=param_space,
                 run_config=tune.RunConfig(
                     name=TUNE_NAME,
