@@ -65,3 +65,17 @@ def test_hyperparams_rejects_an_algorithm_without_a_file(tmp_path) -> None:
     result = hyperparams_command("td3", tmp_path)
     assert result.returncode == 2
     assert "'td3'" in result.stderr and "dqn, ppo, ppo_entities, sac" in result.stderr
+
+
+def test_compare_help_names_every_policy_kind() -> None:
+    from bearing_env.agents.registry import POLICY_CLASSES
+    from bearing_env.train.compare import build_parser
+
+    epilog = " ".join((build_parser().epilog or "").split())
+    # One name per kind: the shortest of the names that build the same class.
+    shortest = {}
+    for name, cls in POLICY_CLASSES.items():
+        if cls not in shortest or len(name) < len(shortest[cls]):
+            shortest[cls] = name
+    missing = [name for name in shortest.values() if name not in epilog]
+    assert missing == []

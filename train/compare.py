@@ -87,7 +87,7 @@ from bearing_env.train.seeds import EVAL_SEED_START
 
 from bearing_env.extras import DISTRIBUTIONS, install_command
 
-DEFAULT_POLICIES: tuple[str, ...] = ("random", "parallax", "greedy", "oracle")
+DEFAULT_POLICIES: tuple[str, ...] = ("random", "parallax", "greedy", "oracle", "lookahead")
 
 QUICK_POLICIES: tuple[str, ...] = ("random", "parallax", "greedy")
 
@@ -101,8 +101,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="bearing-env compare",
         description="Compare exploration policies on the same evaluation episodes.",
         epilog=(
-            "Policy specs: random, parallax, greedy, oracle, sb3:path=MODEL.zip, with options "
-            "as NAME:key=value,... (e.g. random:length=0.25, greedy:n_turns=16). "
+            "Policy specs: random, parallax, greedy, oracle, lookahead, lookahead_oracle, "
+            "pretrained:NAME, sb3:path=MODEL.zip, with options as NAME:key=value,... "
+            "(e.g. random:length=0.25, greedy:n_turns=16, lookahead:depth=3). "
             f"Evaluation seeds start at {EVAL_SEED_START:,}; training seeds stay below."
         ),
     )
