@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import pytest
 from bearing_env.train import cli
-from bearing_env.train.cli_values import parse_key_values
+from bearing_env.train.cli_values import format_key_values, parse_key_values
 from bearing_env.train.compare import main
 from bearing_env.train.compare_config import CompareConfig, policies_from_specs
 from bearing_env.train.compare_log import LOG_NAME, EpisodeLog
@@ -211,6 +211,14 @@ def test_env_kwargs_and_policy_labels_parse() -> None:
         "random_polygonal#2",
         "random_polygonal[length=0.25]",
     ]
+
+
+def test_env_kwargs_format_back_to_what_parses() -> None:
+    values = {"scenario": "random", "n_landmarks": [3, 12], "move_length": (0.05, 0.3),
+              "label": "4", "noise": {"outlier_rate": 0.05}, "flag": None}  # fmt: skip
+    items = format_key_values(values)
+    assert items[0] == "scenario=random" and items[3] == "label='4'"
+    assert parse_key_values(items, "--env-kwargs") == values
 
 
 def test_command_line_runs_and_resumes(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -34,6 +34,17 @@ def parse_key_values(pairs: Sequence[str], option: str) -> dict[str, Any]:
     return parsed
 
 
+def format_key_values(values: dict[str, Any]) -> list[str]:
+    """``{"k": v}`` -> ``["k=v", ...]``, which ``parse_key_values`` reads back to ``values``
+    (strings bare when they are not literals, everything else as its repr)."""
+    return [
+        f"{key}={value}"
+        if isinstance(value, str) and parse_literal(value) == value
+        else f"{key}={value!r}"
+        for key, value in values.items()
+    ]
+
+
 def json_safe(value: Any) -> Any:
     """Settings as JSON: dicts (string keys) and lists kept, tuples as lists, numbers,
     strings, bools and None as they are, anything else (a schedule, a class) as its repr."""

@@ -7,9 +7,10 @@ median total area after 10 moves per policy and count.
     python -m bearing_env.train.generalisation --model ppo_random --counts 3 4 6 8 10 --episodes 50
 
 The total area is summed over the mapped landmarks (L3, L4, ...), so it grows with the
-count; compare policies within a column. ``--max-landmarks`` must equal the observation
-slots the model was trained with. It needs the ``train`` extra (the shipped model runs
-on stable-baselines3); without it, it says so in one line and exits with status 2.
+count; compare policies within a column. Every count runs with the env kwargs the model
+was trained with (its observation kind and ``max_landmarks`` slots), the landmark count
+and the random scenario aside. It needs the ``train`` extra (the shipped model runs on
+stable-baselines3); without it, it says so in one line and exits with status 2.
 """
 
 from __future__ import annotations
@@ -19,7 +20,10 @@ import json
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
+from bearing_env.agents.sb3 import pretrained_names, pretrained_record
+from bearing_env.train.cli_values import format_key_values
 from bearing_env.train.errors import MissingExtraError, fail
 
 from bearing_env.extras import available
@@ -27,27 +31,31 @@ from bearing_env.extras import available
 DEFAULT_BASELINES = ("random", "parallax", "greedy")
 
 
+def env_kwargs_for_count(trained: dict[str, Any], count: int) -> dict[str, Any]:
+    """The model's training env kwargs on a random layout of ``count`` landmarks."""
+    return {**trained, "scenario": "random", "n_landmarks": count}
+
+
 def run_counts(
     model: str,
     counts: list[int],
     episodes: int,
-    max_landmarks: int,
     workers: int,
     out: Path,
     resume: bool,
 ) -> dict[int, dict[str, float]]:
     """Median total area after 10 moves, per landmark count and policy label."""
+    trained = dict(pretrained_record(model).get("env_kwargs", {}))
     medians: dict[int, dict[str, float]] = {}
     for count in counts:
         folder = out / f"n{count}"
+        env_kwargs = env_kwargs_for_count(trained, count)
         command = [
             sys.executable,
             "-m",
             "bearing_env.train.compare",
             "--env-kwargs",
-            "scenario=random",
-            f"n_landmarks={count}",
-            f"max_landmarks={max_landmarks}",
+            *format_key_values(env_kwargs),
             "--policies",
             *DEFAULT_BASELINES,
             f"pretrained:{model}",
@@ -75,13 +83,19 @@ def main() -> None:
     parser.add_argument("--model", default="ppo_random", help="shipped model name")
     parser.add_argument("--counts", type=int, nargs="+", default=[3, 4, 6, 8, 10])
     parser.add_argument("--episodes", type=int, default=50)
-    parser.add_argument("--max-landmarks", type=int, default=10)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", type=Path, default=Path("outputs/generalisation"))
     parser.add_argument("--resume", action="store_true", help="continue interrupted counts")
     args = parser.parse_args()
-    if min(args.counts) < 3 or max(args.counts) > args.max_landmarks:
-        parser.error(f"--counts must lie in [3, --max-landmarks={args.max_landmarks}]")
+    if args.model not in pretrained_names():
+        parser.error(f"unknown model {args.model!r}; shipped: {', '.join(pretrained_names())}")
+    trained = pretrained_record(args.model).get("env_kwargs", {})
+    max_landmarks = int(trained.get("max_landmarks", max(trained.get("n_landmarks", [3]))))
+    if min(args.counts) < 3 or max(args.counts) > max_landmarks:
+        parser.error(
+            f"--counts must lie in [3, {max_landmarks}]: {args.model} has "
+            f"max_landmarks={max_landmarks} observation slots"
+        )
     for module in ("stable_baselines3", "torch", "rich"):
         if not available(module):
             fail(parser.prog, str(MissingExtraError(module, "this command")))
@@ -89,9 +103,8 @@ def main() -> None:
     from rich.table import Table
 
     medians = run_counts(
-        args.model, args.counts, args.episodes, args.max_landmarks, args.workers, args.out,
-        args.resume,
-    )  # fmt: skip
+        args.model, args.counts, args.episodes, args.workers, args.out, args.resume
+    )
     labels = list(next(iter(medians.values())))
     table = Table(title="median total area after 10 moves, random layouts (evaluation seeds)")
     table.add_column("landmarks")
