@@ -3,8 +3,11 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
+# mypy reads the package as it installs: agents/, train/ and benchmarks/ are subpackages
+# of bearing_env (setuptools package-dir), so the view links them in under that name.
+TYPECHECK_VIEW := $(VENV)/typecheck
 
-.PHONY: test demo lint bench bench-slam clean
+.PHONY: test demo lint typecheck bench bench-slam clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -14,9 +17,7 @@ $(STAMP): pyproject.toml constraints.txt
 	$(PY) -m pip install --quiet -c constraints.txt -e ".[render,train,dev,ray]"
 	touch $(STAMP)
 
-test: $(STAMP)
-	$(PY) -m ruff check bearing_env agents train tests benchmarks
-	$(PY) -m mypy bearing_env agents
+test: lint typecheck
 	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m "not slow"
 
 demo: $(STAMP)
@@ -31,6 +32,13 @@ bench-slam: $(STAMP)
 
 lint: $(STAMP)
 	$(PY) -m ruff check bearing_env agents train tests benchmarks
+
+typecheck: $(STAMP)
+	rm -rf $(TYPECHECK_VIEW) && mkdir -p $(TYPECHECK_VIEW)/bearing_env
+	ln -s $(CURDIR)/bearing_env/* $(CURDIR)/agents $(CURDIR)/train $(CURDIR)/benchmarks \
+		$(TYPECHECK_VIEW)/bearing_env/
+	cd $(TYPECHECK_VIEW) && $(CURDIR)/$(PY) -m mypy --config-file $(CURDIR)/pyproject.toml \
+		--cache-dir $(CURDIR)/.mypy_cache -p bearing_env
 
 clean:
 	rm -rf $(VENV) .pytest_cache .hypothesis build *.egg-info

@@ -13,7 +13,7 @@ import sys
 import tempfile
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import gymnasium as gym
 import numpy as np
@@ -354,7 +354,9 @@ def print_table(results: dict[str, Any]) -> None:
             if console.width >= needed:
                 table = Table(title=references_line(results))
                 for index, name in enumerate(TABLE_HEADER):
-                    justify = "right" if index in NUMERIC_COLUMNS else "left"
+                    justify: Literal["right", "left"] = (
+                        "right" if index in NUMERIC_COLUMNS else "left"
+                    )
                     table.add_column(name, justify=justify, no_wrap=True)
                 for row in rows:
                     table.add_row(*row)

@@ -110,7 +110,7 @@ def timed_figure(bench: Bench, run: Callable[[], tuple[int, float]]) -> dict[str
 
 def single_env_cases(landmarks: Sequence[int]) -> list[tuple[str, dict[str, Any], bool]]:
     """(name, env kwargs, unwrapped) of the single-env rows."""
-    cases = [("khepera", {"scenario": "khepera"}, True)]
+    cases: list[tuple[str, dict[str, Any], bool]] = [("khepera", {"scenario": "khepera"}, True)]
     for n in landmarks:
         cases.append(
             (f"random_{n}", {"scenario": "random", "n_landmarks": n, "max_landmarks": n}, True)
@@ -129,8 +129,9 @@ def run_single_env(
 ) -> tuple[int, float, int]:
     """Step ``env`` with seeded random actions for ``seconds``: (steps, seconds, resets)."""
     rng = np.random.default_rng(seed)
-    low = env.action_space.low
-    high = env.action_space.high
+    box = env.action_space
+    assert isinstance(box, gym.spaces.Box), "the bench steps the continuous id"
+    low, high = box.low, box.high
     env.reset(seed=seed)
     env.step(rng.uniform(low, high).astype(np.float32))  # warm-up, not timed
     env.reset(seed=seed)
@@ -305,7 +306,9 @@ def run_vector_env(
     if space is not None:
         low, high = space.low, space.high
     else:
-        low, high = venv.action_space.low[0], venv.action_space.high[0]
+        box = venv.action_space
+        assert isinstance(box, gym.spaces.Box), "the bench steps the continuous id"
+        low, high = box.low[0], box.high[0]
     shape = (num_envs, *low.shape)
     mode = autoreset_mode(venv)
     venv.reset(seed=seed)

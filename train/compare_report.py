@@ -311,7 +311,7 @@ def plot_curves(summary: Mapping[str, Any], config: CompareConfig, out: Path) ->
     from matplotlib.ticker import MaxNLocator
 
     written = []
-    colours = plt.get_cmap("tab10").colors
+    colours = plt.get_cmap("tab10").colors  # type: ignore[attr-defined]  # a ListedColormap
     env_text = ", ".join(f"{k}={v}" for k, v in config.env_kwargs.items())
     for metric, ylabel, filename in (
         ("area", "total area (FL units², log)", "area_vs_moves.png"),

@@ -38,6 +38,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+from bearing_env.agents.env_access import bearing_env_of
 from bearing_env.train.compare_config import CompareConfig, json_normalised
 
 
@@ -64,7 +65,7 @@ def run_episode(policy: Any, env: gym.Env, seed: int) -> dict[str, Any]:
     initialised landmarks, or None), ``contained`` (initialised landmarks whose region
     holds the truth).
     """
-    base = env.unwrapped
+    base = bearing_env_of(env)
     area_cap = float(base.area_cap)
     observation, info = env.reset(seed=seed)
     policy.reset(seed=seed)

@@ -37,14 +37,22 @@ def random_polygonal_action(rng: np.random.Generator) -> NDArray[np.float32]:
     return np.array([rng.uniform(-1.0, 1.0), 1.0], dtype=np.float32)
 
 
+def rendered_frame(env: gym.Env) -> NDArray[np.uint8]:
+    """The env's ``rgb_array`` frame (TypeError if it renders no array)."""
+    frame = env.render()
+    if not isinstance(frame, np.ndarray):
+        raise TypeError(f"expected an rgb_array frame from render(), got {type(frame).__name__}")
+    return frame
+
+
 def run_episode(
     env: gym.Env, seed: int, moves: int, record: bool
 ) -> tuple[list[dict[str, float]], list[NDArray[np.uint8]]]:
     """One episode; returns per-move metrics and (if ``record``) the rendered frames."""
     policy_rng = np.random.default_rng(seed + 10_000)
     _, info = env.reset(seed=seed)
-    frames = [env.render()] if record else []
-    rows = []
+    frames: list[NDArray[np.uint8]] = [rendered_frame(env)] if record else []
+    rows: list[dict[str, float]] = []
     for move in range(1, moves + 1):
         _, reward, terminated, truncated, info = env.step(random_polygonal_action(policy_rng))
         errors = info["landmark_error"]
@@ -60,7 +68,7 @@ def run_episode(
             }
         )
         if record:
-            frames.append(env.render())
+            frames.append(rendered_frame(env))
         if terminated or truncated:
             break
     return rows, frames

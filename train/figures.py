@@ -105,6 +105,7 @@ def random_polygonal_trace(
 ) -> Trace:
     """Run the random polygonal policy for ``moves`` movements and record the map."""
     from bearing_env.agents import RandomPolygonal
+    from bearing_env.agents.env_access import bearing_env_of, world_of
 
     from bearing_env.envs.bearing_slam import BEARING_FEATURES, observation_slices
     from bearing_env.slam import world_to_fl
@@ -112,12 +113,12 @@ def random_polygonal_trace(
     # The paper's runs have a fixed number of movements: no early stop on success.
     kwargs = {"target_area": NEVER_SUCCEEDS, **env_kwargs, "max_moves": moves}
     env = make_env("bearing_env:BearingSLAM-v0", kwargs)
-    base = env.unwrapped
+    base = bearing_env_of(env)
     policy = RandomPolygonal(env)
     bearing_block = observation_slices(base.max_landmarks)["bearings"]
     observation, info = env.reset(seed=seed)
     policy.reset(seed=seed)
-    world = base.world
+    world = world_of(env)
     l1, l2 = world.landmarks[0], world.landmarks[1]
     areas, errors, bearings, polygons, estimates, trajectory = [], [], [], [], [], []
     contains = []
@@ -129,11 +130,12 @@ def random_polygonal_trace(
         block = obs[bearing_block].reshape(-1, len(BEARING_FEATURES))[: base.n_landmarks]
         bearings.append(np.arctan2(block[:, 2], block[:, 1]).astype(float))
         slam = base.slam
+        assert slam is not None  # the env has been reset
         polygons.append(
             [None if p is None else p.copy() for p in slam.polygons] if keep_polygons else []
         )
         estimates.append(slam.estimates.copy())
-        trajectory.append(world_to_fl(base.world.position, l1, l2))
+        trajectory.append(world_to_fl(world.position, l1, l2))
 
     record(observation, info)
     for _ in range(moves):
@@ -263,8 +265,8 @@ def figure7(
             axes.annotate(
                 name, truth[index], xytext=(-6, -16), textcoords="offset points", fontsize=10
             )
-        path = trace.trajectory_fl[: movement + 1]
-        for start, end in itertools.pairwise(path):
+        path_fl = trace.trajectory_fl[: movement + 1]
+        for start, end in itertools.pairwise(path_fl):
             axes.annotate(
                 "", end, start, arrowprops={"arrowstyle": "->", "color": "0.35", "lw": 1.1}
             )

@@ -259,8 +259,9 @@ def train(settings: TrainSettings) -> TrainResult:
     try:
         if hyperparams.normalize is not None:
             if checkpoint is not None and checkpoint.vecnormalize_path.is_file():
-                venv = load_vecnormalize(checkpoint.vecnormalize_path, venv)
-                venv.training = True
+                resumed = load_vecnormalize(checkpoint.vecnormalize_path, venv)
+                resumed.training = True
+                venv = resumed
             else:
                 venv = VecNormalize(venv, **hyperparams.normalize)
             eval_normalize = {**hyperparams.normalize, "training": False, "norm_reward": False}

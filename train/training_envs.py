@@ -6,7 +6,7 @@ the same validation episodes (``bearing_env.train.seeds``) at every evaluation.
 from __future__ import annotations
 
 import signal
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, SupportsFloat
@@ -135,7 +135,7 @@ def make_training_env(
     if vec_env_kind == "batched":
         monitor_path = None if monitor_dir is None else str(monitor_dir / "batched")
         return make_batched_vec_env(env_id, env_kwargs, n_envs, monitor_path)
-    factories = [
+    factories: list[Callable[[], gym.Env[Any, Any]]] = [
         EnvFactory(
             env_id=env_id,
             env_kwargs=dict(env_kwargs),

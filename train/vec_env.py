@@ -283,7 +283,11 @@ class GymnasiumVecEnv(VecEnv):
     def reset(self) -> VecEnvObs:
         seeds = list(self._seeds)
         seed: list[int | None] | None = None if all(s is None for s in seeds) else seeds
-        observations, infos = self.vector_env.reset(seed=seed, options=self._shared_options())
+        # Vector envs take one seed per sub-env; gymnasium types the argument as one int.
+        observations, infos = self.vector_env.reset(
+            seed=seed,  # type: ignore[arg-type]
+            options=self._shared_options(),
+        )
         self.reset_infos = unbatch_infos(infos, self.num_envs)
         # Seeds and options are used once, as in DummyVecEnv: later episodes run on.
         self._reset_seeds()
@@ -451,7 +455,7 @@ class GymnasiumVecEnv(VecEnv):
         frames = self.vector_env.render()
         if frames is None:
             return [None for _ in range(self.num_envs)]
-        return list(frames)
+        return [np.asarray(frame) for frame in frames]
 
     def render(self, mode: str | None = None) -> np.ndarray | None:
         """SB3's rendering: the frames of :meth:`get_images` tiled into one image for
