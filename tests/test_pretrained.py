@@ -12,7 +12,7 @@ from bearing_env.agents import SB3Policy, pretrained_names, pretrained_record
 
 import bearing_env  # noqa: F401  (registers the ids)
 
-SHIPPED = ("ppo_khepera", "ppo_random")
+SHIPPED = ("ppo_khepera", "ppo_random", "ppo_generalist")
 
 
 def test_the_shipped_models_are_listed() -> None:
@@ -35,6 +35,27 @@ def test_a_shipped_model_acts_on_the_env_of_its_record(name: str) -> None:
         observation, _, terminated, truncated, info = env.step(action)
         done, moves = terminated or truncated, moves + 1
     assert moves >= 1 and np.isfinite(info["total_area"])
+    env.close()
+
+
+@pytest.mark.parametrize("count", [3, 16])
+def test_the_generalist_runs_on_counts_outside_its_training_range(count: int) -> None:
+    # Trained on 3 to 12 landmarks; its deep set reads any count up to max_landmarks.
+    record = pretrained_record("ppo_generalist")
+    assert record["env_kwargs"]["n_landmarks"] == [3, 12]
+    assert record["env_kwargs"]["max_landmarks"] == 16
+    env = gym.make(record["env_id"], **{**record["env_kwargs"], "n_landmarks": count})
+    policy = SB3Policy.pretrained("ppo_generalist", env)
+    policy.reset(seed=0)
+    observation, info = env.reset(seed=1_000_000)
+    first_area = info["total_area"]
+    for _ in range(10):
+        observation, _, terminated, truncated, info = env.step(policy.act(observation, info))
+        if terminated or truncated:
+            break
+    assert len(info["landmark_area"]) == count - 2
+    assert np.all(np.isfinite(info["landmark_area"]))  # every landmark got a region
+    assert info["total_area"] < first_area
     env.close()
 
 

@@ -73,13 +73,13 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--out outputs/compare_khepera_discrete": ("parse", ()),
     "bearing-env compare --episodes 100 --workers 2 --env-kwargs scenario=random "
     "n_landmarks=6 --out outputs/compare_random6": ("parse", ()),
-    "bearing-env train --algo ppo --env BearingSLAM-v0 --timesteps 600000 --seed 0 "
+    "bearing-env train --algo ppo --env BearingSLAM-v0 --seed 0 --eval-freq 250000 "
     "--output runs/ppo_khepera": ("parse", ()),
     "bearing-env train --algo ppo --output runs/ppo_khepera --export "
     "agents/pretrained/ppo_khepera --export-only": ("parse", ()),
     "bearing-env train --algo ppo --env BearingSLAM-v0 --env-kwargs scenario=random "
-    '"n_landmarks=(4,8)" max_landmarks=10 --timesteps 400000 --seed 1 '
-    "--output runs/ppo_random": ("parse", ()),
+    '"n_landmarks=(4,8)" max_landmarks=10 --hyperparams n_envs=8 batch_size=256 gamma=0.99 '
+    "--timesteps 400000 --seed 1 --output runs/ppo_random": ("parse", ()),
     "bearing-env train --algo ppo --output runs/ppo_random --export "
     "agents/pretrained/ppo_random --export-only": ("parse", ()),
     "python -m bearing_env.train.generalisation --model ppo_random --counts 3 4 6 8 10 "
@@ -89,14 +89,11 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 "
     '--conf-file "$(bearing-env hyperparams ppo_entities)"': ("parse", ()),
     'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_entities)" '
-    "--output runs/ppo_entities": ("parse", ()),
-    'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_entities)" '
-    "--timesteps 300000 --seed 0 --output runs/ppo_entities_pilot --eval-freq 25000 "
-    "--eval-episodes 50": ("parse", ()),
-    "bearing-env compare --policies greedy "
-    "sb3:path=runs/ppo_entities_pilot/best/best_model.zip --env-kwargs scenario=random "
-    "n_landmarks=8 max_landmarks=16 observation=entities --episodes 60 "
-    "--out outputs/compare_entities8": ("parse", ()),
+    "--seed 0 --eval-freq 100000 --output runs/ppo_generalist": ("parse", ()),
+    "bearing-env train --algo ppo --output runs/ppo_generalist --export "
+    "agents/pretrained/ppo_generalist --export-only": ("parse", ()),
+    "python -m bearing_env.train.generalisation --model ppo_generalist --counts 3 8 12 16 "
+    "--episodes 200": ("parse", ()),
     "bearing-env compare --policies greedy oracle lookahead lookahead_oracle --episodes 200 "
     "--workers 2 --out outputs/compare_lookahead": ("parse", ()),
     "bearing-env figures --only robust --out docs/figures": ("parse", ()),
