@@ -38,6 +38,36 @@ def test_a_shipped_model_acts_on_the_env_of_its_record(name: str) -> None:
     env.close()
 
 
+@pytest.mark.parametrize("name", SHIPPED)
+def test_a_shipped_model_acts_alike_on_the_vector_env(name: str) -> None:
+    # Sub-env i of the batched vector env acts as the single env seeded seed + i does.
+    from bearing_env.agents import VectorPolicy
+
+    record = pretrained_record(name)
+    vector_env = gym.make_vec(record["env_id"], num_envs=2, **record["env_kwargs"])
+    policy = VectorPolicy(vector_env, lambda env: SB3Policy.pretrained(name, env))
+    observations, infos = vector_env.reset(seed=1_000_000)
+    policy.reset(seed=1_000_000)
+    batches = []
+    for _ in range(3):
+        batch = policy.act(observations, infos)
+        assert vector_env.action_space.contains(batch)
+        batches.append(np.asarray(batch))
+        observations, _, _, _, infos = vector_env.step(batch)
+    single = gym.make(record["env_id"], **record["env_kwargs"])
+    for row in range(2):
+        one = SB3Policy.pretrained(name, single)
+        one.reset(seed=1_000_000 + row)
+        observation, info = single.reset(seed=1_000_000 + row)
+        for batch in batches:
+            action = one.act(observation, info)
+            np.testing.assert_allclose(np.asarray(action), batch[row], rtol=1e-5, atol=1e-6)
+            observation, _, terminated, truncated, info = single.step(action)
+            if terminated or truncated:
+                break
+    vector_env.close()
+
+
 @pytest.mark.parametrize("count", [3, 16])
 def test_the_generalist_runs_on_counts_outside_its_training_range(count: int) -> None:
     # Trained on 3 to 12 landmarks; its deep set reads any count up to max_landmarks.
