@@ -496,8 +496,15 @@ def test_shipped_hyperparameters_parse(algo: str, env_id: str) -> None:
     constructor_kwargs = {k: v for k, v in parsed.algorithm_kwargs.items() if k != "policy"}
     if algo != "ppo":
         constructor_kwargs["buffer_size"] = 10  # the model builds, without a big buffer
+    else:  # every update's rollout splits into whole mini-batches
+        rollout = parsed.algorithm_kwargs["n_steps"] * parsed.n_envs
+        assert rollout % parsed.algorithm_kwargs["batch_size"] == 0
+    from stable_baselines3.common.env_util import make_vec_env
+
+    venv = make_vec_env(env_id, n_envs=parsed.n_envs, env_kwargs=parsed.env_kwargs)
     algorithm_class = algorithm_class_for(algo)
-    algorithm_class(parsed.algorithm_kwargs["policy"], env_id, device="cpu", **constructor_kwargs)
+    algorithm_class(parsed.algorithm_kwargs["policy"], venv, device="cpu", **constructor_kwargs)
+    venv.close()
 
 
 def test_hyperparameters_are_preprocessed_by_rl_zoo3() -> None:
