@@ -99,6 +99,7 @@ def test_generalisation_table_covers_every_policy_and_count(tmp_path: Path) -> N
     assert set(medians) == {"3"}
     assert set(medians["3"]) == {"random_polygonal", "parallax", "greedy_one_step", "ppo_random"}
     assert all(np.isfinite(v) and v > 0 for v in medians["3"].values())
+    assert (out / "generalisation.png").stat().st_size > 10_000
 
 
 def test_generalisation_rejects_counts_beyond_the_observation_slots() -> None:

@@ -93,7 +93,9 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env train --algo ppo --output runs/ppo_generalist --export "
     "agents/pretrained/ppo_generalist --export-only": ("parse", ()),
     "python -m bearing_env.train.generalisation --model ppo_generalist --counts 3 8 12 16 "
-    "--episodes 200": ("parse", ()),
+    "--episodes 200 --out outputs/generalisation_generalist": ("parse", ()),
+    "cp outputs/generalisation_generalist/generalisation.png "
+    "docs/compare/generalisation_generalist.png": ("copy", ()),
     "bearing-env compare --policies greedy oracle lookahead lookahead_oracle --episodes 200 "
     "--workers 2 --out outputs/compare_lookahead": ("parse", ()),
     "bearing-env figures --only robust --out docs/figures": ("parse", ()),
@@ -230,8 +232,9 @@ def test_readme_command_runs_or_parses(command: str, tmp_path: Path) -> None:
         source, destination = Path(argv[1]), Path(argv[2])
         assert (ROOT / destination.parent).is_dir()
         out_option = f"--out {source.parent}"
-        producers = [c for c in CHECKS if c.startswith("bearing-env compare") and out_option in c]
-        assert producers, f"no README compare command writes {source}"
+        writers = ("bearing-env compare", "python -m bearing_env.train.generalisation")
+        producers = [c for c in CHECKS if c.startswith(writers) and out_option in c]
+        assert producers, f"no README command writes {source}"
     elif kind == "parse":
         _parse(argv + list(extra))
     elif kind == "help":

@@ -1,8 +1,11 @@
 """How a policy trained on random layouts generalises across landmark counts.
 
 Runs ``bearing-env compare`` on random layouts (evaluation seeds, unseen in training) for
-each landmark count, including counts the policy never saw, and prints one table of the
-median total area after 10 moves per policy and count.
+each landmark count, including counts the policy never saw, prints one table of the
+median total area after 10 moves per policy and count, and writes it to
+``generalisation.json`` with a plot, ``generalisation.png`` (the medians against the count,
+and each policy's median over GreedyOneStep's but random polygonal's, with the model's
+training range shaded).
 
     python -m bearing_env.train.generalisation --model ppo_random --counts 3 4 6 8 10 --episodes 50
 
@@ -25,10 +28,13 @@ from typing import Any
 from bearing_env.agents.sb3 import pretrained_names, pretrained_record
 from bearing_env.train.cli_values import format_key_values
 from bearing_env.train.errors import MissingExtraError, fail
+from bearing_env.train.files import write_json_atomically
 
 from bearing_env.extras import available
 
 DEFAULT_BASELINES = ("random", "parallax", "greedy")
+#: The label the ratio panel divides by (GreedyOneStep's report label).
+REFERENCE_LABEL = "greedy_one_step"
 
 
 def env_kwargs_for_count(trained: dict[str, Any], count: int) -> dict[str, Any]:
@@ -78,6 +84,49 @@ def run_counts(
     return medians
 
 
+def trained_count_range(trained: dict[str, Any]) -> tuple[int, int]:
+    """The lowest and highest landmark count of the model's training layouts."""
+    counts = trained.get("n_landmarks", 4)
+    if isinstance(counts, int):
+        return counts, counts
+    low, high = counts
+    return int(low), int(high)
+
+
+def plot_medians(
+    medians: dict[int, dict[str, float]], model: str, trained_counts: tuple[int, int], path: Path
+) -> Path:
+    """The medians against the landmark count (log scale) and over GreedyOneStep's."""
+    from bearing_env.train.figures import _plt, save_and_close
+
+    plt = _plt()
+    counts = sorted(medians)
+    labels = list(medians[counts[0]])
+    figure, (areas, ratios) = plt.subplots(1, 2, figsize=(10, 4))
+    for axes in (areas, ratios):
+        axes.axvspan(*trained_counts, color="0.9", label=f"{model}'s training range")
+    colours = plt.get_cmap("tab10").colors
+    for index, label in enumerate(labels):
+        values = [medians[count][label] for count in counts]
+        style = {"linewidth": 2.5 if label == model else 1.2, "color": colours[index % 10]}
+        areas.plot(counts, values, marker="o", label=label, **style)
+        # Random polygonal is several times above the rest: it would flatten that panel.
+        if REFERENCE_LABEL in medians[counts[0]] and label != "random_polygonal":
+            reference = [medians[count][REFERENCE_LABEL] for count in counts]
+            ratio = [value / ref for value, ref in zip(values, reference, strict=True)]
+            ratios.plot(counts, ratio, marker="o", label=label, **style)
+    areas.set_yscale("log")
+    areas.set_xlabel("landmarks")
+    areas.set_ylabel("median total area after 10 moves (FL units², log)")
+    areas.legend(fontsize=8)
+    ratios.axhline(1.0, color="0.4", linewidth=0.8, linestyle="--")
+    ratios.set_xlabel("landmarks")
+    ratios.set_ylabel(f"median ÷ {REFERENCE_LABEL}'s")
+    ratios.legend(fontsize=8)
+    figure.suptitle(f"{model} across landmark counts: random layouts, evaluation seeds")
+    return save_and_close(figure, path, rect=(0, 0, 1, 0.94))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", default="ppo_random", help="shipped model name")
@@ -96,7 +145,7 @@ def main() -> None:
             f"--counts must lie in [3, {max_landmarks}]: {args.model} has "
             f"max_landmarks={max_landmarks} observation slots"
         )
-    for module in ("stable_baselines3", "torch", "rich"):
+    for module in ("stable_baselines3", "torch", "rich", "matplotlib"):
         if not available(module):
             fail(parser.prog, str(MissingExtraError(module, "this command")))
     from rich.console import Console
@@ -113,7 +162,11 @@ def main() -> None:
     for count, row in medians.items():
         table.add_row(str(count), *(f"{row[label]:.3g}" for label in labels))
     Console().print(table)
-    (args.out / "generalisation.json").write_text(json.dumps(medians, indent=1))
+    write_json_atomically(args.out / "generalisation.json", {str(k): v for k, v in medians.items()})
+    figure = plot_medians(
+        medians, args.model, trained_count_range(trained), args.out / "generalisation.png"
+    )
+    print(f"wrote {args.out / 'generalisation.json'} and {figure}")
 
 
 if __name__ == "__main__":
