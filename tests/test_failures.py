@@ -14,7 +14,12 @@ from typing import Any
 import pytest
 from bearing_env.train import compare, compare_log, compare_report
 from bearing_env.train.compare_log import LOG_NAME, CorruptLogError, EpisodeLog
-from bearing_env.train.errors import EXIT_ERROR, os_error_message, with_path
+from bearing_env.train.errors import (
+    EXIT_ERROR,
+    exit_on_output_errors,
+    os_error_message,
+    with_path,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -60,6 +65,47 @@ def a_file(tmp_path: Path) -> Path:
 # --------------------------------------------------------------------------------------
 # The message itself
 # --------------------------------------------------------------------------------------
+
+
+class Refused(Exception):
+    """A command's own refusal, such as a resume that does not match."""
+
+
+@pytest.mark.parametrize(
+    ("raised", "expected", "usage"),
+    [
+        (FileExistsError("out holds a run; pass --resume"), "out holds a run; pass --resume", True),
+        (Refused("the log does not match"), "the log does not match", False),
+        (OSError(errno.ENOSPC, "No space left on device", "out/x.json"),
+         "cannot write out/x.json: No space left on device", False),
+        (FileExistsError(errno.EEXIST, "File exists", "out/x"), "cannot write out/x: File exists",
+         False),
+    ],
+)  # fmt: skip
+def test_output_errors_end_the_command_with_status_2(
+    raised: Exception, expected: str, usage: bool, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="bearing-env x")
+    with pytest.raises(SystemExit) as exit_info:
+        with exit_on_output_errors(parser, Path("out"), "--out", (Refused,)):
+            raise raised
+    assert exit_info.value.code == EXIT_ERROR
+    err = capsys.readouterr().err
+    assert ("usage: bearing-env x" in err) == usage
+    assert expected in err and "Traceback" not in err
+
+
+def test_output_errors_let_interrupts_and_other_errors_through() -> None:
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="bearing-env x")
+    for raised in (KeyboardInterrupt(), RuntimeError("a bug")):
+        with pytest.raises(type(raised)):
+            with exit_on_output_errors(parser, Path("out"), "--out"):
+                raise raised
+
 
 
 def test_the_message_names_the_path_and_the_reason() -> None:

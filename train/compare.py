@@ -78,10 +78,10 @@ from bearing_env.train.compare_runner import EXECUTORS, executor_named, make_env
 from bearing_env.train.comparison import RunMismatchError, run_comparison
 from bearing_env.train.errors import (
     available,
+    exit_on_output_errors,
     fail,
     missing_extra,
     require,
-    write_error_message,
 )
 from bearing_env.train.seeds import EVAL_SEED_START
 
@@ -306,26 +306,19 @@ def main(argv: Sequence[str] | None = None) -> None:
     command = reproducing_command(sys.argv[1:] if argv is None else list(argv))
     started = time.perf_counter()
     try:
-        result = run_comparison(
-            config,
-            out,
-            workers=args.workers,
-            resume=args.resume,
-            overwrite=args.overwrite or args.quick,
-            stop_after=args.stop_after,
-            progress=not args.no_progress,
-            plots=not args.no_plots,
-            command=command,
-            executor=executor_named(args.executor, args.ray_address),
-        )
-    except FileExistsError as error:
-        if error.errno is None:  # raised above: the folder holds a comparison already
-            parser.error(str(error))
-        fail(parser.prog, write_error_message(error, out, "--out"))
-    except (RunMismatchError, CorruptLogError) as error:
-        fail(parser.prog, str(error))
-    except OSError as error:
-        fail(parser.prog, write_error_message(error, out, "--out"))
+        with exit_on_output_errors(parser, out, "--out", (RunMismatchError, CorruptLogError)):
+            result = run_comparison(
+                config,
+                out,
+                workers=args.workers,
+                resume=args.resume,
+                overwrite=args.overwrite or args.quick,
+                stop_after=args.stop_after,
+                progress=not args.no_progress,
+                plots=not args.no_plots,
+                command=command,
+                executor=executor_named(args.executor, args.ray_address),
+            )
     except KeyboardInterrupt:
         print(
             f"\ninterrupted: finished episodes are saved in {out / LOG_NAME}; "

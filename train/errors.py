@@ -17,7 +17,10 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
+
+if TYPE_CHECKING:
+    import argparse
 
 from bearing_env.extras import (
     MODULE_EXTRAS,
@@ -95,6 +98,33 @@ def fail(prog: str, message: str, status: int = EXIT_ERROR) -> NoReturn:
     """Print ``<prog>: error: <message>`` on one line to stderr and exit with ``status``."""
     print(f"{prog}: error: {' '.join(message.split())}", file=sys.stderr)
     raise SystemExit(status)
+
+
+@contextmanager
+def exit_on_output_errors(
+    parser: argparse.ArgumentParser,
+    folder: Path,
+    option: str,
+    refusals: tuple[type[Exception], ...] = (ValueError,),
+) -> Iterator[None]:
+    """How a command that writes into ``folder`` (given by ``option``) ends on errors
+    inside the block.
+
+    A ``FileExistsError`` without an errno (the command's own refusal: the folder holds a
+    run already) is a usage error; a ``refusals`` error (a resume that does not match, a
+    damaged log) is one line; any other ``OSError`` (disk full, no permission, a parent
+    that is a file) is one line naming the file. Each exits with status 2.
+    """
+    try:
+        yield
+    except FileExistsError as error:
+        if error.errno is None:
+            parser.error(str(error))
+        fail(parser.prog, write_error_message(error, folder, option))
+    except refusals as error:
+        fail(parser.prog, str(error))
+    except OSError as error:
+        fail(parser.prog, write_error_message(error, folder, option))
 
 
 @contextmanager

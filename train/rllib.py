@@ -52,7 +52,7 @@ from typing import Any
 
 from bearing_env.train.cli_values import parse_key_values
 from bearing_env.train.compare_config import DEFAULT_ENV_KWARGS
-from bearing_env.train.errors import available, fail, require, write_error_message
+from bearing_env.train.errors import available, exit_on_output_errors, fail, require
 from bearing_env.train.files import atomic_write_text
 from bearing_env.train.ray_executor import ray_session
 from bearing_env.train.seeds import TRAINING_SEED_LIMIT
@@ -456,22 +456,15 @@ def main(argv: Sequence[str] | None = None) -> None:
     )
     started = time.perf_counter()
     try:
-        result = train_rllib(
-            settings,
-            output,
-            resume=args.resume,
-            address=args.ray_address,
-            progress=not args.no_progress,
-            stop_after=args.stop_after,
-        )
-    except FileExistsError as error:
-        if error.errno is None:
-            parser.error(str(error))
-        fail(parser.prog, write_error_message(error, output, "--output"))
-    except ValueError as error:
-        fail(parser.prog, str(error))
-    except OSError as error:
-        fail(parser.prog, write_error_message(error, output, "--output"))
+        with exit_on_output_errors(parser, output, "--output"):
+            result = train_rllib(
+                settings,
+                output,
+                resume=args.resume,
+                address=args.ray_address,
+                progress=not args.no_progress,
+                stop_after=args.stop_after,
+            )
     except KeyboardInterrupt:
         print(
             f"\ninterrupted: the newest checkpoint is in {output / CHECKPOINT_NAME}; rerun "

@@ -31,7 +31,7 @@ from typing import Any
 
 from bearing_env.train.cli_values import parse_literal
 from bearing_env.train.compare_report import csv_text
-from bearing_env.train.errors import fail, require, write_error_message
+from bearing_env.train.errors import exit_on_output_errors, fail, require
 from bearing_env.train.files import atomic_write_text
 from bearing_env.train.ray_executor import ray_session
 from bearing_env.train.rllib import (
@@ -247,7 +247,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     except ImportError as error:
         fail(parser.prog, str(error))
     started = time.perf_counter()
-    try:
+    with exit_on_output_errors(parser, args.out, "--out"):
         rows = run_sweep(
             sweep,
             args.out,
@@ -255,14 +255,6 @@ def main(argv: Sequence[str] | None = None) -> None:
             address=args.ray_address,
             verbose=0 if args.no_progress else 1,
         )
-    except FileExistsError as error:
-        if error.errno is None:
-            parser.error(str(error))
-        fail(parser.prog, write_error_message(error, args.out, "--out"))
-    except ValueError as error:
-        fail(parser.prog, str(error))
-    except OSError as error:
-        fail(parser.prog, write_error_message(error, args.out, "--out"))
     for row in rows:
         swept = ", ".join(f"{key}={row[key]}" for key in sweep.combinations()[0])
         print(f"{swept}: mean episode return {row['episode_return_mean']}")
