@@ -102,12 +102,18 @@ def test_generalisation_table_covers_every_policy_and_count(tmp_path: Path) -> N
     assert (out / "generalisation.png").stat().st_size > 10_000
 
 
-def test_generalisation_rejects_counts_beyond_the_observation_slots() -> None:
+@pytest.mark.parametrize(
+    ("model", "slots"),
+    # ppo_khepera's record names no count or slots: the env's defaults (4, 8 slots) apply.
+    [("ppo_random", 10), ("ppo_khepera", 8), ("ppo_generalist", 16)],
+)
+def test_generalisation_rejects_counts_beyond_the_observation_slots(model: str, slots: int) -> None:
     result = subprocess.run(
-        [sys.executable, "-m", "bearing_env.train.generalisation", "--counts", "12"],
+        [sys.executable, "-m", "bearing_env.train.generalisation", "--model", model,
+         "--counts", "3", str(slots + 1)],
         capture_output=True,
         text=True,
         timeout=120,
-    )
+    )  # fmt: skip
     assert result.returncode == 2
-    assert "--counts" in result.stderr
+    assert f"--counts must lie in [3, {slots}]" in result.stderr

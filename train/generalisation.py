@@ -30,6 +30,7 @@ from bearing_env.train.cli_values import format_key_values
 from bearing_env.train.errors import MissingExtraError, fail
 from bearing_env.train.files import write_json_atomically
 
+from bearing_env.envs.config import EnvConfig
 from bearing_env.extras import available
 
 DEFAULT_BASELINES = ("random", "parallax", "greedy")
@@ -84,15 +85,6 @@ def run_counts(
     return medians
 
 
-def trained_count_range(trained: dict[str, Any]) -> tuple[int, int]:
-    """The lowest and highest landmark count of the model's training layouts."""
-    counts = trained.get("n_landmarks", 4)
-    if isinstance(counts, int):
-        return counts, counts
-    low, high = counts
-    return int(low), int(high)
-
-
 def plot_medians(
     medians: dict[int, dict[str, float]], model: str, trained_counts: tuple[int, int], path: Path
 ) -> Path:
@@ -138,8 +130,9 @@ def main() -> None:
     args = parser.parse_args()
     if args.model not in pretrained_names():
         parser.error(f"unknown model {args.model!r}; shipped: {', '.join(pretrained_names())}")
-    trained = pretrained_record(args.model).get("env_kwargs", {})
-    max_landmarks = int(trained.get("max_landmarks", max(trained.get("n_landmarks", [3]))))
+    # The env's own resolution of the training settings: their counts and observation slots.
+    trained = EnvConfig.create(**pretrained_record(args.model).get("env_kwargs", {}))
+    max_landmarks = trained.max_landmarks
     if min(args.counts) < 3 or max(args.counts) > max_landmarks:
         parser.error(
             f"--counts must lie in [3, {max_landmarks}]: {args.model} has "
@@ -164,7 +157,7 @@ def main() -> None:
     Console().print(table)
     write_json_atomically(args.out / "generalisation.json", {str(k): v for k, v in medians.items()})
     figure = plot_medians(
-        medians, args.model, trained_count_range(trained), args.out / "generalisation.png"
+        medians, args.model, trained.landmark_counts, args.out / "generalisation.png"
     )
     print(f"wrote {args.out / 'generalisation.json'} and {figure}")
 
