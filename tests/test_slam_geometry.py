@@ -473,7 +473,30 @@ def test_the_small_hull_equals_the_general_hull(seed, n, duplicates):
     if duplicates:
         pts = np.concatenate([pts, pts[::2]])
     out = np.empty(pts.size + 1, dtype=complex)
-    small = out[: kernels.small_convex_hull(pts, pts.size, out)].copy()
+    small = out[: kernels.small_convex_hull(pts, pts.size, out, 0.0)].copy()
     general = convex_hull(pts)
     # Both start at the leftmost (then lowest) point and go counter-clockwise.
     np.testing.assert_array_equal(small, general)
+
+
+@SETTINGS
+@given(seed=SEEDS, n_line=st.integers(3, 60), n_off=st.integers(1, 3))
+def test_the_hull_of_nearly_collinear_points_is_a_simple_strictly_convex_polygon(
+    seed, n_line, n_off
+):
+    """Points on one line, off it only by rounding, plus a few others: quickhull's rounded
+    side tests once emitted the line's points in a zig-zag (turns of 0 and 180 degrees),
+    a self-overlapping 'hull' whose outward offset was self-intersecting."""
+    rng = np.random.default_rng(seed)
+    a, b = 10.0 * complex(*rng.normal(size=2)), 10.0 * complex(*rng.normal(size=2))
+    line = a + rng.uniform(size=n_line) * (b - a)
+    centre = rng.uniform(0.0, 5.0) * complex(*rng.normal(size=2))
+    pts = np.concatenate([line, centre + rng.normal(size=n_off) + 1j * rng.normal(size=n_off)])
+    got = convex_hull(pts)
+    ref = shp(pts)
+    if ref.geom_type != "Polygon":  # every point on the line: a segment
+        assert got.size <= 2
+        return
+    assert_strictly_convex_ccw(got)
+    assert ring(got).is_valid
+    assert ring(got).area == pytest.approx(ref.area, rel=1e-9)

@@ -5,6 +5,10 @@
                                   table and JSON (benchmarks/bench_env.py, make bench)
     bearing-env bench-slam [...]  world-model update() throughput against CartPole-v1
                                   (benchmarks/bench_slam.py; also ``bearing-env bench --slam``)
+    bearing-env region-search [...]  a seeded search for regions that break the world
+                                  model's promises (benchmarks/region_search.py)
+    bearing-env soak [...]        the envs over random configurations, checking the
+                                  conservative guarantee at every step (benchmarks/soak.py)
     bearing-env compare [...]     exploration policies on the same evaluation episodes
     bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
     bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (shipped rl-zoo3 files)
@@ -39,6 +43,14 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "bench-slam": (
         "bearing_env.benchmarks.bench_slam",
         "world-model update() throughput vs CartPole-v1",
+    ),
+    "region-search": (
+        "bearing_env.benchmarks.region_search",
+        "a seeded search for world-model regions that are not simple, convex or conservative",
+    ),
+    "soak": (
+        "bearing_env.benchmarks.soak",
+        "a soak of the envs over random configurations, checking containment every step",
     ),
     "train": (
         "bearing_env.train.train_cli",

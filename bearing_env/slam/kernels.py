@@ -154,7 +154,14 @@ def convex_hull(points: np.ndarray, n_points: int, out: np.ndarray) -> int:
     clouds have hundreds of points but a few dozen hull vertices. A chain from ``a`` to
     ``b`` owns the points strictly to the right of ``a -> b`` (outside the hull so far);
     its farthest point ``c`` is a hull vertex, and the chains ``a -> c`` and ``c -> b``
-    own what lies right of them. Points on a line through two hull vertices are dropped.
+    own what lies right of them.
+
+    Quickhull only filters: it decides sides with rounded cross products, so among
+    nearly collinear points it can emit several, out of order (a zig-zag along one
+    edge that no left-turn test can see, since it turns by 0 or 180 degrees). Those
+    candidates are finished by :func:`small_convex_hull`, whose chains are monotone in
+    x and so always make a simple polygon, dropping each point within the polygons'
+    tolerance of its neighbours' chord.
     """
     if n_points == 0:
         return 0
@@ -242,13 +249,22 @@ def convex_hull(points: np.ndarray, n_points: int, out: np.ndarray) -> int:
             start, mid, i_from, i_far
         )
         top += 3
-    return _convexify(out, k)
+    candidates = out[:k].copy()
+    extent, magnitude = scale_of(candidates, k)
+    return small_convex_hull(candidates, k, out, tolerance_of(extent, magnitude))
 
 
 @njit(**_JIT)
-def small_convex_hull(points: np.ndarray, n_points: int, out: np.ndarray) -> int:
+def small_convex_hull(points: np.ndarray, n_points: int, out: np.ndarray, tol: float) -> int:
     """:func:`convex_hull` for a few points (up to a few dozen), without its set-up:
-    Andrew's monotone chain over an insertion sort."""
+    Andrew's monotone chain over an insertion sort, into ``out`` (``n_points + 1``).
+
+    A point within ``tol`` of the chord from the previous hull vertex to the next
+    candidate is dropped (``tol = 0`` drops exactly collinear points only). The lower
+    chain runs left to right and the upper one back, each monotone in x, so the result
+    is a simple polygon whatever the rounding, and with ``tol > 0`` each of its turns
+    is a clear left turn.
+    """
     if n_points == 0:
         return 0
     order = np.empty(n_points, dtype=np.int64)
@@ -265,14 +281,14 @@ def small_convex_hull(points: np.ndarray, n_points: int, out: np.ndarray) -> int
     k = 0
     for j in range(n_points):  # lower chain
         p = points[order[j]]
-        while k >= 2 and cross(out[k - 1] - out[k - 2], p - out[k - 2]) <= 0.0:
+        while k >= 2 and _within_chord(out[k - 2], out[k - 1], p, tol):
             k -= 1
         out[k] = p
         k += 1
     lower = k + 1
     for j in range(n_points - 2, -1, -1):  # upper chain
         p = points[order[j]]
-        while k >= lower and cross(out[k - 1] - out[k - 2], p - out[k - 2]) <= 0.0:
+        while k >= lower and _within_chord(out[k - 2], out[k - 1], p, tol):
             k -= 1
         out[k] = p
         k += 1
@@ -283,24 +299,10 @@ def small_convex_hull(points: np.ndarray, n_points: int, out: np.ndarray) -> int
 
 
 @njit(**_JIT)
-def _convexify(poly: np.ndarray, n: int) -> int:
-    """Drop the vertices where a nearly convex CCW polygon does not turn left, in place.
-
-    Quickhull decides sides with rounded cross products; among nearly collinear points it
-    can emit one out of order, a spike of zero width. ``poly[0]`` is the leftmost point,
-    a true hull vertex, so one stack pass (as in Graham's scan) repairs the order.
-    """
-    if n < 3:
-        return n
-    k = 1
-    for i in range(1, n + 1):
-        p = poly[i % n]
-        while k >= 2 and cross(poly[k - 1] - poly[k - 2], p - poly[k - 2]) <= 0.0:
-            k -= 1
-        if i < n:
-            poly[k] = p
-            k += 1
-    return k
+def _within_chord(a: complex, b: complex, c: complex, tol: float) -> bool:
+    """Whether ``b`` fails to turn left by more than ``tol`` on the way from ``a`` to ``c``:
+    it lies right of the chord ``a -> c``, or within ``tol`` of it."""
+    return cross(b - a, c - a) <= tol * abs(c - a)
 
 
 # --------------------------------------------------------------------------------------
@@ -662,7 +664,7 @@ def cone_region(a: float, b: float, epsilon: float, out: np.ndarray) -> tuple[in
     if n == 0:
         return 0, FR_EMPTY
     hull = np.empty(7, dtype=np.complex128)
-    count = small_convex_hull(candidates, n, hull)
+    count = small_convex_hull(candidates, n, hull, 0.0)
     for i in range(count):
         if abs(hull[i]) > MAX_FR_EXTENT:
             return 0, FR_UNBOUNDED
@@ -744,7 +746,7 @@ def sample_hypotheses(
     for i in range(m1):
         for j in range(m2):
             inverses[j] = 1.0 / (s2[j] - s1[i])
-        for v in range(small_convex_hull(inverses, m2, extreme)):
+        for v in range(small_convex_hull(inverses, m2, extreme, 0.0)):
             h1[k] = s1[i]
             inv_d[k] = extreme[v]
             k += 1
