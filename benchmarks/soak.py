@@ -1,0 +1,185 @@
+"""A soak of the envs over random valid configurations, checking the conservative
+guarantee at every step.
+
+Each configuration draws an id (continuous or discrete), a scenario (random layouts of 3
+to 30 landmarks, Khepera, the paper's simulation), epsilon in 0.5-10 degrees, a move
+length range, the observation kind, the reward and the episode length; the transfer is
+conservative, the fusion the paper's intersection, and the noise uniform within
++-epsilon, so every initialised region must hold its landmark. Episodes run on random
+actions from a seeded action space.
+
+    python -m bearing_env.benchmarks.soak --steps 1000000
+    bearing-env soak --steps 20000 --seed 3
+
+It counts steps, exceptions, non-finite values (NaN anywhere in the observation, reward
+or areas; an uninitialised area is inf by design) and containment misses, prints them,
+and exits with status 1 if any is non-zero. Ctrl-C stops early and prints the counts so
+far.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import traceback
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from bearing_env.train.errors import exit_on_output_errors
+from bearing_env.train.files import write_json_atomically
+
+import bearing_env  # noqa: F401  (registers the ids)
+
+IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
+
+
+@dataclass
+class SoakReport:
+    steps: int = 0
+    episodes: int = 0
+    configurations: int = 0
+    containment_checks: int = 0
+    misses: int = 0
+    nonfinite: int = 0
+    exceptions: int = 0
+    #: The first failures: the configuration and what went wrong.
+    failures: list[dict[str, Any]] = field(default_factory=list)
+
+    @property
+    def defects(self) -> int:
+        return self.misses + self.nonfinite + self.exceptions
+
+    def note(self, kwargs: dict[str, Any], seed: int, what: str, limit: int = 10) -> None:
+        if len(self.failures) < limit:
+            self.failures.append({"env_kwargs": kwargs, "seed": seed, "what": what})
+
+
+def random_configuration(rng: np.random.Generator) -> tuple[str, dict[str, Any]]:
+    """An env id and valid keyword arguments, drawn from ``rng``."""
+    env_id = str(rng.choice(IDS))
+    kwargs: dict[str, Any] = {
+        "scenario": str(rng.choice(["random", "random", "khepera", "paper_sim"])),
+        "epsilon_deg": float(rng.uniform(0.5, 10.0)),
+        "observation": str(rng.choice(["flat", "entities"])),
+        "reward": str(rng.choice(["log_area", "area"])),
+        "max_moves": int(rng.integers(5, 41)),
+        "transfer": "conservative",
+        "fusion": "intersect",
+    }
+    if kwargs["scenario"] == "random":
+        kwargs["n_landmarks"] = int(rng.integers(3, 31))
+    if rng.uniform() < 0.5:
+        low = float(rng.uniform(0.01, 0.1))
+        kwargs["move_length"] = (low, float(rng.uniform(low, 0.5)))
+    return env_id, kwargs
+
+
+def finite(value: Any) -> bool:
+    """No NaN or inf in an observation (a Box array or a dict of them)."""
+    if isinstance(value, dict):
+        return all(finite(item) for item in value.values())
+    return bool(np.isfinite(value).all())
+
+
+def soak_configuration(
+    env_id: str, kwargs: dict[str, Any], seed: int, episodes: int, report: SoakReport
+) -> None:
+    """Run ``episodes`` episodes of one configuration into ``report``."""
+    report.configurations += 1
+    env: gym.Env[Any, Any] | None = None
+    try:
+        env = gym.make(
+            env_id, max_episode_steps=kwargs["max_moves"], disable_env_checker=True, **kwargs
+        )
+        env.action_space.seed(seed)
+        for episode in range(episodes):
+            observation, _ = env.reset(seed=seed + episode)
+            report.episodes += 1
+            done = False
+            while not done:
+                observation, reward, terminated, truncated, info = env.step(
+                    env.action_space.sample()
+                )
+                done = terminated or truncated
+                report.steps += 1
+                area = np.asarray(info["landmark_area"])
+                if not (finite(observation) and math.isfinite(reward)) or np.isnan(area).any():
+                    report.nonfinite += 1
+                    report.note(kwargs, seed + episode, f"non-finite value at step {report.steps}")
+                initialised = np.isfinite(area)
+                missed = initialised & ~np.asarray(info["landmark_contains_truth"])
+                report.containment_checks += int(initialised.sum())
+                if missed.any():
+                    report.misses += int(missed.sum())
+                    what = f"truth outside {int(missed.sum())} region(s) at step {report.steps}"
+                    report.note(kwargs, seed + episode, what)
+    except Exception as error:  # a soak counts every failure and goes on
+        report.exceptions += 1
+        report.note(kwargs, seed, "".join(traceback.format_exception_only(error)).strip())
+    finally:
+        if env is not None:
+            env.close()
+
+
+def run(steps: int, seed: int, episodes: int, progress: bool = False) -> SoakReport:
+    """Soak at least ``steps`` env steps over configurations drawn from ``seed``."""
+    rng = np.random.default_rng(seed)
+    report = SoakReport()
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:  # the core install has no tqdm: no bar
+        progress = False
+    bar = tqdm(total=steps, unit="step", desc="soak") if progress else None
+    try:
+        while report.steps < steps:
+            before = report.steps
+            env_id, kwargs = random_configuration(rng)
+            soak_configuration(env_id, kwargs, int(rng.integers(2**31)), episodes, report)
+            if bar is not None:
+                bar.update(report.steps - before)
+    except KeyboardInterrupt:
+        print("interrupted: the counts cover what ran so far", file=sys.stderr)
+    finally:
+        if bar is not None:
+            bar.close()
+    return report
+
+
+def make_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="bearing-env soak", description=__doc__.splitlines()[0])
+    parser.add_argument("--steps", type=int, default=1_000_000, help="env steps (default 1000000)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the configurations")
+    parser.add_argument("--episodes", type=int, default=5, help="episodes per configuration")
+    parser.add_argument("--json", default=None, help="also write the counts here")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = make_parser()
+    args = parser.parse_args(argv)
+    for option in ("steps", "episodes"):
+        if getattr(args, option) < 1:
+            parser.error(f"--{option} must be >= 1, got {getattr(args, option)!r}")
+    if args.seed < 0:
+        parser.error(f"--seed must be >= 0, got {args.seed!r}")
+    if args.json is not None and not Path(args.json).parent.is_dir():
+        parser.error(f"--json: no folder {str(Path(args.json).parent)!r} to write {args.json!r} in")
+    report = run(args.steps, args.seed, args.episodes, not args.no_progress)
+    counts = {name: value for name, value in asdict(report).items() if name != "failures"}
+    print(f"seed {args.seed}: " + ", ".join(f"{name} {value:,}" for name, value in counts.items()))
+    for failure in report.failures:
+        print(f"failure: {failure}")
+    if args.json:
+        with exit_on_output_errors(parser, Path(args.json), "--json"):
+            write_json_atomically(Path(args.json), {"seed": args.seed, **asdict(report)})
+    if report.defects:
+        sys.exit(1)
+
+
+if __name__ == "__main__":
+    main()

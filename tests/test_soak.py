@@ -1,0 +1,60 @@
+"""``bearing-env soak``: random valid configurations, the guarantee checked at every step."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from bearing_env.benchmarks import soak
+
+
+def test_random_configurations_are_valid_and_vary():
+    rng = np.random.default_rng(3)
+    drawn = [soak.random_configuration(rng) for _ in range(30)]
+    assert {env_id for env_id, _ in drawn} == set(soak.IDS)
+    assert len({kwargs["scenario"] for _, kwargs in drawn}) >= 2
+    for env_id, kwargs in drawn[:6]:
+        gym.make(env_id, max_episode_steps=kwargs["max_moves"], **kwargs).close()
+
+
+def test_a_short_soak_counts_steps_and_checks_and_finds_nothing(capsys):
+    soak.main(["--steps", "150", "--seed", "4", "--no-progress"])
+    out = capsys.readouterr().out
+    assert "misses 0, nonfinite 0, exceptions 0" in out
+    report = soak.run(150, seed=4, episodes=5)
+    assert report.steps >= 150 and report.containment_checks > 0 and report.defects == 0
+
+
+class LosesTheTruth(gym.Wrapper):
+    def step(self, action):
+        observation, reward, terminated, truncated, info = self.env.step(action)
+        info["landmark_contains_truth"] = np.zeros_like(info["landmark_contains_truth"])
+        return observation, reward, terminated, truncated, info
+
+
+def test_the_soak_counts_misses_and_exceptions_and_exits_1(monkeypatch, capsys):
+    make = gym.make
+    monkeypatch.setattr(soak.gym, "make", lambda *a, **k: LosesTheTruth(make(*a, **k)))
+    report = soak.run(60, seed=5, episodes=2)
+    assert report.misses > 0 and report.failures[0]["what"].startswith("truth outside")
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(soak.gym, "make", broken)
+    with pytest.raises(SystemExit) as exit_info:
+        soak.main(["--steps", "1", "--no-progress"])
+    assert exit_info.value.code == 1
+    assert "RuntimeError: boom" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("argv", "named"),
+    [(["--steps", "0"], "--steps"), (["--episodes", "-1"], "--episodes"),
+     (["--seed", "-2"], "--seed"), (["--json", "no/such/dir/x.json"], "--json")],
+)
+def test_the_soak_refuses_bad_values_in_one_line(argv, named, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        soak.main(argv)
+    assert exit_info.value.code == 2
+    assert named in capsys.readouterr().err.strip().splitlines()[-1]
