@@ -290,6 +290,10 @@ def test_attribute_access() -> None:
     assert env.get_attr("path_cost") == (0.0, 1.0)
     with pytest.raises(ValueError, match="expected 2 values"):
         env.set_attr("path_cost", [1.0])
+    with pytest.raises(AttributeError, match="'nosuch'"):  # not silently kept
+        env.set_attr("nosuch", 1)
+    with pytest.raises(AttributeError, match="'nosuch'"):
+        env.get_attr("nosuch")
 
 
 def test_sub_envs_with_settings_changed_by_set_attr_step_like_single_envs() -> None:

@@ -93,7 +93,8 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
     `path_cost`, ...; `config` for the whole `EnvConfig`), `n_landmarks`, `slam` (the
     sub-env's map, a `PolygonSLAM` view of the shared batch), `world` (its ground
     truth, read-only) and `np_random`. `set_attr(name, values)` changes settings per
-    sub-env (validated); sub-envs whose settings differ are stepped in separate groups.
+    sub-env (validated), and `config` and `np_random`; any other name raises
+    `AttributeError`. Sub-envs whose settings differ are stepped in separate groups.
     `call(name)` calls what `get_attr(name)` gives when it is callable.
 
     ## Version History
@@ -160,8 +161,6 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         self._state.n_landmarks[:] = first.landmark_counts[1]
         self._maps = MapBank(self.num_envs)
         self._rngs: list[np.random.Generator | None] = [None] * self.num_envs
-        #: Attributes set by ``set_attr`` that are not settings, per sub-env.
-        self._extra_attributes: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
         self._worlds = [WorldView(self, row) for row in range(self.num_envs)]
         self._renderers: list[Any] = [None] * self.num_envs
 
@@ -321,9 +320,10 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         elif attribute is not None or name in _ROW_ATTRIBUTES:
             raise AttributeError(f"the sub-envs' {name!r} cannot be set")
         else:
-            for extras, value in zip(self._extra_attributes, values, strict=True):
-                extras[name] = value
-            return
+            raise AttributeError(
+                f"the sub-envs have no attribute {name!r} to set; set_attr sets 'config', "
+                "'np_random' and the settings (see EnvConfig)"
+            )
         grid_fixed = self.decode_actions is not core.decode_continuous
         for row, config in enumerate(configs):
             core.check_config_switch(self._row_config(row), config, grid_fixed)
@@ -384,8 +384,6 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             return self._rng(row)
         if name in ("observation_space", "action_space"):
             return getattr(self, f"single_{name}")
-        if name in self._extra_attributes[row]:
-            return self._extra_attributes[row][name]
         attribute = getattr(self.single_env_class, name, None)
         if isinstance(attribute, (Setting, property)):
             # Settings and the properties derived from the config alone (epsilon,
