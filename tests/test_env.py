@@ -518,6 +518,20 @@ def test_step_before_reset_raises() -> None:
         BearingSLAMEnv().step([0.0, 0.0])
 
 
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_reset_refuses_options_naming_them(env_id: str) -> None:
+    env = gym.make(env_id, scenario="khepera")
+    expected = env.reset(seed=2)
+    with pytest.raises(TypeError, match=r"unknown reset options \['reset_mask'\]"):
+        env.reset(seed=2, options={"reset_mask": np.array([True])})
+    with pytest.raises(TypeError, match="dict or None, got 'area_cap'"):
+        env.reset(seed=2, options="area_cap")  # type: ignore[arg-type]
+    for options in (None, {}):  # no options at all is fine, and the same reset
+        observation, info = env.reset(seed=2, options=options)
+        np.testing.assert_array_equal(observation, expected[0])
+        assert info.keys() == expected[1].keys()
+
+
 # --------------------------------------------------------------------------------------
 # Fuzz: observations stay finite and in the space
 # --------------------------------------------------------------------------------------

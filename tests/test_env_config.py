@@ -215,8 +215,8 @@ def test_vector_set_attr_validates_every_value_before_applying_any() -> None:
         env.set_attr("max_landmarks", 12)
     with pytest.raises(AttributeError, match="no_such_attribute"):
         env.get_attr("no_such_attribute")
-    env.set_attr("label", ["a", "b", "c"])  # not a setting: kept per sub-env
-    assert env.get_attr("label") == ("a", "b", "c")
+    with pytest.raises(AttributeError, match="'label'"):  # not a setting: refused
+        env.set_attr("label", ["a", "b", "c"])
 
 
 def test_a_new_epsilon_gives_a_new_empty_map() -> None:

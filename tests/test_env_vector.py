@@ -198,8 +198,6 @@ def test_invalid_arguments_raise_clear_errors() -> None:
         BearingSLAMVectorEnv(2.5)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="autoreset_mode"):
         BearingSLAMVectorEnv(2, autoreset_mode="sometimes")
-    with pytest.raises(ValueError, match="autoreset_mode"):
-        BearingSLAMVectorEnv(2, autoreset_mode=AutoresetMode.DISABLED)
     with pytest.raises(ValueError, match="max_episode_steps"):
         BearingSLAMVectorEnv(2, max_episode_steps=0)
     with pytest.raises(ValueError, match="render_mode"):
@@ -290,6 +288,10 @@ def test_attribute_access() -> None:
     assert env.get_attr("path_cost") == (0.0, 1.0)
     with pytest.raises(ValueError, match="expected 2 values"):
         env.set_attr("path_cost", [1.0])
+    with pytest.raises(AttributeError, match="'nosuch'"):  # not silently kept
+        env.set_attr("nosuch", 1)
+    with pytest.raises(AttributeError, match="'nosuch'"):
+        env.get_attr("nosuch")
 
 
 def test_sub_envs_with_settings_changed_by_set_attr_step_like_single_envs() -> None:
@@ -312,6 +314,129 @@ def test_sub_envs_with_settings_changed_by_set_attr_step_like_single_envs() -> N
     # The costs really differ per sub-env (a batch using env 0's setting would give 0).
     assert total_cost[0] == total_cost[2] == 0.0
     assert total_cost[1] < 0.0 and total_cost[3] < 0.0
+
+
+# ----------------------------------------------------------------------------------------
+# reset(options={"reset_mask": ...}) and autoreset_mode="disabled"
+# ----------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("env_id", "mode", "kwargs"),
+    [
+        ("BearingSLAM-v0", AutoresetMode.NEXT_STEP, {"scenario": "khepera"}),
+        ("BearingSLAM-v0", AutoresetMode.SAME_STEP, {"scenario": "khepera"}),
+        ("BearingSLAM-v0", AutoresetMode.DISABLED, {"scenario": "khepera"}),
+        ("BearingSLAMDiscrete-v0", AutoresetMode.DISABLED, {"observation": "entities"}),
+    ],
+    ids=["next-step", "same-step", "disabled", "disabled-discrete-entities"],
+)
+def test_masked_resets_reproduce_sync_vector_env_exactly(
+    env_id: str, mode: AutoresetMode, kwargs: dict[str, Any]
+) -> None:
+    """Resets of some sub-envs, mid-episode or after their end, seeded by an int, a list
+    or not at all, between steps: every result equal to ``SyncVectorEnv``'s, masks included."""
+    n = 3
+    batched, reference = make_pair(env_id, n, mode, max_moves=4, **kwargs)
+    assert_same(batched.reset(seed=3), reference.reset(seed=3))
+    batched.action_space.seed(8)
+    rng = np.random.default_rng(5)
+    seeds: list[Any] = [None, 100, [None, 7, 9]]
+    done = np.zeros(n, dtype=bool)
+    mid_episode = ended = 0
+    for step in range(16):
+        mask = rng.random(n) < 0.3
+        if mode == AutoresetMode.DISABLED:
+            mask |= done  # an ended sub-env must be reset before it steps again
+        if mask.any():
+            seed = seeds[step % len(seeds)]
+            # SyncVectorEnv pops the mask from the dict it is given: one dict each.
+            result = batched.reset(seed=seed, options={"reset_mask": mask.copy()})
+            assert_same(result, reference.reset(seed=seed, options={"reset_mask": mask.copy()}))
+            assert result[1]["_total_area"].tolist() == mask.tolist()
+            mid_episode += int(np.sum(mask & ~done))
+            ended += int(np.sum(mask & done))
+        actions = batched.action_space.sample()
+        result = batched.step(actions)
+        assert_same(result, reference.step(actions))
+        done = result[2] | result[3]
+    assert mid_episode >= 3 and ended >= 1  # both kinds of masked reset were compared
+    batched.close()
+    reference.close()
+
+
+def test_disabled_mode_refuses_to_step_an_ended_sub_env_until_it_is_reset() -> None:
+    batched, reference = make_pair(
+        "BearingSLAM-v0", 2, AutoresetMode.DISABLED, scenario="khepera", max_moves=2
+    )
+    assert batched.metadata["autoreset_mode"] == AutoresetMode.DISABLED
+    actions = np.zeros((2, 2), dtype=np.float32)
+    for env in (batched, reference):
+        env.reset(seed=0)
+        env.step(actions)
+        _, _, terminated, truncated, _ = env.step(actions)
+        assert np.all(terminated | truncated)
+    with pytest.raises(AssertionError):  # SyncVectorEnv's refusal
+        reference.step(actions)
+    with pytest.raises(RuntimeError, match=r"sub-envs \[0, 1\].*reset_mask"):
+        batched.step(actions)
+    mask = np.array([True, True])
+    assert_same(
+        batched.reset(options={"reset_mask": mask.copy()}),
+        reference.reset(options={"reset_mask": mask.copy()}),
+    )
+    assert_same(batched.step(actions), reference.step(actions))
+
+
+@pytest.mark.parametrize(
+    ("options", "error", "shown"),
+    [
+        ({"reset_mask": [True]}, TypeError, "[True]"),
+        ({"reset_mask": [True, False, True]}, TypeError, "list"),
+        ({"reset_mask": None}, TypeError, "None"),
+        ({"reset_mask": np.array([1, 0, 1])}, TypeError, "int64"),
+        ({"reset_mask": np.array([True])}, ValueError, "shape (1,)"),
+        ({"reset_mask": np.ones((1, 3), dtype=bool)}, ValueError, "shape (1, 3)"),
+        ({"reset_mask": np.zeros(3, dtype=bool)}, ValueError, "at least one"),
+        ({"reset_masks": np.ones(3, dtype=bool)}, TypeError, "'reset_masks'"),
+        ({"seed": 1}, TypeError, "'seed'"),
+        (["reset_mask"], TypeError, "['reset_mask']"),
+    ],
+    ids=[
+        "one-entry-list",
+        "list",
+        "none",
+        "int-array",
+        "short",
+        "2-d",
+        "all-false",
+        "unknown-key",
+        "sub-env-key",
+        "not-a-dict",
+    ],
+)
+def test_a_malformed_reset_is_refused_like_sync_vector_env_and_changes_nothing(
+    options: Any, error: type[Exception], shown: str
+) -> None:
+    batched, reference = make_pair("BearingSLAM-v0", 3, AutoresetMode.NEXT_STEP)
+    twin = BearingSLAMVectorEnv(3, max_episode_steps=20)
+    for env in (batched, reference, twin):
+        env.reset(seed=1)
+    with pytest.raises(error, match="reset") as raised:
+        batched.reset(seed=4, options=options)
+    assert shown in str(raised.value)
+    with pytest.raises(error):  # SyncVectorEnv (or its sub-envs) refuse it too
+        reference.reset(seed=4, options=dict(options) if isinstance(options, dict) else options)
+    actions = np.zeros((3, 2), dtype=np.float32)
+    assert_same(batched.step(actions), twin.step(actions))  # the refusal changed nothing
+
+
+def test_the_first_reset_must_reset_every_sub_env() -> None:
+    env = BearingSLAMVectorEnv(3)
+    with pytest.raises(ValueError, match="first reset"):
+        env.reset(seed=0, options={"reset_mask": np.array([True, False, True])})
+    observations, infos = env.reset(seed=0, options={"reset_mask": np.ones(3, dtype=bool)})
+    assert_same((observations, infos), BearingSLAMVectorEnv(3).reset(seed=0))
 
 
 # ----------------------------------------------------------------------------------------

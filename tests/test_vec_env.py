@@ -269,7 +269,8 @@ def test_a_vector_env_without_sub_env_access_serves_only_whole_batch_requests() 
 
 
 class RecordingVectorEnv(VectorWrapper):
-    """Records the arguments of every ``reset``."""
+    """Records the arguments of every ``reset`` (the options go no further: the sub-envs
+    take none and refuse any)."""
 
     def __init__(self, env: VectorEnv[Any, Any, Any]) -> None:
         super().__init__(env)
@@ -279,7 +280,7 @@ class RecordingVectorEnv(VectorWrapper):
         self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
         self.resets.append((seed, options))
-        return self.env.reset(seed=seed, options=options)
+        return self.env.reset(seed=seed)
 
 
 def test_seeds_and_options_are_used_once() -> None:

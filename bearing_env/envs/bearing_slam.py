@@ -7,7 +7,7 @@ settings are one :class:`~bearing_env.envs.config.EnvConfig`.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from typing import Any, Generic, SupportsFloat, TypeVar, cast
 
 import gymnasium as gym
@@ -223,6 +223,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     The landmark layout is the scenario's (`"random"`: a new layout every episode). The
     robot starts at a uniformly random position inside the wall margin, away from the
     landmarks, with a uniformly random heading, takes one reading, and has an empty map.
+    `reset(options=...)` takes no options: `None` or `{}`; any key raises `TypeError`
+    naming it.
 
     ## Episode End
 
@@ -473,6 +475,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[NDArray[np.float32], dict[str, Any]]:
+        check_reset_options(options)
         super().reset(seed=seed)
         rows, config = self._rows, self.config
         core.reset_rows(self._state, rows, config, [self.np_random], self._maps)
@@ -573,6 +576,20 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         """(turn angle in radians, requested move length in metres) from an action."""
         turns, lengths = self._decode_batch(self._checked_action(action)[None])
         return float(turns[0]), float(lengths[0])
+
+
+def check_reset_options(options: object, known: Collection[str] = ()) -> Mapping[str, Any]:
+    """``reset``'s ``options`` as a mapping (empty for None), whose keys must be among
+    ``known`` (the single env takes none): TypeError naming the value or the keys."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise TypeError(f"reset options must be a dict or None, got {options!r}")
+    unknown = [key for key in options if key not in known]
+    if unknown:
+        expected = f"expected keys among {sorted(known)!r}" if known else "it takes none"
+        raise TypeError(f"unknown reset options {unknown!r}; {expected}")
+    return options
 
 
 def observation_space(config: EnvConfig) -> spaces.Box[np.float32]:

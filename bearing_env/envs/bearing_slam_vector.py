@@ -18,12 +18,14 @@ from gymnasium.vector.utils import batch_space
 from numpy.typing import NDArray
 
 from bearing_env.envs import core
-from bearing_env.envs.bearing_slam import BearingSLAMEnv, Setting
+from bearing_env.envs.bearing_slam import BearingSLAMEnv, Setting, check_reset_options
 from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
 from bearing_env.envs.config import MAX_N_LANDMARKS, EnvConfig
 from bearing_env.envs.core import BatchState, MapBank, WorldView
 
-AUTORESET_MODES = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)
+AUTORESET_MODES = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP, AutoresetMode.DISABLED)
+#: The keys ``reset(options=...)`` takes (the sub-envs themselves take none).
+RESET_OPTIONS = ("reset_mask",)
 
 #: Per-landmark info arrays and the value that pads them when landmark counts vary.
 LANDMARK_INFO_PADDING: dict[str, Any] = {
@@ -71,12 +73,22 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
       reset by the next `step()`, which ignores its action and returns its first
       observation with reward 0;
     - `AutoresetMode.SAME_STEP`: it is reset at once; its last observation and info are
-      in `infos["final_obs"]` and `infos["final_info"]` (what SB3's adapter needs).
+      in `infos["final_obs"]` and `infos["final_info"]` (what SB3's adapter needs);
+    - `AutoresetMode.DISABLED`: it is not reset; `step()` raises `RuntimeError` until it
+      is, by `reset(options={"reset_mask": terminated | truncated})`.
+
+    `reset(seed=..., options={"reset_mask": mask})` resets only the sub-envs where `mask`
+    (a numpy bool array of `num_envs`, at least one True) is True, in any mode: the others
+    keep their episodes, pending autoresets and last observations, and the infos hold the
+    reset sub-envs only (`_key` masks). The seeds of the others are not used. A mask of
+    another type, dtype or shape, or an unknown option, raises `TypeError`/`ValueError`
+    naming it; the first reset must reset every sub-env.
 
     ## Arguments
 
     - `num_envs`: number of sub-environments, >= 1.
-    - `autoreset_mode`: `"next_step"` (default) or `"same_step"` (or the enum).
+    - `autoreset_mode`: `"next_step"` (default), `"same_step"` or `"disabled"` (or the
+      enum).
     - `max_episode_steps`: truncate after this many steps, like the `TimeLimit` that
       `gym.make` adds (`gym.make_vec` passes the registered 20); None for no limit.
     - `render_mode`: None or `"rgb_array"` (`render()` returns a tuple of frames).
@@ -93,7 +105,8 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
     `path_cost`, ...; `config` for the whole `EnvConfig`), `n_landmarks`, `slam` (the
     sub-env's map, a `PolygonSLAM` view of the shared batch), `world` (its ground
     truth, read-only) and `np_random`. `set_attr(name, values)` changes settings per
-    sub-env (validated); sub-envs whose settings differ are stepped in separate groups.
+    sub-env (validated), and `config` and `np_random`; any other name raises
+    `AttributeError`. Sub-envs whose settings differ are stepped in separate groups.
     `call(name)` calls what `get_attr(name)` gives when it is callable.
 
     ## Version History
@@ -160,8 +173,6 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         self._state.n_landmarks[:] = first.landmark_counts[1]
         self._maps = MapBank(self.num_envs)
         self._rngs: list[np.random.Generator | None] = [None] * self.num_envs
-        #: Attributes set by ``set_attr`` that are not settings, per sub-env.
-        self._extra_attributes: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
         self._worlds = [WorldView(self, row) for row in range(self.num_envs)]
         self._renderers: list[Any] = [None] * self.num_envs
 
@@ -174,6 +185,9 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         self._autoreset_envs = np.zeros(self.num_envs, dtype=bool)
         self._elapsed_steps = np.zeros(self.num_envs, dtype=np.int64)
         self._has_reset = False
+        #: The flat observations last returned: a reset with a ``reset_mask`` returns
+        #: them again for the sub-envs it leaves alone, as ``SyncVectorEnv`` does.
+        self._observations = np.zeros(self._flat_shape, dtype=np.float32)
 
     # ------------------------------------------------------------------------------------
     # VectorEnv API
@@ -185,18 +199,29 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         seed: int | Sequence[int | None] | None = None,
         options: dict[str, Any] | None = None,
     ) -> tuple[NDArray[np.float32], dict[str, Any]]:
-        """Reset every sub-env; an int seed gives sub-env ``i`` the seed ``seed + i``."""
-        for row, row_seed in enumerate(self._seeds(seed)):
+        """Reset every sub-env, or those of ``options["reset_mask"]`` (a bool array of
+        ``num_envs``), as ``SyncVectorEnv`` does: the others keep their episodes and their
+        last observations, and the infos hold only the reset sub-envs (``_key`` masks).
+        An int seed gives sub-env ``i`` the seed ``seed + i``; a list gives one seed (or
+        None) per sub-env; the seeds of sub-envs left alone are not used."""
+        mask = self._reset_mask(options)
+        seeds = self._seeds(seed)
+        if not self._has_reset and not mask.all():
+            raise ValueError(
+                "the first reset() must reset every sub-env, got options['reset_mask'] = "
+                f"{mask!r}"
+            )
+        rows = np.flatnonzero(mask)
+        for row in rows.tolist():
             # As gym.Env.reset: a seed makes a new generator; without one, the
             # generator carries on (or is made from fresh entropy the first time).
-            if row_seed is not None or self._rngs[row] is None:
-                self._rngs[row], _ = seeding.np_random(row_seed)
-        observations = np.zeros(self._flat_shape, dtype=np.float32)
-        infos = self._reset_rows(np.arange(self.num_envs), observations, {})
-        self._autoreset_envs[:] = False
-        self._elapsed_steps[:] = 0
+            if seeds[row] is not None or self._rngs[row] is None:
+                self._rngs[row], _ = seeding.np_random(seeds[row])
+        observations = self._observations.copy()
+        infos = self._reset_rows(rows, observations, {})
+        self._autoreset_envs[rows] = False
         self._has_reset = True
-        return self._observation(observations), infos
+        return self._returned(observations), infos
 
     def step(
         self, actions: NDArray[Any]
@@ -209,6 +234,13 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
     ]:
         if not self._has_reset:
             raise RuntimeError("call reset() before step()")
+        if self.autoreset_mode == AutoresetMode.DISABLED and self._autoreset_envs.any():
+            ended = np.flatnonzero(self._autoreset_envs).tolist()
+            raise RuntimeError(
+                f"sub-envs {ended} have ended (terminated or truncated) and autoreset_mode "
+                "is DISABLED: reset them with reset(options={'reset_mask': ...}) before "
+                "step() again"
+            )
         actions = np.asarray(actions)
         if actions.shape != self.action_space.shape:
             raise ValueError(
@@ -252,7 +284,12 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             infos = self._reset_rows(np.concatenate(finished), observations, infos)
         infos = self._reset_rows(np.flatnonzero(resetting), observations, infos)
         self._autoreset_envs = terminations | truncations
-        return self._observation(observations), rewards, terminations, truncations, infos
+        return self._returned(observations), rewards, terminations, truncations, infos
+
+    def _returned(self, flat: NDArray[np.float32]) -> Any:
+        """The observations ``reset`` or ``step`` returns, kept as the latest ones."""
+        self._observations = flat
+        return self._observation(flat.copy())
 
     def _observation(self, flat: NDArray[np.float32]) -> Any:
         """Observations of the sub-envs' kind from flat ones (as the single env's)."""
@@ -321,9 +358,10 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         elif attribute is not None or name in _ROW_ATTRIBUTES:
             raise AttributeError(f"the sub-envs' {name!r} cannot be set")
         else:
-            for extras, value in zip(self._extra_attributes, values, strict=True):
-                extras[name] = value
-            return
+            raise AttributeError(
+                f"the sub-envs have no attribute {name!r} to set; set_attr sets 'config', "
+                "'np_random' and the settings (see EnvConfig)"
+            )
         grid_fixed = self.decode_actions is not core.decode_continuous
         for row, config in enumerate(configs):
             core.check_config_switch(self._row_config(row), config, grid_fixed)
@@ -384,8 +422,6 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             return self._rng(row)
         if name in ("observation_space", "action_space"):
             return getattr(self, f"single_{name}")
-        if name in self._extra_attributes[row]:
-            return self._extra_attributes[row][name]
         attribute = getattr(self.single_env_class, name, None)
         if isinstance(attribute, (Setting, property)):
             # Settings and the properties derived from the config alone (epsilon,
@@ -413,6 +449,30 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             if value is not None and not _is_int(value):
                 raise TypeError(f"each seed must be an int or None, got {value!r} in {seed!r}")
         return [None if value is None else int(value) for value in seeds]
+
+    def _reset_mask(self, options: object) -> NDArray[np.bool_]:
+        """Which sub-envs ``reset(options=options)`` resets: ``options["reset_mask"]``,
+        checked as ``SyncVectorEnv`` checks it (TypeError/ValueError naming it), else all."""
+        checked = check_reset_options(options, RESET_OPTIONS)
+        if "reset_mask" not in checked:
+            return np.ones(self.num_envs, dtype=np.bool_)
+        mask = checked["reset_mask"]
+        if not isinstance(mask, np.ndarray) or mask.dtype != np.bool_:
+            kind = f"dtype {mask.dtype}" if isinstance(mask, np.ndarray) else type(mask).__name__
+            raise TypeError(
+                f"options['reset_mask'] must be a numpy array of dtype bool, got {mask!r} "
+                f"({kind})"
+            )
+        if mask.shape != (self.num_envs,):
+            raise ValueError(
+                f"options['reset_mask'] must have shape ({self.num_envs},), one entry per "
+                f"sub-env, got shape {mask.shape}: {mask!r}"
+            )
+        if not mask.any():
+            raise ValueError(
+                f"options['reset_mask'] must reset at least one sub-env, got {mask!r}"
+            )
+        return mask.copy()
 
     def _reset_rows(
         self, rows: IntArray, observations: NDArray[np.float32], infos: dict[str, Any]
