@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import gymnasium as gym
 
-#: The registered ids, their entry points, and the default episode length. The spec's
-#: ``max_episode_steps`` equals the environments' default ``max_moves`` so the two
-#: truncations agree.
+#: The registered ids and their entry points. They register ``max_episode_steps=None``:
+#: the envs' own ``max_moves`` is the one episode cap (a registered TimeLimit would cut
+#: ``gym.make(id, max_moves=40)`` at its own length), and an env's ``spec`` reports its
+#: ``max_moves`` as ``max_episode_steps`` for the libraries that read a horizon there.
 ENV_IDS: dict[str, str] = {
     "BearingSLAM-v0": "bearing_env.envs.bearing_slam:BearingSLAMEnv",
     "BearingSLAMDiscrete-v0": "bearing_env.envs.bearing_slam_discrete:BearingSLAMDiscreteEnv",
@@ -22,7 +23,6 @@ VECTOR_ENTRY_POINTS: dict[str, str] = {
     "BearingSLAM-v0": "bearing_env.envs.bearing_slam_vector:BearingSLAMVectorEnv",
     "BearingSLAMDiscrete-v0": "bearing_env.envs.bearing_slam_vector:BearingSLAMDiscreteVectorEnv",
 }
-MAX_EPISODE_STEPS = 20
 
 
 def register_envs() -> None:
@@ -35,5 +35,5 @@ def register_envs() -> None:
             id=env_id,
             entry_point=entry_point,
             vector_entry_point=VECTOR_ENTRY_POINTS[env_id],
-            max_episode_steps=MAX_EPISODE_STEPS,
+            max_episode_steps=None,
         )

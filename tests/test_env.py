@@ -29,7 +29,7 @@ from bearing_env.envs.bearing_slam import (
     observation_size,
     observation_slices,
 )
-from bearing_env.registration import MAX_EPISODE_STEPS, register_envs
+from bearing_env.registration import register_envs
 from bearing_env.slam.batch import RELAXED_STATE_ARRAYS, STATE_ARRAYS
 
 ENV_IDS = sorted(
@@ -52,10 +52,40 @@ INFO_KEYS = {
 }
 
 
-def test_both_ids_are_registered() -> None:
+def test_both_ids_are_registered_without_a_time_limit() -> None:
     assert ENV_IDS == ["BearingSLAM-v0", "BearingSLAMDiscrete-v0"]
     for env_id in ENV_IDS:
-        assert gym.spec(env_id).max_episode_steps == MAX_EPISODE_STEPS == DEFAULT_MAX_MOVES
+        assert gym.spec(env_id).max_episode_steps is None
+        env = gym.make(env_id)
+        assert env.spec is not None and env.spec.max_episode_steps == DEFAULT_MAX_MOVES
+
+
+def moves_until_the_end(env: gym.Env[Any, Any]) -> int:
+    env.reset(seed=3)
+    env.action_space.seed(3)
+    moves = 0
+    while True:
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        moves += 1
+        if terminated or truncated:
+            assert truncated and not terminated
+            return moves
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_max_moves_is_the_one_episode_cap(env_id: str) -> None:
+    """gym.make(id, max_moves=40) runs 40 moves (a registered TimeLimit once cut it at
+    20); the spec reads the cap, and gym.make of that spec runs as many."""
+    kwargs = {"scenario": "khepera", "target_area": 1e-9}
+    env = gym.make(env_id, max_moves=40, **kwargs)
+    assert moves_until_the_end(env) == 40
+    assert env.spec is not None and env.spec.max_episode_steps == 40
+    assert moves_until_the_end(gym.make(env.spec)) == 40
+    env.unwrapped.max_moves = 7  # type: ignore[attr-defined]
+    spec = env.unwrapped.spec  # (gymnasium's wrappers cache the spec they were made with)
+    assert spec is not None and spec.max_episode_steps == 7 and moves_until_the_end(env) == 7
+    # An explicit max_episode_steps still adds gymnasium's TimeLimit on top, as for any id.
+    assert moves_until_the_end(gym.make(env_id, max_episode_steps=5, **kwargs)) == 5
 
 
 def test_registration_can_run_twice_silently() -> None:

@@ -6,6 +6,7 @@ settings are one :class:`~bearing_env.envs.config.EnvConfig`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Collection, Mapping
 from typing import Any, Generic, SupportsFloat, TypeVar, cast
@@ -13,6 +14,7 @@ from typing import Any, Generic, SupportsFloat, TypeVar, cast
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
+from gymnasium.envs.registration import EnvSpec
 from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.envs import core
@@ -230,10 +232,10 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     - Termination (success): every landmark L3, L4, ... is initialised and its region's
       area is at most `target_area`.
-    - Truncation: after `max_moves` moves. Stepping an episode that has ended, without
-      `reset()`, raises `RuntimeError`. The registered ids also carry
-      `max_episode_steps = 20` (the default `max_moves`) on their spec; when passing a
-      larger `max_moves` to `gym.make`, pass the same `max_episode_steps`.
+    - Truncation: after `max_moves` moves, the one episode cap:
+      `gym.make(id, max_moves=40)` runs 40 moves. The ids register no `TimeLimit`, and
+      `env.spec.max_episode_steps` reads `max_moves`. Stepping an episode that has ended,
+      without `reset()`, raises `RuntimeError`.
 
     ## Info
 
@@ -541,6 +543,23 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
+
+    # ``gym.make`` assigns the spec after construction; the ids register no
+    # ``max_episode_steps``, so the spec reads the env's own cap instead.
+    _spec: EnvSpec | None = None
+
+    @property  # type: ignore[override]
+    def spec(self) -> EnvSpec | None:
+        """The spec ``gym.make`` gave, whose ``max_episode_steps`` (unless the caller set
+        one, which adds a ``TimeLimit``) is this env's ``max_moves``."""
+        spec = self._spec
+        if spec is None or spec.max_episode_steps is not None:
+            return spec
+        return dataclasses.replace(spec, max_episode_steps=self.config.max_moves)
+
+    @spec.setter
+    def spec(self, spec: EnvSpec | None) -> None:
+        self._spec = spec
 
     def __getstate__(self) -> dict[str, Any]:
         # A pygame window or surface cannot be pickled; a fresh one is made on demand.
