@@ -126,7 +126,10 @@ def soak_configuration(
 
 
 def run(steps: int, seed: int, episodes: int, progress: bool = False) -> SoakReport:
-    """Soak at least ``steps`` env steps over configurations drawn from ``seed``."""
+    """Soak at least ``steps`` env steps over configurations drawn from ``seed``.
+
+    Every configuration that runs steps at least one, so at most ``steps`` are drawn:
+    configurations that all fail before their first step end the soak too."""
     rng = np.random.default_rng(seed)
     report = SoakReport()
     try:
@@ -135,7 +138,7 @@ def run(steps: int, seed: int, episodes: int, progress: bool = False) -> SoakRep
         progress = False
     bar = tqdm(total=steps, unit="step", desc="soak") if progress else None
     try:
-        while report.steps < steps:
+        while report.steps < steps and report.configurations < steps:
             before = report.steps
             env_id, kwargs = random_configuration(rng)
             soak_configuration(env_id, kwargs, int(rng.integers(2**31)), episodes, report)

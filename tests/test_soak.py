@@ -42,10 +42,10 @@ def test_the_soak_counts_misses_and_exceptions_and_exits_1(monkeypatch, capsys):
         raise RuntimeError("boom")
 
     monkeypatch.setattr(soak.gym, "make", broken)
-    with pytest.raises(SystemExit) as exit_info:
-        soak.main(["--steps", "1", "--no-progress"])
+    with pytest.raises(SystemExit) as exit_info:  # and ends although no step ever runs
+        soak.main(["--steps", "3", "--no-progress"])
     assert exit_info.value.code == 1
-    assert "RuntimeError: boom" in capsys.readouterr().out
+    assert "exceptions 3" in (out := capsys.readouterr().out) and "RuntimeError: boom" in out
 
 
 @pytest.mark.parametrize(
