@@ -275,3 +275,88 @@ def test_train_on_a_full_disk_names_the_file(
     line = one_line_error(capsys.readouterr().err, "bearing-env train")
     assert str(run / "run.json") in line and "No space left on device" in line
     assert not [p for p in run.iterdir() if p.name.endswith(".tmp")]
+
+
+# --------------------------------------------------------------------------------------
+# The Python API: bad values are a TypeError or ValueError naming them
+# --------------------------------------------------------------------------------------
+
+
+def _make_discrete(**kwargs: Any) -> None:
+    import gymnasium as gym
+
+    gym.make("bearing_env:BearingSLAMDiscrete-v0", **kwargs)
+
+
+def _replicate(count: Any) -> None:
+    import numpy as np
+
+    from bearing_env.slam import PolygonSLAM
+
+    PolygonSLAM(4, np.deg2rad(2.0)).replicate(count)
+
+
+def _fr_region(epsilon: float) -> None:
+    from bearing_env.slam import fr_region
+
+    fr_region(1.0, 1.2, epsilon)
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "message"),
+    [
+        (lambda: _make_discrete(n_turns=10**8), ValueError,
+         "n_turns must be <= 4096, got 100000000"),
+        (lambda: _make_discrete(n_turns=10**9), ValueError, "n_turns must be <= 4096"),
+        (lambda: _make_discrete(n_move_lengths=10**9, move_length=(0.1, 0.3)), ValueError,
+         "n_move_lengths must be <= 4096, got 1000000000"),
+        (lambda: _replicate(-1), ValueError, "replicate count must be >= 1, got -1"),
+        (lambda: _replicate(0), ValueError, "replicate count must be >= 1, got 0"),
+        (lambda: _replicate(2.5), TypeError, "replicate count must be an int, got 2.5"),
+        (lambda: _fr_region(-0.1), ValueError, "epsilon must be in (0, pi/2) radians, got -0.1"),
+        (lambda: _fr_region(0.0), ValueError, "epsilon must be in (0, pi/2) radians, got 0.0"),
+        (lambda: _fr_region(2.0), ValueError, "epsilon must be in (0, pi/2) radians, got 2.0"),
+    ],
+    ids=[
+        "n_turns=1e8", "n_turns=1e9", "n_move_lengths=1e9", "replicate(-1)", "replicate(0)",
+        "replicate(2.5)", "fr_region(eps<0)", "fr_region(eps=0)", "fr_region(eps>pi/2)",
+    ],
+)  # fmt: skip
+def test_api_values_out_of_range_are_refused_by_name(
+    call: Any, error: type[Exception], message: str
+) -> None:
+    with pytest.raises(error) as raised:
+        call()
+    assert message in str(raised.value)
+
+
+def test_the_largest_action_tables_are_accepted() -> None:
+    _make_discrete(n_turns=4096, n_move_lengths=4096, move_length=(0.1, 0.3))
+
+
+@pytest.mark.parametrize("dtype", ["float16", "longdouble", "int8", "float32", "float64"])
+def test_continuous_actions_of_any_real_dtype_step_like_float64(dtype: str) -> None:
+    import gymnasium as gym
+    import numpy as np
+
+    def first_step(action: Any) -> Any:
+        env = gym.make("bearing_env:BearingSLAM-v0", scenario="khepera")
+        env.reset(seed=3)
+        return env.step(action)[0]
+
+    values = [-1.0, 1.0]  # exact in every dtype (0.5 is not an int8)
+    expected = first_step(np.array(values, dtype=np.float64))
+    assert np.array_equal(first_step(np.array(values, dtype=dtype)), expected)
+
+
+@pytest.mark.parametrize(
+    "action", [["a", "b"], [1 + 1j, 0], [True, False], [None, 0.5]], ids=str
+)
+def test_non_numeric_continuous_actions_are_refused_by_value(action: list[Any]) -> None:
+    import gymnasium as gym
+    import numpy as np
+
+    env = gym.make("bearing_env:BearingSLAM-v0", scenario="khepera")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="must be real numbers"):
+        env.step(np.array(action))
