@@ -99,7 +99,10 @@ from bearing_env.benchmarks.bench_timing import (
     log,
     profile,
 )
-from bearing_env.train.cli_values import json_safe, parse_key_values
+from bearing_env.train.cli_values import COUNT, at_least, json_safe, parse_key_values, seconds
+from bearing_env.train.errors import exit_on_output_errors
+
+from bearing_env.envs.config import MAX_N_LANDMARKS
 
 # --------------------------------------------------------------------------------------
 # Command line
@@ -110,14 +113,30 @@ def _split_list(values: Sequence[str]) -> list[str]:
     return [item for value in values for item in value.replace(",", " ").split()]
 
 
-def _int_list(values: Sequence[str], option: str) -> list[int]:
+def _int_list(
+    values: Sequence[str], option: str, minimum: int = 1, maximum: int | None = None
+) -> list[int]:
+    """The integers of ``values`` (comma or space separated), each checked by
+    ``cli_values.at_least(minimum, maximum)``; ArgumentTypeError naming ``option``."""
+    check = at_least(minimum, maximum)
+    items = _split_list(values)
+    if not items:
+        raise argparse.ArgumentTypeError(f"argument {option}: expected integers")
     try:
-        numbers = [int(item) for item in _split_list(values)]
-    except ValueError as error:
-        raise argparse.ArgumentTypeError(f"{option}: {error}") from error
-    if not numbers or min(numbers) < 1:
-        raise argparse.ArgumentTypeError(f"{option} needs positive integers")
-    return numbers
+        return [check(item) for item in items]
+    except argparse.ArgumentTypeError as error:
+        raise argparse.ArgumentTypeError(f"argument {option}: {error}") from None
+
+
+def _check_env_kwargs(env_kwargs: dict[str, Any]) -> None:
+    """Build (and close) one BearingSLAM-v0 env with ``env_kwargs``: an unknown or bad
+    kwarg fails now, in one line, not after minutes of measurements."""
+    import gymnasium as gym
+
+    try:
+        gym.make("BearingSLAM-v0", **env_kwargs).close()
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"--env-kwargs: {error}") from None
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -128,7 +147,12 @@ def build_parser() -> argparse.ArgumentParser:
         "JSON. (The world-model update() benchmark: bearing-env bench --slam.)",
     )
     add = parser.add_argument
-    add("--seconds", type=float, default=None, help=f"time per measurement ({DEFAULT_SECONDS:g})")
+    add(
+        "--seconds",
+        type=seconds,
+        default=None,
+        help=f"time per measurement, finite and > 0 ({DEFAULT_SECONDS:g})",
+    )
     add("--json", type=Path, default=DEFAULT_JSON, help="output JSON (default %(default)s)")
     add("--no-json", action="store_true", help="do not write the JSON")
     add(
@@ -150,7 +174,8 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="+",
         default=None,
         metavar="N",
-        help="landmark counts of the single-env random scenario (default 4,16,64)",
+        help=f"landmark counts of the single-env random scenario, 3 to {MAX_N_LANDMARKS} "
+        "(default 4,16,64)",
     )
     add(
         "--env-kwargs",
@@ -159,16 +184,16 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="K=V",
         help="env kwargs of the vector and PPO sections (default scenario=khepera)",
     )
-    add("--ppo-envs", type=int, default=None, help=f"PPO n_envs (default {DEFAULT_PPO_ENVS})")
+    add("--ppo-envs", type=COUNT, default=None, help=f"PPO n_envs (default {DEFAULT_PPO_ENVS})")
     add(
         "--ppo-steps",
-        type=int,
+        type=COUNT,
         default=None,
         help=f"timed PPO env steps, rounded up to whole rollouts (default {DEFAULT_PPO_STEPS})",
     )
     add(
         "--ppo-rounds",
-        type=int,
+        type=COUNT,
         default=None,
         help=f"interleaved timed rounds per PPO kind; the median counts "
         f"(default {DEFAULT_PPO_ROUNDS}; --quick 1)",
@@ -197,7 +222,7 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("single", "vector"),
         help="cProfile that loop for --seconds, print the top 25 functions by tottime, exit",
     )
-    add("--profile-num-envs", type=int, default=64, help="vector env size for --profile vector")
+    add("--profile-num-envs", type=COUNT, default=64, help="vector env size for --profile vector")
     add(
         "--slam",
         action="store_true",
@@ -232,15 +257,18 @@ def settings_from_args(args: argparse.Namespace, parser: argparse.ArgumentParser
         parser.error(f"--ppo-kinds: choose from {','.join(PPO_KINDS)}")
     try:
         num_envs = _int_list(args.num_envs, "--num-envs") if args.num_envs else None
-        landmarks = _int_list(args.landmarks, "--landmarks") if args.landmarks else None
+        landmarks = (
+            _int_list(args.landmarks, "--landmarks", 3, MAX_N_LANDMARKS)
+            if args.landmarks
+            else None
+        )
         env_kwargs = {"scenario": "khepera", **parse_key_values(args.env_kwargs, "--env-kwargs")}
+        _check_env_kwargs(env_kwargs)
         overrides = parse_key_values(args.ppo_hyperparams, "--ppo-hyperparams")
     except (argparse.ArgumentTypeError, ValueError) as error:
         parser.error(str(error))
     quick = bool(args.quick)
-    seconds = args.seconds if args.seconds is not None else (0.05 if quick else DEFAULT_SECONDS)
-    if not seconds > 0:
-        parser.error("--seconds must be > 0")
+    measure = args.seconds if args.seconds is not None else (0.05 if quick else DEFAULT_SECONDS)
     ppo_envs = args.ppo_envs if args.ppo_envs is not None else (2 if quick else DEFAULT_PPO_ENVS)
     ppo_steps = args.ppo_steps
     if ppo_steps is None:
@@ -255,7 +283,7 @@ def settings_from_args(args: argparse.Namespace, parser: argparse.ArgumentParser
         quick_overrides["batch_size"] = int(overrides.get("n_steps", 8)) * ppo_envs
         overrides = {**quick_overrides, **overrides}
     return Settings(
-        seconds=float(seconds),
+        seconds=float(measure),
         sections=tuple(section for section in SECTIONS if section in sections),
         num_envs=tuple(num_envs or ((1, 4) if quick else DEFAULT_NUM_ENVS)),
         landmarks=tuple(landmarks or DEFAULT_SINGLE_LANDMARKS),
@@ -341,8 +369,7 @@ def main(argv: Sequence[str] | None = None) -> dict[str, Any] | None:
     if "--slam" in arguments:  # forward to the world-model benchmark, which has its own options
         from bearing_env.benchmarks import bench_slam
 
-        sys.argv = ["bench_slam", *(arg for arg in arguments if arg != "--slam")]
-        bench_slam.main()
+        bench_slam.main([arg for arg in arguments if arg != "--slam"])
         return None
     parser = build_parser()
     args = parser.parse_args(arguments)
@@ -350,11 +377,18 @@ def main(argv: Sequence[str] | None = None) -> dict[str, Any] | None:
     if args.profile is not None:
         profile(args.profile, settings.seconds, args.profile_num_envs, settings.env_kwargs)
         return None
+    json_path = settings.json_path
+    if json_path is not None:
+        # A --json that cannot be written (a parent that is a file, a read-only folder)
+        # fails before the measurements; a full disk at the end: one line naming it.
+        with exit_on_output_errors(parser, json_path, "--json", refusals=()):
+            json_path.parent.mkdir(parents=True, exist_ok=True)
     results = run(settings)
     print_table(results)
-    if settings.json_path is not None:
-        write_json(settings.json_path, results)
-        print(f"\nJSON: {settings.json_path}")
+    if json_path is not None:
+        with exit_on_output_errors(parser, json_path, "--json", refusals=()):
+            write_json(json_path, results)
+        print(f"\nJSON: {json_path}")
     return results
 
 

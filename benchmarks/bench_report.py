@@ -10,7 +10,6 @@ import math
 import os
 import platform
 import sys
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Literal
@@ -21,6 +20,7 @@ from bearing_env.benchmarks.bench_timing import (
     ppo_label,
     vector_label,
 )
+from bearing_env.train.files import atomic_write_text
 
 import bearing_env
 
@@ -167,18 +167,9 @@ def _finite(value: Any) -> Any:
 
 
 def write_json(path: Path, results: dict[str, Any]) -> None:
-    """Write ``results`` to ``path`` atomically (temp file in the same folder + os.replace)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    text = json.dumps(_finite(results), indent=2, allow_nan=False) + "\n"
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(handle, "w") as fh:
-            fh.write(text)
-        os.replace(temporary, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(temporary)
-        raise
+    """Write ``results`` to ``path`` atomically (``files.atomic_write_text``: an OSError
+    names ``path``)."""
+    atomic_write_text(path, json.dumps(_finite(results), indent=2, allow_nan=False) + "\n")
 
 
 def _pct(value: float | None) -> str:

@@ -10,10 +10,16 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
+from collections.abc import Sequence
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
+from bearing_env.train.cli_values import seconds
+from bearing_env.train.errors import exit_on_output_errors
+from bearing_env.train.files import atomic_write_text
 
 from bearing_env.slam import PolygonSLAM
 
@@ -69,11 +75,18 @@ def updates_per_second(n_landmarks: int, transfer: str, seconds: float) -> float
     return count / (time.perf_counter() - start)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seconds", type=float, default=2.0, help="time per measurement")
-    parser.add_argument("--json", type=str, default=None, help="also write results here")
-    args = parser.parse_args()
+def main(argv: Sequence[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(
+        prog="bearing-env bench-slam", description=__doc__.splitlines()[0]
+    )
+    parser.add_argument(
+        "--seconds",
+        type=seconds,
+        default=2.0,
+        help="time per measurement, finite and > 0 (default %(default)s)",
+    )
+    parser.add_argument("--json", type=Path, default=None, help="also write results here")
+    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
 
     cartpole = cartpole_steps_per_second(args.seconds)
     print(f"CartPole-v1 env.step: {cartpole:10.0f} steps/s (reference, same run)")
@@ -88,9 +101,9 @@ def main() -> None:
                 f"update() {transfer:>12} {n:3d} landmarks: {rate:8.0f} /s"
                 f"  = {rate / cartpole:6.1%} of CartPole   {rate / base:5.2f} x the 4-landmark rate"
             )
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(results, fh, indent=2)
+    if args.json is not None:
+        with exit_on_output_errors(parser, args.json, "--json", refusals=()):
+            atomic_write_text(args.json, json.dumps(results, indent=2))
 
 
 if __name__ == "__main__":

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from bearing_env.train.cli_values import COUNT, SEED
 from bearing_env.train.errors import exit_on_output_errors
 from bearing_env.train.files import write_json_atomically
 
@@ -81,7 +82,7 @@ def make_parser() -> argparse.ArgumentParser:
         prog="bearing-env region-search", description=__doc__.splitlines()[0]
     )
     parser.add_argument(
-        "--movements", type=int, default=2_000_000,
+        "--movements", type=COUNT, default=2_000_000,
         help="movements to check per transfer (default 2000000)",
     )
     parser.add_argument(
@@ -90,11 +91,11 @@ def make_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--fusion", choices=FUSIONS, default="intersect", help="map fusion")
     parser.add_argument(
-        "--moves", type=int, default=1,
+        "--moves", type=COUNT, default=1,
         help="movements per map before a fresh one (default 1: single movements)",
     )
-    parser.add_argument("--batch", type=int, default=4096, help="maps per batch")
-    parser.add_argument("--seed", type=int, default=0, help="search seed")
+    parser.add_argument("--batch", type=COUNT, default=4096, help="maps per batch")
+    parser.add_argument("--seed", type=SEED, default=0, help="search seed")
     parser.add_argument(
         "--noise-fraction", type=float, default=1.0,
         help="noise bound as a fraction of epsilon; containment is checked when <= 1",
@@ -107,13 +108,6 @@ def make_parser() -> argparse.ArgumentParser:
 def parse_args(argv: list[str] | None = None) -> tuple[argparse.ArgumentParser, argparse.Namespace]:
     parser = make_parser()
     args = parser.parse_args(argv)
-    for option in ("movements", "moves", "batch"):
-        if getattr(args, option) < 1:
-            parser.error(f"--{option} must be >= 1, got {getattr(args, option)!r}")
-    if args.json is not None and not Path(args.json).parent.is_dir():
-        parser.error(f"--json: no folder {str(Path(args.json).parent)!r} to write {args.json!r} in")
-    if args.seed < 0:
-        parser.error(f"--seed must be >= 0, got {args.seed!r}")
     if not (math.isfinite(args.noise_fraction) and args.noise_fraction >= 0.0):
         parser.error(f"--noise-fraction must be finite and >= 0, got {args.noise_fraction!r}")
     return parser, args
@@ -121,6 +115,9 @@ def parse_args(argv: list[str] | None = None) -> tuple[argparse.ArgumentParser, 
 
 def main(argv: list[str] | None = None) -> None:
     parser, args = parse_args(argv)
+    if args.json:  # an unwritable --json fails before the search, in one line
+        with exit_on_output_errors(parser, Path(args.json), "--json", refusals=()):
+            Path(args.json).parent.mkdir(parents=True, exist_ok=True)
     base = SearchSettings(fusion=args.fusion, moves=args.moves, noise_fraction=args.noise_fraction)
     reports: dict[str, SearchReport] = {}
     for transfer in args.transfers:
@@ -141,7 +138,7 @@ def main(argv: list[str] | None = None) -> None:
             name: {c: getattr(r, c) for c in COLUMNS} | {"examples": r.examples}
             for name, r in reports.items()
         }}
-        with exit_on_output_errors(parser, Path(args.json), "--json"):
+        with exit_on_output_errors(parser, Path(args.json), "--json", refusals=()):
             write_json_atomically(Path(args.json), payload)
     if any(report.defects for report in reports.values()):
         sys.exit(1)

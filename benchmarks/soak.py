@@ -29,6 +29,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+from bearing_env.train.cli_values import COUNT, SEED
 from bearing_env.train.errors import exit_on_output_errors
 from bearing_env.train.files import write_json_atomically
 
@@ -126,7 +127,10 @@ def soak_configuration(
 
 
 def run(steps: int, seed: int, episodes: int, progress: bool = False) -> SoakReport:
-    """Soak at least ``steps`` env steps over configurations drawn from ``seed``."""
+    """Soak at least ``steps`` env steps over configurations drawn from ``seed``.
+
+    Every configuration that runs steps at least one, so at most ``steps`` are drawn:
+    configurations that all fail before their first step end the soak too."""
     rng = np.random.default_rng(seed)
     report = SoakReport()
     try:
@@ -135,7 +139,7 @@ def run(steps: int, seed: int, episodes: int, progress: bool = False) -> SoakRep
         progress = False
     bar = tqdm(total=steps, unit="step", desc="soak") if progress else None
     try:
-        while report.steps < steps:
+        while report.steps < steps and report.configurations < steps:
             before = report.steps
             env_id, kwargs = random_configuration(rng)
             soak_configuration(env_id, kwargs, int(rng.integers(2**31)), episodes, report)
@@ -151,9 +155,11 @@ def run(steps: int, seed: int, episodes: int, progress: bool = False) -> SoakRep
 
 def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="bearing-env soak", description=__doc__.splitlines()[0])
-    parser.add_argument("--steps", type=int, default=1_000_000, help="env steps (default 1000000)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the configurations")
-    parser.add_argument("--episodes", type=int, default=5, help="episodes per configuration")
+    parser.add_argument(
+        "--steps", type=COUNT, default=1_000_000, help="env steps (default 1000000)"
+    )
+    parser.add_argument("--seed", type=SEED, default=0, help="seed of the configurations")
+    parser.add_argument("--episodes", type=COUNT, default=5, help="episodes per configuration")
     parser.add_argument("--json", default=None, help="also write the counts here")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     return parser
@@ -162,20 +168,16 @@ def make_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> None:
     parser = make_parser()
     args = parser.parse_args(argv)
-    for option in ("steps", "episodes"):
-        if getattr(args, option) < 1:
-            parser.error(f"--{option} must be >= 1, got {getattr(args, option)!r}")
-    if args.seed < 0:
-        parser.error(f"--seed must be >= 0, got {args.seed!r}")
-    if args.json is not None and not Path(args.json).parent.is_dir():
-        parser.error(f"--json: no folder {str(Path(args.json).parent)!r} to write {args.json!r} in")
+    if args.json:  # an unwritable --json fails before the soak, in one line
+        with exit_on_output_errors(parser, Path(args.json), "--json", refusals=()):
+            Path(args.json).parent.mkdir(parents=True, exist_ok=True)
     report = run(args.steps, args.seed, args.episodes, not args.no_progress)
     counts = {name: value for name, value in asdict(report).items() if name != "failures"}
     print(f"seed {args.seed}: " + ", ".join(f"{name} {value:,}" for name, value in counts.items()))
     for failure in report.failures:
         print(f"failure: {failure}")
     if args.json:
-        with exit_on_output_errors(parser, Path(args.json), "--json"):
+        with exit_on_output_errors(parser, Path(args.json), "--json", refusals=()):
             write_json_atomically(Path(args.json), {"seed": args.seed, **asdict(report)})
     if report.defects:
         sys.exit(1)

@@ -275,3 +275,329 @@ def test_train_on_a_full_disk_names_the_file(
     line = one_line_error(capsys.readouterr().err, "bearing-env train")
     assert str(run / "run.json") in line and "No space left on device" in line
     assert not [p for p in run.iterdir() if p.name.endswith(".tmp")]
+
+
+# --------------------------------------------------------------------------------------
+# The Python API: bad values are a TypeError or ValueError naming them
+# --------------------------------------------------------------------------------------
+
+
+def _make_discrete(**kwargs: Any) -> None:
+    import gymnasium as gym
+
+    gym.make("bearing_env:BearingSLAMDiscrete-v0", **kwargs)
+
+
+def _replicate(count: Any) -> None:
+    import numpy as np
+
+    from bearing_env.slam import PolygonSLAM
+
+    PolygonSLAM(4, np.deg2rad(2.0)).replicate(count)
+
+
+def _fr_region(epsilon: float) -> None:
+    from bearing_env.slam import fr_region
+
+    fr_region(1.0, 1.2, epsilon)
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "message"),
+    [
+        (lambda: _make_discrete(n_turns=10**8), ValueError,
+         "n_turns must be <= 4096, got 100000000"),
+        (lambda: _make_discrete(n_turns=10**9), ValueError, "n_turns must be <= 4096"),
+        (lambda: _make_discrete(n_move_lengths=10**9, move_length=(0.1, 0.3)), ValueError,
+         "n_move_lengths must be <= 4096, got 1000000000"),
+        (lambda: _replicate(-1), ValueError, "replicate count must be >= 1, got -1"),
+        (lambda: _replicate(0), ValueError, "replicate count must be >= 1, got 0"),
+        (lambda: _replicate(2.5), TypeError, "replicate count must be an int, got 2.5"),
+        (lambda: _fr_region(-0.1), ValueError, "epsilon must be in (0, pi/2) radians, got -0.1"),
+        (lambda: _fr_region(0.0), ValueError, "epsilon must be in (0, pi/2) radians, got 0.0"),
+        (lambda: _fr_region(2.0), ValueError, "epsilon must be in (0, pi/2) radians, got 2.0"),
+    ],
+    ids=[
+        "n_turns=1e8", "n_turns=1e9", "n_move_lengths=1e9", "replicate(-1)", "replicate(0)",
+        "replicate(2.5)", "fr_region(eps<0)", "fr_region(eps=0)", "fr_region(eps>pi/2)",
+    ],
+)  # fmt: skip
+def test_api_values_out_of_range_are_refused_by_name(
+    call: Any, error: type[Exception], message: str
+) -> None:
+    with pytest.raises(error) as raised:
+        call()
+    assert message in str(raised.value)
+
+
+def test_the_largest_action_tables_are_accepted() -> None:
+    _make_discrete(n_turns=4096, n_move_lengths=4096, move_length=(0.1, 0.3))
+
+
+@pytest.mark.parametrize("dtype", ["float16", "longdouble", "int8", "float32", "float64"])
+def test_continuous_actions_of_any_real_dtype_step_like_float64(dtype: str) -> None:
+    import gymnasium as gym
+    import numpy as np
+
+    def first_step(action: Any) -> Any:
+        env = gym.make("bearing_env:BearingSLAM-v0", scenario="khepera")
+        env.reset(seed=3)
+        return env.step(action)[0]
+
+    values = [-1.0, 1.0]  # exact in every dtype (0.5 is not an int8)
+    expected = first_step(np.array(values, dtype=np.float64))
+    assert np.array_equal(first_step(np.array(values, dtype=dtype)), expected)
+
+
+@pytest.mark.parametrize(
+    "action", [["a", "b"], [1 + 1j, 0], [True, False], [None, 0.5]], ids=str
+)
+def test_non_numeric_continuous_actions_are_refused_by_value(action: list[Any]) -> None:
+    import gymnasium as gym
+    import numpy as np
+
+    env = gym.make("bearing_env:BearingSLAM-v0", scenario="khepera")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="must be real numbers"):
+        env.step(np.array(action))
+
+
+# --------------------------------------------------------------------------------------
+# Bad values on the command line: an argparse usage error, one error line, status 2
+# --------------------------------------------------------------------------------------
+
+
+def usage_error(stderr: str, prog: str) -> str:
+    """The one error line of a usage error: argparse's usage lines may come first, then
+    exactly one ``<prog>: error: ...`` line, and no traceback."""
+    lines = [line for line in stderr.splitlines() if line.strip()]
+    assert "Traceback" not in stderr, stderr
+    errors = [line for line in lines if line.startswith(f"{prog}: error: ")]
+    assert len(errors) == 1 and lines[-1] == errors[0], stderr
+    assert all(line.startswith(("usage:", " ")) for line in lines[:-1]), stderr
+    return errors[0]
+
+
+def cli_exit(
+    argv: list[str], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> tuple[int | str | None, str]:
+    """Run ``bearing-env ARGV`` in this process; its exit status and its stderr."""
+    from bearing_env.train import cli
+
+    monkeypatch.setattr(sys, "argv", ["bearing-env", *argv])  # cli.main sets it: restore
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(argv)
+    return exit_info.value.code, capsys.readouterr().err
+
+
+def closed_port() -> int:
+    """A port on 127.0.0.1 that nothing listens on (bound, then released)."""
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+_QUICK = ["--policies", "random", "--env-kwargs", "scenario=khepera", "max_moves=2"]
+_TRAIN = ["train", "--algo", "ppo", "--no-progress", "--no-tensorboard", "--eval-freq", "0"]
+
+#: (argv, text of the error line). ``{tmp}``: a fresh folder; ``{a_file}``: a regular file;
+#: ``{port}``: a closed port on 127.0.0.1.
+BAD_VALUES: list[tuple[list[str], str]] = [
+    # compare
+    (["compare", "--env", "NoSuch-v0", *_QUICK], "unknown env id 'NoSuch-v0'"),
+    (["compare", "--seed-start", "-5"], "argument --seed-start: must be >= 0, got -5"),
+    (["compare", "--bootstrap-seed", "-1"], "argument --bootstrap-seed: must be >= 0, got -1"),
+    (["compare", "--episodes", "0"], "argument --episodes: must be >= 1, got 0"),
+    (["compare", "--episodes", "x"], "argument --episodes: expected an integer, got 'x'"),
+    (["compare", "--workers", "0"], "argument --workers: must be >= 1, got 0"),
+    (["compare", "--workers", "-1"], "argument --workers: must be >= 1, got -1"),
+    (["compare", "--bootstrap", "-1"], "argument --bootstrap: must be >= 1, got -1"),
+    (["compare", "--stop-after", "-1"], "argument --stop-after: must be >= 0, got -1"),
+    (["compare", *_QUICK, "--resume", "--out", "{tmp}/none"], "holds no comparison"),
+    (["compare", "--resume", "--overwrite"],
+     "argument --overwrite: not allowed with argument --resume"),
+    (["compare", *_QUICK, "--executor", "ray", "--ray-address", "127.0.0.1:{port}"],
+     "Ray address '127.0.0.1:{port}' does not answer"),
+    (["compare", *_QUICK, "--executor", "ray", "--ray-address", "nowhere"],
+     "Ray address 'nowhere': expected HOST:PORT"),
+    # train
+    ([*_TRAIN, "--hyperparams", "n_steps=-1", "--output", "{tmp}/run"],
+     "hyperparameter n_steps must be >= 1, got -1"),
+    ([*_TRAIN, "--hyperparams", "batch_size=0", "--output", "{tmp}/run"],
+     "hyperparameter batch_size must be >= 2, got 0"),
+    ([*_TRAIN, "--torch-threads", "-1"], "argument --torch-threads: must be >= 0, got -1"),
+    ([*_TRAIN, "--env", "NoSuch-v0", "--output", "{tmp}/run"], "unknown env id 'NoSuch-v0'"),
+    ([*_TRAIN, "--timesteps", "0"], "argument --timesteps: must be >= 1, got 0"),
+    ([*_TRAIN, "--seed", "-1"], "argument --seed: must be >= 0, got -1"),
+    ([*_TRAIN, "--n-envs", "0"], "argument --n-envs: must be >= 1, got 0"),
+    ([*_TRAIN, "--eval-episodes", "0"], "argument --eval-episodes: must be >= 1, got 0"),
+    ([*_TRAIN, "--checkpoint-freq", "0"], "argument --checkpoint-freq: must be >= 1, got 0"),
+    ([*_TRAIN, "--keep-checkpoints", "0"], "argument --keep-checkpoints: must be >= 1, got 0"),
+    ([*_TRAIN, "--eval-freq", "-1"], "argument --eval-freq: must be >= 0, got -1"),
+    # bench
+    (["bench", "--landmarks", "2"], "argument --landmarks: must be >= 3, got 2"),
+    (["bench", "--num-envs", "0"], "argument --num-envs: must be >= 1, got 0"),
+    (["bench", "--env-kwargs", "foo=1"], "--env-kwargs: "),
+    (["bench", "--json", "{a_file}/b.json"], "cannot write {a_file}: File exists"),
+    (["bench", "--seconds", "inf"], "argument --seconds: must be finite and > 0, got inf"),
+    (["bench", "--seconds", "nan"], "argument --seconds: must be finite and > 0, got nan"),
+    (["bench", "--seconds", "0"], "argument --seconds: must be finite and > 0, got 0.0"),
+    (["bench", "--ppo-envs", "0"], "argument --ppo-envs: must be >= 1, got 0"),
+    (["bench", "--profile-num-envs", "0"], "argument --profile-num-envs: must be >= 1, got 0"),
+    # bench-slam
+    (["bench-slam", "--seconds", "-1"], "argument --seconds: must be finite and > 0, got -1.0"),
+    (["bench-slam", "--seconds", "inf"], "argument --seconds: must be finite and > 0, got inf"),
+    # figures
+    (["figures", "--seeds", "-1"], "argument --seeds: must be >= 1, got -1"),
+    (["figures", "--seeds", "0"], "argument --seeds: must be >= 1, got 0"),
+    (["figures", "--seed-start", "-1"], "argument --seed-start: must be >= 0, got -1"),
+    (["figures", "--fig7-seed", "-1"], "argument --fig7-seed: must be >= 0, got -1"),
+    (["figures", "--only", "7", "--out", "{a_file}/figs"],
+     "cannot write {a_file}/figs: Not a directory"),
+    # demo
+    (["demo", "--episodes", "0"], "argument --episodes: must be >= 1, got 0"),
+    (["demo", "--episodes", "-1"], "argument --episodes: must be >= 1, got -1"),
+    (["demo", "--moves", "0"], "argument --moves: must be >= 1, got 0"),
+    (["demo", "--moves", "-1"], "argument --moves: must be >= 1, got -1"),
+    (["demo", "--seed", "-1"], "argument --seed: must be >= 0, got -1"),
+    # rllib and sweep share their options
+    (["rllib", "--iterations", "0"], "argument --iterations: must be >= 1, got 0"),
+    (["rllib", "--checkpoint-every", "0"], "argument --checkpoint-every: must be >= 1, got 0"),
+    (["rllib", "--stop-after", "-1"], "argument --stop-after: must be >= 0, got -1"),
+    (["sweep", "--seed", "-1"], "argument --seed: must be >= 0, got -1"),
+]
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"), BAD_VALUES, ids=[" ".join(argv) for argv, _ in BAD_VALUES]
+)
+def test_a_bad_value_ends_in_one_line_naming_it_with_status_2(
+    argv: list[str],
+    expected: str,
+    tmp_path: Path,
+    a_file: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    if "train" in argv:
+        pytest.importorskip("stable_baselines3")
+    port = closed_port()
+    fill = {"tmp": str(tmp_path), "a_file": str(a_file), "port": str(port)}
+    argv = [arg.format(**fill) for arg in argv]
+    code, err = cli_exit(argv, capsys, monkeypatch)
+    assert code == EXIT_ERROR, err
+    line = usage_error(err, f"bearing-env {argv[0]}")
+    assert expected.format(**fill) in line
+
+
+def test_train_on_a_missing_cuda_device_fails_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    torch = pytest.importorskip("torch")
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
+    code, err = cli_exit([*_TRAIN, "--device", "cuda", "--output", str(tmp_path / "r")],
+                         capsys, monkeypatch)
+    assert code == EXIT_ERROR
+    line = usage_error(err, "bearing-env train")
+    assert "device 'cuda': CUDA is not available" in line
+    assert not (tmp_path / "r").exists()  # refused before anything was written
+
+
+def test_ppo_says_up_front_that_it_trains_whole_rollouts() -> None:
+    pytest.importorskip("stable_baselines3")
+    from bearing_env.train.train import rollout_notice
+
+    notice = rollout_notice({"n_steps": 256}, 16, 0, 100)
+    assert notice is not None and "\n" not in notice
+    assert "whole rollouts of 4096 env steps" in notice and "to 4096 timesteps, not 100" in notice
+    assert rollout_notice({"n_steps": 256}, 16, 0, 8192) is None  # whole rollouts: no note
+    assert "to 8192 timesteps, not 5000" in (rollout_notice({"n_steps": 256}, 16, 4096, 5000) or "")
+    assert rollout_notice({"train_freq": 1}, 4, 0, 100) is None  # off-policy: exact
+    with pytest.raises(ValueError, match="n_steps \\* n_envs must be >= 2"):
+        rollout_notice({"n_steps": 1}, 1, 0, 100)
+
+
+def test_a_ray_address_that_does_not_answer_is_refused() -> None:
+    from bearing_env.train.ray_executor import RayAddressError, check_ray_address
+
+    port = closed_port()
+    with pytest.raises(RayAddressError, match=f"'127.0.0.1:{port}' does not answer"):
+        check_ray_address(f"127.0.0.1:{port}", timeout=1.0)
+    with pytest.raises(RayAddressError, match="does not answer"):
+        check_ray_address(f"ray://127.0.0.1:{port}", timeout=1.0)
+    for malformed in ("127.0.0.1", "http://127.0.0.1:6379", "127.0.0.1:port"):
+        with pytest.raises(RayAddressError, match="expected HOST:PORT"):
+            check_ray_address(malformed)
+    check_ray_address("auto")  # left to Ray
+
+
+def test_bench_slam_into_a_closed_pipe_ends_quietly(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from bearing_env.train.errors import EXIT_BROKEN_PIPE
+
+    read_end, write_end = os.pipe()
+    os.close(read_end)  # `| head` has gone: every write is EPIPE
+    with open(write_end, "w", buffering=1) as closed_pipe:
+        monkeypatch.setattr(sys, "stdout", closed_pipe)
+        code, err = cli_exit(["bench-slam", "--seconds", "0.01"], capsys, monkeypatch)
+        monkeypatch.undo()
+    assert code == EXIT_BROKEN_PIPE
+    assert err == ""
+
+
+# --------------------------------------------------------------------------------------
+# bearing-env figures and bench: a read-only or full disk ends in one line
+# --------------------------------------------------------------------------------------
+
+
+def _read_only(*args: Any, **kwargs: Any) -> None:
+    raise OSError(errno.EROFS, os.strerror(errno.EROFS))
+
+
+def _disk_full(fd: int) -> None:
+    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+
+@pytest.mark.parametrize(
+    ("command", "patch", "written", "reason"),
+    [
+        (["figures", "--only", "7"], ("replace", _read_only), "fig7_polygons.png",
+         "Read-only file system"),
+        (["figures", "--only", "7"], ("fsync", _disk_full), "figures.json",
+         "No space left on device"),
+        (["bench", "--sections", "slam", "--seconds", "0.01"], ("replace", _read_only), "b.json",
+         "Read-only file system"),
+        (["bench", "--sections", "slam", "--seconds", "0.01"], ("fsync", _disk_full), "b.json",
+         "No space left on device"),
+        (["bench-slam", "--seconds", "0.01"], ("replace", _read_only), "b.json",
+         "Read-only file system"),
+        (["bench-slam", "--seconds", "0.01"], ("fsync", _disk_full), "b.json",
+         "No space left on device"),
+    ],
+    ids=["figures-read-only", "figures-full", "bench-read-only", "bench-full",
+         "bench-slam-read-only", "bench-slam-full"],
+)  # fmt: skip
+def test_figures_and_bench_on_a_bad_disk_name_the_file(
+    command: list[str],
+    patch: tuple[str, Any],
+    written: str,
+    reason: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The atomic writers' rename fails on a read-only file system, their fsync on a full
+    disk; either way the message names the file."""
+    out = tmp_path / "out"
+    where = ["--out", str(out)] if command[0] == "figures" else ["--json", str(out / "b.json")]
+    monkeypatch.setattr(os, *patch)
+    code, err = cli_exit([*command, *where], capsys, monkeypatch)
+    assert code == EXIT_ERROR, err
+    lines = [line for line in err.splitlines() if line.strip()]
+    errors = [line for line in lines if line.startswith(f"bearing-env {command[0]}: error: ")]
+    assert "Traceback" not in err and errors == lines[-1:], err  # after bench's progress log
+    assert str(out / written) in errors[0] and reason in errors[0]

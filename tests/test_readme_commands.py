@@ -54,6 +54,11 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env figures --out docs/figures": ("parse", ()),
     "bearing-env hyperparams ppo": ("run", ()),
     "bearing-env hyperparams": ("run", ()),
+    "bearing-env region-search --movements 2000000 --seed 2026": (
+        "run",
+        ("--movements", "300", "--no-progress"),
+    ),
+    "bearing-env soak --steps 1000000 --seed 2026": ("run", ("--steps", "30", "--no-progress")),
     "python -m bearing_env.train.demo": ("run", ("--episodes", "1", "--moves", "3")),
     "bearing-env compare --episodes 200 --workers 2 --out outputs/compare_khepera": (
         "parse",

@@ -237,12 +237,14 @@ def test_region_search_prints_counts_and_exits_1_on_a_defect(monkeypatch, capsys
         (["--moves", "-1"], "--moves"),
         (["--seed", "-5"], "--seed"),
         (["--noise-fraction", "nan"], "--noise-fraction"),
-        (["--json", "no/such/folder/out.json"], "--json"),
+        (["--json", "{a_file}/out.json"], "--json"),
     ],
 )
-def test_region_search_refuses_bad_values_in_one_line(argv, named, capsys):
+def test_region_search_refuses_bad_values_in_one_line(argv, named, capsys, tmp_path):
+    a_file = tmp_path / "a_file"
+    a_file.write_text("")
     with pytest.raises(SystemExit) as exit_info:
-        region_search.main(argv)
+        region_search.main([arg.format(a_file=a_file) for arg in argv])
     assert exit_info.value.code == 2
     last = capsys.readouterr().err.strip().splitlines()[-1]
     assert named in last and "error" in last

@@ -42,19 +42,21 @@ def test_the_soak_counts_misses_and_exceptions_and_exits_1(monkeypatch, capsys):
         raise RuntimeError("boom")
 
     monkeypatch.setattr(soak.gym, "make", broken)
-    with pytest.raises(SystemExit) as exit_info:
-        soak.main(["--steps", "1", "--no-progress"])
+    with pytest.raises(SystemExit) as exit_info:  # and ends although no step ever runs
+        soak.main(["--steps", "3", "--no-progress"])
     assert exit_info.value.code == 1
-    assert "RuntimeError: boom" in capsys.readouterr().out
+    assert "exceptions 3" in (out := capsys.readouterr().out) and "RuntimeError: boom" in out
 
 
 @pytest.mark.parametrize(
     ("argv", "named"),
     [(["--steps", "0"], "--steps"), (["--episodes", "-1"], "--episodes"),
-     (["--seed", "-2"], "--seed"), (["--json", "no/such/dir/x.json"], "--json")],
+     (["--seed", "-2"], "--seed"), (["--json", "{a_file}/x.json"], "--json")],
 )
-def test_the_soak_refuses_bad_values_in_one_line(argv, named, capsys):
+def test_the_soak_refuses_bad_values_in_one_line(argv, named, capsys, tmp_path):
+    a_file = tmp_path / "a_file"
+    a_file.write_text("")
     with pytest.raises(SystemExit) as exit_info:
-        soak.main(argv)
+        soak.main([arg.format(a_file=a_file) for arg in argv])
     assert exit_info.value.code == 2
     assert named in capsys.readouterr().err.strip().splitlines()[-1]

@@ -20,7 +20,9 @@ Each subcommand forwards its remaining arguments to the module that implements i
 ``bearing-env demo --help`` shows that module's options. A subcommand that needs an
 optional extra that is not installed (``train``: stable-baselines3, torch, matplotlib, ...;
 ``render``: pygame; ``ray``: ray, RLlib, Ray Tune) says which one to install,
-``pip install "bearing_env[train]"``, and exits with status 2.
+``pip install "bearing_env[train]"``, and exits with status 2. A bad option value ends
+as an argparse usage error (status 2) whose one error line names the option and the value
+(``bearing_env.train.cli_values``); output into a closed pipe (``... | head``) ends quietly.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import argparse
 import importlib
 import sys
 
-from bearing_env.train.errors import exit_on_missing_extra
+from bearing_env.train.errors import exit_on_missing_extra, exit_quietly_on_broken_pipe
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "demo": (
@@ -97,7 +99,7 @@ def main(argv: list[str] | None = None) -> None:
     module_name, _ = SUBCOMMANDS[command]
     sys.argv = [f"bearing-env {command}", *rest]
     # A subcommand whose optional extra is not installed says which one, in one line.
-    with exit_on_missing_extra(f"bearing-env {command}"):
+    with exit_quietly_on_broken_pipe(), exit_on_missing_extra(f"bearing-env {command}"):
         module = importlib.import_module(module_name)
         module.main()
 

@@ -1,16 +1,72 @@
-"""Values on their way in from the command line and out to JSON: ``KEY=VALUE`` items
-parsed as Python literals, and settings made JSON-safe.
+"""Values on their way in from the command line and out to JSON: counts, seeds and
+seconds checked as argparse parses them, ``KEY=VALUE`` items parsed as Python literals,
+and settings made JSON-safe.
 
-Used by ``bearing-env train`` (``--env-kwargs``, ``--hyperparams``), ``compare``
-(``--env-kwargs``) and ``bench`` (``--env-kwargs``, ``--ppo-hyperparams``), so the three
-read ``KEY=VALUE`` alike.
+Every subcommand's numeric options use the argparse types here (:func:`at_least`,
+:data:`COUNT`, :data:`SEED`, :func:`seconds`), so a bad value, such as ``--episodes 0``,
+``--seed -1`` or ``--seconds inf``, ends the command as an argparse usage error (exit
+status 2) whose one error line names the option and the value:
+``bearing-env compare: error: argument --episodes: must be >= 1, got 0``. Out-of-range
+values are refused, never replaced by defaults. The checks are the env config's own
+(:func:`bearing_env.envs.config.int_at_least`, :func:`~bearing_env.envs.config.positive_float`).
+
+``KEY=VALUE`` items: ``bearing-env train`` (``--env-kwargs``, ``--hyperparams``),
+``compare`` (``--env-kwargs``) and ``bench`` (``--env-kwargs``, ``--ppo-hyperparams``)
+read them alike.
 """
 
 from __future__ import annotations
 
+import argparse
 import ast
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import Any, TypeVar
+
+from bearing_env.envs.config import int_at_least, int_at_most, positive_float
+
+_T = TypeVar("_T")
+
+
+def _checked(check: Callable[..., _T], *args: Any) -> _T:
+    """``check(*args, "")`` (a validator of :mod:`bearing_env.envs.config`, whose last
+    argument is the name to put in its message), its error as an argparse type error;
+    argparse names the option."""
+    try:
+        return check(*args, "")
+    except (TypeError, ValueError) as error:
+        raise argparse.ArgumentTypeError(str(error).strip()) from None
+
+
+def at_least(minimum: int, maximum: int | None = None) -> Callable[[str], int]:
+    """An argparse ``type``: an integer ``>= minimum`` (and ``<= maximum`` if given)."""
+
+    def integer(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        value = _checked(int_at_least, value, minimum)
+        return value if maximum is None else _checked(int_at_most, value, maximum)
+
+    integer.__name__ = f"integer >= {minimum}"
+    return integer
+
+
+#: argparse ``type`` of a count of things to do (episodes, workers, seeds, moves): >= 1.
+COUNT = at_least(1)
+#: argparse ``type`` of a count that may be 0 (0 documented as "none"/"never"): >= 0.
+NON_NEGATIVE = at_least(0)
+#: argparse ``type`` of a seed: an integer >= 0 (numpy refuses negative seeds).
+SEED = at_least(0)
+
+
+def seconds(text: str) -> float:
+    """An argparse ``type``: a finite number of seconds > 0 (``inf`` would never end)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
+    return _checked(positive_float, value)
 
 
 def parse_literal(text: str) -> Any:
@@ -55,3 +111,23 @@ def json_safe(value: Any) -> Any:
     if value is None or isinstance(value, (bool, int, float, str)):
         return value
     return repr(value)
+
+
+def registered_env_id(env_id: str) -> str:
+    """``env_id`` (``"NAME-vN"`` or ``"module:NAME-vN"``, as ``gym.make`` reads it) when it
+    names a registered env; ValueError naming it otherwise (Gymnasium's own message leaves
+    out the version and the module)."""
+    import importlib
+
+    import gymnasium as gym
+
+    module, _, name = env_id.rpartition(":")
+    try:
+        importlib.import_module(module or "bearing_env")  # registers the module's ids
+    except ImportError as error:
+        raise ValueError(f"unknown env id {env_id!r}: cannot import {module!r} ({error})") from None
+    try:
+        gym.spec(name)
+    except gym.error.Error as error:
+        raise ValueError(f"unknown env id {env_id!r}: {error}") from None
+    return env_id

@@ -61,7 +61,13 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.cli_values import parse_key_values
+from bearing_env.train.cli_values import (
+    COUNT,
+    NON_NEGATIVE,
+    SEED,
+    parse_key_values,
+    registered_env_id,
+)
 from bearing_env.train.compare_config import (
     DEFAULT_BOOTSTRAP,
     DEFAULT_BOOTSTRAP_SEED,
@@ -82,6 +88,11 @@ from bearing_env.train.errors import (
     fail,
     missing_extra,
     require,
+)
+from bearing_env.train.ray_executor import (
+    RAY_CONNECT_TIMEOUT,
+    RayAddressError,
+    check_ray_address,
 )
 from bearing_env.train.seeds import EVAL_SEED_START
 
@@ -125,18 +136,21 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--episodes",
-        type=int,
+        type=COUNT,
         default=None,
         help="evaluation episodes per policy (default 200; --quick 20)",
     )
     parser.add_argument(
         "--seed-start",
-        type=int,
+        type=SEED,
         default=EVAL_SEED_START,
         help="seed of the first evaluation episode (default %(default)s)",
     )
     parser.add_argument(
-        "--workers", type=int, default=1, help="processes to run episodes in (default %(default)s)"
+        "--workers",
+        type=COUNT,
+        default=1,
+        help="processes to run episodes in, >= 1 (default %(default)s)",
     )
     parser.add_argument(
         "--executor",
@@ -149,7 +163,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--ray-address",
         default=None,
         metavar="ADDRESS",
-        help="with --executor ray: the running cluster to join (HOST:PORT, or auto)",
+        help="with --executor ray: the running cluster to join (HOST:PORT, or auto); a "
+        f"HOST:PORT that does not answer within {RAY_CONNECT_TIMEOUT:g} s is refused",
     )
     parser.add_argument(
         "--out",
@@ -157,15 +172,18 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="output folder (default outputs/compare; with --quick outputs/compare_quick)",
     )
-    parser.add_argument(
-        "--resume", action="store_true", help="finish the comparison already in --out"
+    again = parser.add_mutually_exclusive_group()
+    again.add_argument(
+        "--resume",
+        action="store_true",
+        help="finish the comparison already in --out (refused if --out holds none)",
     )
-    parser.add_argument(
+    again.add_argument(
         "--overwrite", action="store_true", help="discard the comparison already in --out"
     )
     parser.add_argument(
         "--stop-after",
-        type=int,
+        type=NON_NEGATIVE,
         default=None,
         metavar="N",
         help="run at most N new episodes, then write the outputs (resume later)",
@@ -178,11 +196,16 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--bootstrap",
-        type=int,
+        type=COUNT,
         default=DEFAULT_BOOTSTRAP,
-        help="bootstrap resamples for the CIs (default %(default)s)",
+        help="bootstrap resamples for the CIs, >= 1 (default %(default)s)",
     )
-    parser.add_argument("--bootstrap-seed", type=int, default=DEFAULT_BOOTSTRAP_SEED)
+    parser.add_argument(
+        "--bootstrap-seed",
+        type=SEED,
+        default=DEFAULT_BOOTSTRAP_SEED,
+        help="seed of the bootstrap resampling (default %(default)s)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     return parser
@@ -228,6 +251,7 @@ def shipped_policies(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
 
 
 def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
+    registered_env_id(args.env)
     env_kwargs = dict(DEFAULT_ENV_KWARGS)
     if args.env_kwargs is not None:
         env_kwargs = parse_key_values(args.env_kwargs, "--env-kwargs")
@@ -237,10 +261,12 @@ def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
         *(QUICK_POLICIES if args.quick else DEFAULT_POLICIES),
         *shipped_policies(args.env, env_kwargs),
     ]
-    episodes = args.episodes or (QUICK_EPISODES if args.quick else DEFAULT_EPISODES)
-    if episodes < 1:
-        raise ValueError(f"--episodes must be >= 1, got {episodes}")
-    out = args.out or Path("outputs/compare_quick" if args.quick else "outputs/compare")
+    episodes = args.episodes
+    if episodes is None:
+        episodes = QUICK_EPISODES if args.quick else DEFAULT_EPISODES
+    out = args.out if args.out is not None else Path(
+        "outputs/compare_quick" if args.quick else "outputs/compare"
+    )
     config = CompareConfig(
         policies=policies_from_specs(policies),
         env_id=args.env,
@@ -289,6 +315,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     try:
         if args.executor == "ray":
             require("ray", "--executor ray", extra="ray")
+            if args.ray_address is not None:
+                check_ray_address(args.ray_address)
         config, out = config_from_args(args)
         # Fail fast on a bad env or policy spec, before any worker starts.
         from bearing_env.agents.registry import make_policy
@@ -306,13 +334,14 @@ def main(argv: Sequence[str] | None = None) -> None:
     command = reproducing_command(sys.argv[1:] if argv is None else list(argv))
     started = time.perf_counter()
     try:
-        with exit_on_output_errors(parser, out, "--out", (RunMismatchError, CorruptLogError)):
+        refusals = (RunMismatchError, CorruptLogError, RayAddressError)
+        with exit_on_output_errors(parser, out, "--out", refusals):
             result = run_comparison(
                 config,
                 out,
                 workers=args.workers,
                 resume=args.resume,
-                overwrite=args.overwrite or args.quick,
+                overwrite=args.overwrite or (args.quick and not args.resume),
                 stop_after=args.stop_after,
                 progress=not args.no_progress,
                 plots=not args.no_plots,

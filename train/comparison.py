@@ -114,6 +114,13 @@ def run_comparison(
     out = Path(out)
     log = EpisodeLog(out / LOG_NAME)
     config_path = out / CONFIG_NAME
+    if resume and overwrite:
+        raise ValueError("resume and overwrite contradict each other: choose one")
+    if resume and not (log.path.exists() or config_path.exists()):
+        raise RunMismatchError(
+            f"cannot resume: {out} holds no comparison (no {LOG_NAME}, no {CONFIG_NAME}); "
+            "run without --resume to start one"
+        )
     if log.path.exists() and not (resume or overwrite):
         raise FileExistsError(
             f"{out} already holds a comparison ({LOG_NAME}); pass --resume to finish it "

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
+from bearing_env.train.cli_values import COUNT, SEED
 from bearing_env.train.errors import fail, write_error_message
 from numpy.typing import NDArray
 
@@ -97,11 +98,17 @@ def save_animation(frames: list[NDArray[np.uint8]], path: Path) -> Path:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--episodes", type=int, default=3)
-    parser.add_argument("--moves", type=int, default=DEFAULT_MOVES)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", type=Path, default=Path("outputs"))
+    parser = argparse.ArgumentParser(prog="bearing-env demo", description=__doc__.splitlines()[0])
+    parser.add_argument("--episodes", type=COUNT, default=3, help="default %(default)s")
+    parser.add_argument(
+        "--moves", type=COUNT, default=DEFAULT_MOVES, help="moves per episode (default %(default)s)"
+    )
+    parser.add_argument(
+        "--seed", type=SEED, default=0, help="seed of episode 0; episode i: seed + i (default 0)"
+    )
+    parser.add_argument(
+        "--out", type=Path, default=Path("outputs"), help="animation folder (default %(default)s)"
+    )
     args = parser.parse_args(argv)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     rendering = available("pygame")

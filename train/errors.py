@@ -3,6 +3,8 @@
 - An ``OSError`` while writing outputs (disk full, no permission, a parent that is a
   file, a read-only file system) ends the command with ``<prog>: error: <path>: <reason>``
   and exit status :data:`EXIT_ERROR`.
+- Output into a closed pipe (``bearing-env bench-slam | head -3``) ends the command
+  quietly (:func:`exit_quietly_on_broken_pipe`), as Python's documentation recommends.
 - A command or call that needs an optional extra that is not installed
   (``render``: pygame; ``train``: stable-baselines3, torch, matplotlib, ...; ``ray``:
   Ray, RLlib, Ray Tune) raises
@@ -13,6 +15,7 @@
 from __future__ import annotations
 
 import errno
+import os
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -32,11 +35,14 @@ from bearing_env.extras import (
 )
 
 __all__ = [
+    "EXIT_BROKEN_PIPE",
     "EXIT_ERROR",
     "MODULE_EXTRAS",
     "MissingExtraError",
     "available",
     "exit_on_missing_extra",
+    "exit_on_output_errors",
+    "exit_quietly_on_broken_pipe",
     "fail",
     "install_command",
     "missing_extra",
@@ -48,6 +54,8 @@ __all__ = [
 
 #: Exit status of a command that failed with a clear message (argparse's, for usage errors).
 EXIT_ERROR = 2
+#: Exit status when the reader of stdout went away (Python's own status on EPIPE).
+EXIT_BROKEN_PIPE = 1
 
 _HINTS = {
     getattr(errno, name): hint
@@ -58,6 +66,7 @@ _HINTS = {
         ("EPERM", "no permission to write there"),
         ("EROFS", "the file system is read-only"),
         ("ENOTDIR", "a parent of that path is a file, not a folder"),
+        ("EEXIST", "something of that name is in the way"),
     )
     if hasattr(errno, name)
 }
@@ -138,3 +147,18 @@ def exit_on_missing_extra(prog: str) -> Iterator[None]:
         if clear is None:
             raise
         fail(prog, str(clear))
+
+
+@contextmanager
+def exit_quietly_on_broken_pipe() -> Iterator[None]:
+    """End the command quietly, with :data:`EXIT_BROKEN_PIPE`, when the reader of its
+    stdout goes away (``bearing-env bench-slam | head -3``): no traceback, and no second
+    error when Python flushes stdout at exit, because stdout then points at
+    ``os.devnull`` (the recipe of Python's ``signal`` documentation)."""
+    try:
+        yield
+        sys.stdout.flush()  # inside the try: the last lines may fail only now
+    except BrokenPipeError:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        raise SystemExit(EXIT_BROKEN_PIPE) from None

@@ -49,8 +49,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from bearing_env.train.cli_values import COUNT, SEED
 from bearing_env.train.compare_runner import make_env
-from bearing_env.train.errors import fail
+from bearing_env.train.errors import exit_on_output_errors, fail
 from bearing_env.train.files import atomic_save_figure, atomic_write_text
 from bearing_env.train.seeds import EVAL_SEED_START
 from numpy.typing import NDArray
@@ -628,18 +629,21 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--seeds",
-        type=int,
+        type=COUNT,
         default=None,
         help=f"runs averaged in Figs. 10 and 11 (default {DEFAULT_SEEDS})",
     )
     parser.add_argument(
         "--seed-start",
-        type=int,
+        type=SEED,
         default=EVAL_SEED_START,
         help="seed of the first run of Figs. 10 and 11 (default %(default)s)",
     )
     parser.add_argument(
-        "--fig7-seed", type=int, default=0, help="first seed tried for Fig. 7 (default %(default)s)"
+        "--fig7-seed",
+        type=SEED,
+        default=0,
+        help="first seed tried for Fig. 7 (default %(default)s)",
     )
     parser.add_argument(
         "--transfer",
@@ -662,12 +666,23 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> None:
-    args = build_parser().parse_args(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
     if not available("matplotlib"):
-        fail("bearing-env figures", str(MissingExtraError("matplotlib", "drawing the figures")))
-    n_seeds = args.seeds or (QUICK_SEEDS if args.quick else DEFAULT_SEEDS)
+        fail(parser.prog, str(MissingExtraError("matplotlib", "drawing the figures")))
+    n_seeds = args.seeds
+    if n_seeds is None:
+        n_seeds = QUICK_SEEDS if args.quick else DEFAULT_SEEDS
     seeds = list(range(args.seed_start, args.seed_start + n_seeds))
     wanted = set(args.only or ("7", "10", "11", "robust"))
+    # Disk full, no permission, a parent that is a file: one line naming the file.
+    with exit_on_output_errors(parser, args.out, "--out", refusals=()):
+        make_figures(args, seeds, wanted)
+
+
+def make_figures(args: argparse.Namespace, seeds: list[int], wanted: set[str]) -> None:
+    """Draw the ``wanted`` figures into ``args.out`` and merge their numbers into
+    ``figures.json`` there."""
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
     results: dict[str, Any] = {}

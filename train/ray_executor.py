@@ -13,6 +13,12 @@ tasks join that cluster; without it, a Ray instance already started in this proc
 (``ray.init``) is used, else a local one is started for the run and shut down after it.
 Every node needs the same ``bearing_env`` installed (``pip install "bearing_env[ray]"``).
 
+Before ``ray.init`` joins a ``HOST:PORT`` (or ``ray://HOST:PORT``) address,
+:func:`check_ray_address` opens a TCP connection to it: an address that does not answer
+within :data:`RAY_CONNECT_TIMEOUT` seconds is refused with a
+:class:`RayAddressError` naming it (``ray.init`` itself would wait much longer, then fail
+with a traceback). ``auto`` is left to Ray.
+
 **Files.** A policy that reads files (``sb3:path=...``, ``pretrained:NAME``) gets them
 through Ray's object store, not the file system: the bytes of each file
 (:func:`bearing_env.agents.registry.spec_files`) are put there once, and each worker
@@ -31,7 +37,9 @@ import contextlib
 import hashlib
 import logging
 import os
+import socket
 import tempfile
+import urllib.parse
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -44,7 +52,53 @@ from bearing_env.extras import require
 #: A policy's files as they travel: option -> (file name, bytes).
 FileBundle = dict[str, tuple[str, bytes]]
 
-__all__ = ["FileBundle", "materialise", "ray_session", "read_bundle", "run_on_ray"]
+__all__ = [
+    "RAY_CONNECT_TIMEOUT",
+    "FileBundle",
+    "RayAddressError",
+    "check_ray_address",
+    "materialise",
+    "ray_session",
+    "read_bundle",
+    "run_on_ray",
+]
+
+#: Seconds a Ray cluster address (``--ray-address HOST:PORT``) has to accept a TCP
+#: connection before it is refused: a head node on a reachable network answers in
+#: milliseconds, and 5 s leaves room for a slow VPN without hanging the command.
+RAY_CONNECT_TIMEOUT = 5.0
+
+
+class RayAddressError(ValueError):
+    """A Ray cluster address that is malformed or does not answer."""
+
+
+def check_ray_address(address: str, timeout: float = RAY_CONNECT_TIMEOUT) -> None:
+    """Refuse a ``HOST:PORT`` (or ``ray://HOST:PORT``) Ray address whose port does not
+    accept a TCP connection within ``timeout`` seconds (:class:`RayAddressError` naming
+    it). ``auto`` and ``local`` (which Ray resolves itself) pass unchecked."""
+    if address in ("auto", "local"):
+        return
+    malformed = f"Ray address {address!r}: expected HOST:PORT, ray://HOST:PORT or auto"
+    scheme, separator, rest = address.rpartition("://")
+    if separator and scheme != "ray":
+        raise RayAddressError(malformed)
+    try:
+        parts = urllib.parse.urlsplit(f"//{rest}")
+        host, port = parts.hostname, parts.port
+    except ValueError:
+        host = port = None
+    if not host or port is None:
+        raise RayAddressError(malformed)
+    try:
+        with socket.create_connection((host, port), timeout=timeout):
+            pass
+    except OSError as error:
+        reason = "no answer" if isinstance(error, TimeoutError) else error.strerror or str(error)
+        raise RayAddressError(
+            f"Ray address {address!r} does not answer ({reason} within {timeout:g} s); "
+            "is the cluster's head node running (ray start --head) and reachable?"
+        ) from None
 
 
 def _ray() -> Any:
@@ -104,6 +158,8 @@ def ray_session(address: str | None = None, num_cpus: int | None = None) -> Iter
     if address is not None and num_cpus is not None:
         raise ValueError("num_cpus applies to a local Ray instance, not to a cluster address")
     started = not ray.is_initialized()
+    if started and address is not None:
+        check_ray_address(address)
     if started:
         options: dict[str, Any] = {
             "address": address,

@@ -50,11 +50,11 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.cli_values import parse_key_values
+from bearing_env.train.cli_values import COUNT, NON_NEGATIVE, SEED, parse_key_values
 from bearing_env.train.compare_config import DEFAULT_ENV_KWARGS
 from bearing_env.train.errors import available, exit_on_output_errors, fail, require
 from bearing_env.train.files import atomic_write_text
-from bearing_env.train.ray_executor import ray_session
+from bearing_env.train.ray_executor import RAY_CONNECT_TIMEOUT, check_ray_address, ray_session
 from bearing_env.train.seeds import TRAINING_SEED_LIMIT
 
 from bearing_env.registration import ENV_IDS
@@ -343,38 +343,38 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
     )
     add(
         "--iterations",
-        type=int,
+        type=COUNT,
         default=defaults.iterations,
         help="training iterations in total (default %(default)s)",
     )
-    add("--seed", type=int, default=defaults.seed, help="RLlib's seed (default %(default)s)")
+    add("--seed", type=SEED, default=defaults.seed, help="RLlib's seed (default %(default)s)")
     add(
         "--num-env-runners",
-        type=int,
+        type=NON_NEGATIVE,
         default=defaults.num_env_runners,
         help="remote env runners, one CPU each (0: sample in the driver; default %(default)s)",
     )
     add(
         "--envs-per-runner",
-        type=int,
+        type=COUNT,
         default=defaults.envs_per_runner,
         help="sub-envs of each runner's batched vector env (default %(default)s)",
     )
     add(
         "--train-batch-size",
-        type=int,
+        type=COUNT,
         default=defaults.train_batch_size,
         help="env steps per iteration (default %(default)s)",
     )
     add(
         "--minibatch-size",
-        type=int,
+        type=COUNT,
         default=defaults.minibatch_size,
         help="SGD minibatch (default %(default)s)",
     )
     add(
         "--epochs",
-        type=int,
+        type=COUNT,
         default=defaults.epochs,
         help="SGD passes over each batch (default %(default)s)",
     )
@@ -384,7 +384,8 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
         "--ray-address",
         default=None,
         metavar="ADDRESS",
-        help="a running Ray cluster to join (HOST:PORT, or auto); default a local instance",
+        help="a running Ray cluster to join (HOST:PORT, or auto); default a local instance. "
+        f"A HOST:PORT that does not answer within {RAY_CONNECT_TIMEOUT:g} s is refused",
     )
     add("--no-progress", action="store_true", help="no progress bar")
 
@@ -426,14 +427,14 @@ def build_parser() -> argparse.ArgumentParser:
     add("--resume", action="store_true", help="continue the run in --output")
     add(
         "--checkpoint-every",
-        type=int,
+        type=COUNT,
         default=1,
         metavar="N",
         help="write a checkpoint every N iterations (default %(default)s; and at the end)",
     )
     add(
         "--stop-after",
-        type=int,
+        type=NON_NEGATIVE,
         default=None,
         metavar="N",
         help="train at most N new iterations, then stop (resume later)",
@@ -447,6 +448,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     try:
         require("ray.rllib", "RLlib training", extra="ray")
         settings = settings_from_args(args, checkpoint_every=args.checkpoint_every)
+        if args.ray_address is not None:
+            check_ray_address(args.ray_address)
     except (ValueError, TypeError) as error:
         parser.error(str(error))
     except ImportError as error:

@@ -33,7 +33,7 @@ from bearing_env.train.cli_values import parse_literal
 from bearing_env.train.compare_report import csv_text
 from bearing_env.train.errors import exit_on_output_errors, fail, require
 from bearing_env.train.files import atomic_write_text
-from bearing_env.train.ray_executor import ray_session
+from bearing_env.train.ray_executor import check_ray_address, ray_session
 from bearing_env.train.rllib import (
     RLlibSettings,
     add_settings_arguments,
@@ -242,6 +242,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             grid=parse_grid(args.grid, "--grid"),
             env_grid=parse_grid(args.env_grid, "--env-grid"),
         )
+        if args.ray_address is not None:
+            check_ray_address(args.ray_address)
     except (ValueError, TypeError) as error:
         parser.error(str(error))
     except ImportError as error:

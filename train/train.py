@@ -217,8 +217,62 @@ def _close_quietly(venv: VecEnv) -> None:
         venv.close()
 
 
+def check_device(device: str) -> None:
+    """ValueError naming ``device`` unless torch can use it here: ``auto``, ``cpu``, or
+    ``cuda``/``cuda:N``/``mps`` when that hardware is present (SB3 would quietly train on
+    the CPU instead, or fail at the first tensor)."""
+    if device == "auto":
+        return
+    try:
+        parsed = torch.device(device)
+    except (RuntimeError, TypeError) as error:
+        raise ValueError(f"device {device!r} is not a torch device ({error})") from None
+    if parsed.type == "cuda":
+        if not torch.cuda.is_available():
+            raise ValueError(
+                f"device {device!r}: CUDA is not available on this machine (torch "
+                f"{torch.__version__}); use --device cpu"
+            )
+        if parsed.index is not None and parsed.index >= torch.cuda.device_count():
+            raise ValueError(
+                f"device {device!r}: this machine has {torch.cuda.device_count()} CUDA devices"
+            )
+    elif parsed.type == "mps" and not torch.backends.mps.is_available():
+        raise ValueError(
+            f"device {device!r}: MPS is not available on this machine; use --device cpu"
+        )
+    elif parsed.type not in ("cpu", "cuda", "mps"):
+        raise ValueError(f"device {device!r}: expected auto, cpu, cuda, cuda:N or mps")
+
+
+def rollout_notice(
+    algorithm_kwargs: dict[str, Any], n_envs: int, done: int, target: int
+) -> str | None:
+    """For an on-policy algorithm (``n_steps`` in its settings), which trains in whole
+    rollouts of ``n_steps * n_envs`` env steps: a one-line note when ``target`` is not
+    reached in whole rollouts from ``done``, saying where the run will stop instead.
+    ValueError when a rollout is a single step (SB3 refuses it)."""
+    if "n_steps" not in algorithm_kwargs:
+        return None
+    n_steps = int(algorithm_kwargs["n_steps"])
+    rollout = n_steps * n_envs
+    if rollout < 2:
+        raise ValueError(
+            f"n_steps * n_envs must be >= 2 (one rollout), got n_steps={n_steps}, n_envs={n_envs}"
+        )
+    remaining = target - done
+    if remaining <= 0 or remaining % rollout == 0:
+        return None
+    end = done + -(-remaining // rollout) * rollout
+    return (
+        f"note: training runs in whole rollouts of {rollout} env steps (n_steps {n_steps} x "
+        f"n_envs {n_envs}), so this run trains to {end} timesteps, not {target}"
+    )
+
+
 def train(settings: TrainSettings) -> TrainResult:
     """Train (or resume) a run; see the module docstring for the files it writes."""
+    check_device(settings.device)
     algorithm_class = algorithm_class_for(settings.algo)
     raw, checkpoint = resolve_run(settings)
     hyperparams = parse_hyperparameters(raw, settings.algo)
@@ -238,8 +292,18 @@ def train(settings: TrainSettings) -> TrainResult:
             f"cannot resume {settings.algo.upper()} with n_envs={n_envs}: its replay buffer was "
             f"collected with n_envs={previous_record['n_envs']}"
         )
+    notice = rollout_notice(
+        hyperparams.algorithm_kwargs,
+        n_envs,
+        checkpoint.timesteps if checkpoint is not None else 0,
+        target,
+    )
     if settings.torch_threads is not None:
+        if settings.torch_threads < 1:
+            raise ValueError(f"torch_threads must be >= 1 (or None), got {settings.torch_threads}")
         torch.set_num_threads(settings.torch_threads)
+    if notice is not None:
+        print(notice, file=sys.stderr)
 
     vec_env_kind = resolve_vec_env_kind(settings.vec_env, settings.env_id)
     # The validation env is built first, in this process: bad env kwargs fail here, fast.

@@ -16,9 +16,17 @@ import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-from bearing_env.train.cli_values import parse_key_values
+from bearing_env.train.cli_values import (
+    COUNT,
+    NON_NEGATIVE,
+    SEED,
+    at_least,
+    parse_key_values,
+    registered_env_id,
+)
 from bearing_env.train.errors import fail, write_error_message
 from bearing_env.train.export import ExportedModel, export_run
+from bearing_env.train.seeds import MAX_VALIDATION_EPISODES
 from bearing_env.train.train import (
     DEFAULT_CHECKPOINT_FREQ,
     DEFAULT_EVAL_EPISODES,
@@ -49,9 +57,15 @@ def build_parser() -> argparse.ArgumentParser:
     add("--env-kwargs", nargs="*", default=[], metavar="K=V", help="merged over the YAML's")
     add("--hyperparams", nargs="*", default=[], metavar="K=V", help="override YAML entries")
     add("--conf-file", type=Path, help="hyperparameter file (default: the shipped <algo>.yml)")
-    add("--timesteps", type=int, help="total env steps of the run (default the YAML's n_timesteps)")
-    add("--seed", type=int, default=0, help="default %(default)s")
-    add("--n-envs", type=int, help="parallel envs (default the YAML's n_envs)")
+    add(
+        "--timesteps",
+        type=COUNT,
+        help="total env steps of the run (default the YAML's n_timesteps); PPO trains in "
+        "whole rollouts of n_steps x n_envs steps, so it may train a little more: it says "
+        "so before it starts",
+    )
+    add("--seed", type=SEED, default=0, help="default %(default)s")
+    add("--n-envs", type=COUNT, help="parallel envs (default the YAML's n_envs)")
     add(
         "--vec-env",
         choices=VEC_ENV_CHOICES,
@@ -64,23 +78,50 @@ def build_parser() -> argparse.ArgumentParser:
     add("--output", type=Path, help="run folder (default runs/<algo>_<env>_seed<seed>)")
     add("--resume", action="store_true", help="continue the run in --output from its checkpoint")
     add(
-        "--eval-freq", type=int, default=DEFAULT_EVAL_FREQ, help="env steps (0: never; %(default)s)"
+        "--eval-freq",
+        type=NON_NEGATIVE,
+        default=DEFAULT_EVAL_FREQ,
+        help="env steps (0: never; %(default)s)",
     )
-    add("--eval-episodes", type=int, default=DEFAULT_EVAL_EPISODES, help="default %(default)s")
+    add(
+        "--eval-episodes",
+        type=at_least(1, MAX_VALIDATION_EPISODES),
+        default=DEFAULT_EVAL_EPISODES,
+        help="default %(default)s",
+    )
     add(
         "--checkpoint-freq",
-        type=int,
+        type=COUNT,
         default=DEFAULT_CHECKPOINT_FREQ,
         help="env steps (%(default)s)",
     )
     add(
-        "--keep-checkpoints", type=int, default=DEFAULT_KEEP_CHECKPOINTS, help="default %(default)s"
+        "--keep-checkpoints",
+        type=COUNT,
+        default=DEFAULT_KEEP_CHECKPOINTS,
+        help="default %(default)s",
     )
     add("--no-progress", action="store_true", help="no progress bar")
     add("--no-tensorboard", action="store_true", help="no TensorBoard logs")
-    add("--device", default="cpu", help="torch device (default %(default)s)")
-    add("--torch-threads", type=int, default=1, help="0: torch's default (default %(default)s)")
-    add("--verbose", type=int, default=0, help="1: SB3 training tables; -1: no evaluation lines")
+    add(
+        "--device",
+        default="cpu",
+        help="torch device: cpu, cuda, cuda:N, mps or auto; refused when this machine "
+        "lacks it (default %(default)s)",
+    )
+    add(
+        "--torch-threads",
+        type=NON_NEGATIVE,
+        default=1,
+        help="0: torch's default (default %(default)s)",
+    )
+    add(
+        "--verbose",
+        type=int,
+        choices=(-1, 0, 1, 2),
+        default=0,
+        help="1: SB3 training tables; -1: no evaluation lines",
+    )
     add(
         "--export",
         type=Path,
@@ -96,7 +137,7 @@ def default_output(algo: str, env_id: str, seed: int) -> Path:
 
 
 def settings_from_args(args: argparse.Namespace) -> TrainSettings:
-    env_id = args.env or DEFAULT_ENV_IDS[args.algo]
+    env_id = registered_env_id(args.env or DEFAULT_ENV_IDS[args.algo])
     return TrainSettings(
         algo=args.algo,
         env_id=env_id,

@@ -35,6 +35,8 @@ import numpy as np
 from bearing_env.train.conf_files import default_conf_file
 from stable_baselines3.common.base_class import BaseAlgorithm
 
+from bearing_env.envs.config import int_at_least
+
 #: The algorithms ``bearing-env train`` ships hyperparameters for, and the env id each
 #: trains on by default.
 DEFAULT_ENV_IDS: dict[str, str] = {
@@ -148,14 +150,46 @@ def read_hyperparameters(algo: str, env_id: str, conf_file: Path | None = None) 
     return dict(entry)
 
 
+#: The smallest accepted value of the algorithms' integer hyperparameters (``--hyperparams``
+#: or the YAML): below it stable-baselines3 fails with an assertion, or never trains.
+#: PPO's minibatch needs 2 samples (SB3 normalises advantages over it).
+MIN_HYPERPARAMETERS: dict[str, int] = {
+    "n_steps": 1,
+    "batch_size": 1,
+    "n_epochs": 1,
+    "buffer_size": 1,
+    "learning_starts": 0,
+    "target_update_interval": 1,
+}
+
+_MIN_BY_ALGO: dict[str, dict[str, int]] = {"ppo": {"batch_size": 2}}
+
+
+def check_hyperparameters(kwargs: Mapping[str, Any], algo: str) -> None:
+    """ValueError (TypeError for a non-integer) naming the hyperparameter and its value
+    when an integer hyperparameter is below :data:`MIN_HYPERPARAMETERS` (``train_freq``
+    and ``gradient_steps`` too, when they are plain integers: >= 1, and >= 1 or -1)."""
+    minimums = {**MIN_HYPERPARAMETERS, **_MIN_BY_ALGO.get(algo.lower(), {})}
+    for key, minimum in minimums.items():
+        if key in kwargs:
+            int_at_least(kwargs[key], minimum, f"hyperparameter {key}")
+    train_freq = kwargs.get("train_freq")
+    if isinstance(train_freq, (int, np.integer)) and not isinstance(train_freq, bool):
+        int_at_least(train_freq, 1, "hyperparameter train_freq")
+    gradient_steps = kwargs.get("gradient_steps")
+    if isinstance(gradient_steps, (int, np.integer)) and gradient_steps != -1:
+        int_at_least(gradient_steps, 1, "hyperparameter gradient_steps (or -1)")
+
+
 def parse_hyperparameters(raw: Mapping[str, Any], algo: str = "ppo") -> Hyperparameters:
     """Preprocess a raw rl-zoo3 entry with rl-zoo3's ``_preprocess_hyperparams`` into the
     env settings and the algorithm's constructor arguments.
 
     Raises:
         ValueError: a key this trainer does not implement, a missing or non-positive
-            ``n_timesteps``/``n_envs``, or a value rl-zoo3 cannot preprocess (the message
-            names it).
+            ``n_timesteps``/``n_envs``, an integer hyperparameter below its minimum
+            (:func:`check_hyperparameters`), or a value rl-zoo3 cannot preprocess (the
+            message names it).
     """
     entry = dict(raw)
     unsupported = sorted(UNSUPPORTED_ZOO_KEYS & entry.keys())
@@ -181,6 +215,7 @@ def parse_hyperparameters(raw: Mapping[str, Any], algo: str = "ppo") -> Hyperpar
     for key in ("policy_kwargs", "replay_buffer_kwargs"):
         if key in kwargs and not isinstance(kwargs[key], dict):
             raise ValueError(f"{key} must evaluate to a dict, got {raw[key]!r}")
+    check_hyperparameters(kwargs, algo)
     n_envs, n_timesteps = int(manager.n_envs), int(manager.n_timesteps)
     if n_envs < 1 or n_timesteps < 1:
         raise ValueError(f"n_envs and n_timesteps must be >= 1, got {n_envs}, {n_timesteps}")

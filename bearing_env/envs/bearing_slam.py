@@ -162,7 +162,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     | 1   | move length | `lo + (a[1] + 1) / 2 * (hi - lo)` metres, `(lo, hi) = move_length` |
 
     Non-finite actions, actions outside `[-1, 1]^2`, and actions that are not real numbers
-    (strings, bools, complex numbers) raise `ValueError`.
+    (strings, bools, complex numbers) raise `ValueError`. Real actions of any dtype are
+    accepted (float16, longdouble and integers are cast to float64 first).
     `BearingSLAMDiscrete-v0` has a `Discrete` action space instead (see
     `BearingSLAMDiscreteEnv`).
 

@@ -61,8 +61,8 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
     All the arguments of `BearingSLAMEnv` (as keywords, or as `config=EnvConfig(...)`),
     plus:
 
-    - `n_turns`: number of relative headings (>= 1); default 8.
-    - `n_move_lengths`: number of move lengths (>= 1); default 3, or 1 when
+    - `n_turns`: number of relative headings, 1 to `MAX_ACTION_TABLE` (4096); default 8.
+    - `n_move_lengths`: number of move lengths, 1 to 4096; default 3, or 1 when
       `move_length` is a single length.
 
     Both are fields of `EnvConfig` too (the continuous env ignores them).

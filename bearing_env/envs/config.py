@@ -57,6 +57,11 @@ EPSILON_DEG_RANGE = (0.0, 45.0)
 DEFAULT_N_TURNS = 8
 #: Default number of move lengths of the discrete env when ``move_length`` is a range.
 DEFAULT_N_MOVE_LENGTHS = 3
+#: Most entries of each discrete action table (``n_turns``, ``n_move_lengths``). The
+#: tables are rebuilt at every step, so their size is per-step cost (10**8 turns take
+#: seconds a step, 10**9 exhaust memory); 4096 turns are 0.088 degrees apart, far finer
+#: than the bearing error bound (epsilon_deg > 0, 2 by default) lets a map tell apart.
+MAX_ACTION_TABLE = 4096
 
 REWARDS: tuple[str, ...] = ("log_area", "area")
 #: Observation kinds: the flat Box (default) or a Dict of a robot block and a landmark
@@ -194,7 +199,7 @@ class EnvConfig:
         )
         if max_landmarks is None:
             max_landmarks = max(DEFAULT_MAX_LANDMARKS, counts[1])
-        n_turns = int_at_least(n_turns, 1, "n_turns")
+        n_turns = int_at_most(int_at_least(n_turns, 1, "n_turns"), MAX_ACTION_TABLE, "n_turns")
         if n_move_lengths is None:
             n_move_lengths = 1 if lengths[0] == lengths[1] else DEFAULT_N_MOVE_LENGTHS
         return cls(
@@ -270,8 +275,9 @@ class EnvConfig:
         normalise("area_cap", area_cap)
         max_landmarks = int_at_least(self.max_landmarks, hi, "max_landmarks")
         normalise("max_landmarks", int_at_most(max_landmarks, MAX_N_LANDMARKS, "max_landmarks"))
-        normalise("n_turns", int_at_least(self.n_turns, 1, "n_turns"))
-        normalise("n_move_lengths", int_at_least(self.n_move_lengths, 1, "n_move_lengths"))
+        for table in ("n_turns", "n_move_lengths"):
+            size = int_at_least(getattr(self, table), 1, table)
+            normalise(table, int_at_most(size, MAX_ACTION_TABLE, table))
         choice(self.fusion, FUSIONS, "fusion")
         max_outliers = int_at_least(self.max_outliers, 0, "max_outliers")
         normalise("max_outliers", int_at_most(max_outliers, DEFAULT_WINDOW - 1, "max_outliers"))

@@ -788,6 +788,10 @@ def decode_continuous(config: EnvConfig, actions: Any) -> tuple[FloatArray, Floa
     values = _real_values(actions, "actions")
     if values.ndim != 2 or values.shape[1] != 2:
         raise ValueError(f"actions must have shape (N, 2), got shape {values.shape}")
+    if values.dtype != np.float32 and values.dtype != np.float64:
+        # float16, longdouble and integer actions: the compiled decoder takes float32 or
+        # float64 only (numba has no float16 or longdouble). Cast; the range check follows.
+        values = values.astype(np.float64)
     turns, lengths = np.empty(values.shape[0]), np.empty(values.shape[0])
     lo, hi = config.move_length
     outcome = kernels.decode_continuous(values, lo, hi, turns, lengths)

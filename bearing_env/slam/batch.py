@@ -126,11 +126,7 @@ class BatchedPolygonSLAM:
     ) -> None:
         self.num_maps = _int_at_least(num_maps, 1, "num_maps")
         self.n_landmarks = _int_at_least(n_landmarks, 3, "n_landmarks", "(L1, L2 and one more)")
-        if isinstance(epsilon, bool) or not isinstance(epsilon, (float, int, np.number)):
-            raise TypeError(f"epsilon must be a number of radians, got {epsilon!r}")
-        epsilon = float(epsilon)
-        if not 0.0 < epsilon < math.pi / 2:
-            raise ValueError(f"epsilon must be in (0, pi/2) radians, got {epsilon!r}")
+        epsilon = checked_epsilon(epsilon)
         if transfer not in TRANSFERS:
             raise ValueError(f"transfer must be one of {TRANSFERS}, got {transfer!r}")
         if on_inconsistency not in INCONSISTENCY_POLICIES:
@@ -444,6 +440,17 @@ def check_bearings(bearings: ArrayLike, shape: tuple[int, ...], name: str) -> Fl
             f"{name} must be finite or NaN (a missed reading), got {arr.tolist()}"
         )
     return np.ascontiguousarray(arr)
+
+
+def checked_epsilon(epsilon: object) -> float:
+    """The bearing error bound as a float in (0, pi/2) radians (TypeError or ValueError
+    naming the value otherwise): the one check of every map and of ``fr_region``."""
+    if isinstance(epsilon, bool) or not isinstance(epsilon, (float, int, np.number)):
+        raise TypeError(f"epsilon must be a number of radians, got {epsilon!r}")
+    value = float(epsilon)
+    if not 0.0 < value < math.pi / 2:
+        raise ValueError(f"epsilon must be in (0, pi/2) radians, got {epsilon!r}")
+    return value
 
 
 def _int_at_least(value: object, minimum: int, name: str, why: str = "") -> int:
