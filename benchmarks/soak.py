@@ -94,7 +94,7 @@ def soak_configuration(
     env: gym.Env[Any, Any] | None = None
     try:
         env = gym.make(
-            env_id, max_episode_steps=kwargs["max_moves"], disable_env_checker=True, **kwargs
+            env_id, disable_env_checker=True, **kwargs
         )
         env.action_space.seed(seed)
         for episode in range(episodes):

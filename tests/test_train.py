@@ -679,3 +679,20 @@ def test_checkpoints_keep_sb3_checkpoint_callback_names(tmp_path: Path) -> None:
     assert isinstance(callback, CheckpointCallback)
     assert callback._on_step() is True  # SB3's mid-rollout save never runs
     assert not list(tmp_path.iterdir())
+
+
+def test_rl_zoo3_envs_run_max_moves() -> None:
+    """rl-zoo3 makes its envs from the registered spec with the YAML's env_kwargs: with
+    no registered TimeLimit, max_moves=40 runs 40 moves there too."""
+    from bearing_env.train.zoo import _experiment_manager
+
+    manager = _experiment_manager("ppo", "BearingSLAM-v0")
+    manager.env_kwargs = {"scenario": "khepera", "max_moves": 40, "target_area": 1e-9}
+    envs = manager.create_envs(n_envs=1, no_log=True)
+    envs.seed(5)
+    envs.reset()
+    for move in range(1, 41):
+        _, _, dones, infos = envs.step(np.array([[0.3, 0.5]], dtype=np.float32))
+        assert bool(dones[0]) == (move == 40), move
+    assert infos[0]["TimeLimit.truncated"]
+    envs.close()

@@ -22,7 +22,7 @@ from bearing_env.train import train_cli
 from bearing_env.train.cli_values import parse_key_values
 from bearing_env.train.train import TrainSettings, train
 from bearing_env.train.training_envs import EnvFactory, resolve_vec_env_kind
-from bearing_env.train.vec_env import GymnasiumVecEnv, gym_make_kwargs, make_batched_vec_env
+from bearing_env.train.vec_env import GymnasiumVecEnv, make_batched_vec_env
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 from stable_baselines3 import DQN, PPO
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, VecNormalize
@@ -45,7 +45,7 @@ def sync_vector_env(
         num_envs=n_envs,
         vectorization_mode="sync",
         vector_kwargs={"autoreset_mode": autoreset_mode},
-        **gym_make_kwargs(env_kwargs),
+        **env_kwargs,
     )
 
 
@@ -375,7 +375,6 @@ def test_a_registered_vector_entry_point_is_used(
             "env_id": "BearingSLAM-v0",
             "num_envs": 2,
             "max_moves": 7,
-            "max_episode_steps": 7,
             "autoreset_mode": AutoresetMode.SAME_STEP,
         }
     ]

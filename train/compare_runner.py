@@ -43,13 +43,10 @@ from bearing_env.train.compare_config import CompareConfig, json_normalised
 
 
 def make_env(env_id: str, env_kwargs: Mapping[str, Any]) -> gym.Env:
-    """``gym.make`` with the TimeLimit matched to ``max_moves`` (see the README)."""
+    """``gym.make``, with the ids registered first (spawned workers import nothing)."""
     import bearing_env  # noqa: F401  (registers the ids in spawned workers)
 
-    kwargs = dict(env_kwargs)
-    if "max_moves" in kwargs and "max_episode_steps" not in kwargs:
-        kwargs["max_episode_steps"] = kwargs["max_moves"]
-    return gym.make(env_id, **kwargs)
+    return gym.make(env_id, **env_kwargs)
 
 
 def _finite_or_none(value: float) -> float | None:

@@ -118,7 +118,6 @@ def main(argv: list[str] | None = None) -> None:
         scenario="khepera",
         move_length=MOVE_LENGTH,
         max_moves=args.moves,
-        max_episode_steps=args.moves,
         render_mode="rgb_array" if rendering else None,
     )
     started = time.perf_counter()

@@ -15,7 +15,6 @@ import gymnasium as gym
 from bearing_env.train.seeds import validation_seeds
 from bearing_env.train.vec_env import (
     MONITOR_INFO_KEYWORDS,
-    gym_make_kwargs,
     has_vector_entry_point,
     make_batched_vec_env,
     monitor_csv_path,
@@ -86,7 +85,7 @@ class EnvFactory:
         if self.ignore_interrupts:
             signal.signal(signal.SIGINT, signal.SIG_IGN)
         bearing_env.registration.register_envs()
-        env: gym.Env[Any, Any] = gym.make(self.env_id, **gym_make_kwargs(self.env_kwargs))
+        env: gym.Env[Any, Any] = gym.make(self.env_id, **self.env_kwargs)
         env = SuccessInfo(env)
         if self.monitor:
             env = Monitor(

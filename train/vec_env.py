@@ -49,15 +49,6 @@ FINAL_INFO_KEY = "final_info"
 MONITOR_INFO_KEYWORDS: tuple[str, ...] = ("is_success",)
 
 
-def gym_make_kwargs(env_kwargs: Mapping[str, Any]) -> dict[str, Any]:
-    """``env_kwargs`` for ``gym.make``: a ``max_moves`` also sets the spec's time limit
-    (``max_episode_steps``, 20 by default), unless that is given too."""
-    kwargs = dict(env_kwargs)
-    if "max_moves" in kwargs:
-        kwargs.setdefault("max_episode_steps", kwargs["max_moves"])
-    return kwargs
-
-
 def env_spec(env_id: str) -> EnvSpec:
     """The registered spec of ``env_id``, importing ``module`` first for ``module:Id``.
 
@@ -488,8 +479,8 @@ def make_batched_vec_env(
     The vector env is the id's registered ``vector_entry_point`` (a natively batched
     env), made with ``autoreset_mode=SAME_STEP``. An id without one falls back to a
     ``SyncVectorEnv`` of single envs, so this works for any id, and switches to the
-    batched env by itself once it is registered. ``max_moves`` implies
-    ``max_episode_steps``, as for single envs (:func:`gym_make_kwargs`).
+    batched env by itself once it is registered. The envs' ``max_moves`` is their one
+    episode cap.
 
     Episodes are logged by SB3's ``VecMonitor`` (return, length, ``is_success``) to
     ``<monitor_path>.monitor.csv``, which a resumed run extends instead of overwriting.
@@ -497,7 +488,7 @@ def make_batched_vec_env(
     if n_envs < 1:
         raise ValueError(f"n_envs must be >= 1, got {n_envs}")
     bearing_env.registration.register_envs()
-    kwargs = gym_make_kwargs(env_kwargs)
+    kwargs = dict(env_kwargs)
     if env_spec(env_id).vector_entry_point is not None:
         vector_env = gym.make_vec(
             env_id,

@@ -89,8 +89,9 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
     - `num_envs`: number of sub-environments, >= 1.
     - `autoreset_mode`: `"next_step"` (default), `"same_step"` or `"disabled"` (or the
       enum).
-    - `max_episode_steps`: truncate after this many steps, like the `TimeLimit` that
-      `gym.make` adds (`gym.make_vec` passes the registered 20); None for no limit.
+    - `max_episode_steps`: an extra cap, as the `TimeLimit` that an explicit
+      `gym.make(id, max_episode_steps=...)` adds; default None (the ids register none:
+      `max_moves` is the episode cap).
     - `render_mode`: None or `"rgb_array"` (`render()` returns a tuple of frames).
     - `n_landmarks=(lo, hi)` works too. The per-landmark info arrays (`landmark_area`,
       `landmark_error`, `landmark_contains_truth`, `outliers`) are then padded to

@@ -31,7 +31,7 @@ from bearing_env.slam import FUSIONS, INCONSISTENCY_POLICIES, TRANSFERS
 from bearing_env.slam.batch import DEFAULT_MAX_OUTLIERS, DEFAULT_WINDOW
 from bearing_env.world import SCENARIOS, Arena, NoiseModel
 
-#: Default episode length in moves; also the registered ``max_episode_steps``.
+#: Default episode length in moves (``max_moves``, the one episode cap).
 DEFAULT_MAX_MOVES = 20
 #: Default number of landmark slots in the observation (more if ``n_landmarks`` is larger).
 DEFAULT_MAX_LANDMARKS = 8
