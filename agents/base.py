@@ -23,7 +23,7 @@ import numpy as np
 from gymnasium import spaces
 from numpy.typing import NDArray
 
-from bearing_env.slam.geometry import wrap_angle as _wrap_angles
+from bearing_env.numerics import wrap, wrap_angle
 
 from .env_access import bearing_env_of
 
@@ -56,12 +56,6 @@ def policy_rng(seed: int | None) -> np.random.Generator:
     if seed is None:
         return np.random.default_rng()
     return np.random.default_rng([int(seed), POLICY_STREAM])
-
-
-def wrap_angle(angle: float) -> float:
-    """Wrap an angle to [-pi, pi): ``bearing_env.slam.geometry.wrap_angle`` of one angle,
-    as a Python float."""
-    return float(_wrap_angles(angle))
 
 
 @dataclass(frozen=True)
@@ -108,12 +102,12 @@ class ActionCodec:
     def encode(self, turn: float, length: float) -> Action:
         """The env action closest to "turn by ``turn`` radians, move ``length`` metres"."""
         if self.discrete:
-            turn_gap = np.abs((self.turn_table - turn + math.pi) % (2.0 * math.pi) - math.pi)
+            turn_gap = np.abs(wrap_angle(self.turn_table - turn))
             turn_index = int(np.argmin(turn_gap))
             length_index = int(np.argmin(np.abs(self.length_table - length)))
             return int(turn_index * self.length_table.size + length_index)
         lo, hi = self.length_range
-        turn_unit = wrap_angle(turn) / math.pi
+        turn_unit = wrap(turn) / math.pi
         length_unit = 1.0 if hi <= lo else 2.0 * (length - lo) / (hi - lo) - 1.0
         return np.clip(np.array([turn_unit, length_unit]), -1.0, 1.0).astype(np.float32)
 
@@ -154,7 +148,7 @@ class ActionCodec:
                 length_values = [hi] if lengths == 1 else list(np.linspace(hi, lo, lengths))
             else:
                 length_values = [float(v) for v in lengths]
-            turns = [wrap_angle(2.0 * math.pi * k / n_turns) for k in range(n_turns)]
+            turns = [wrap(2.0 * math.pi * k / n_turns) for k in range(n_turns)]
             chosen = [(t, float(ln)) for ln in length_values for t in turns]
         movements: list[Movement] = []
         seen: set[tuple[float, float]] = set()

@@ -44,9 +44,10 @@ from numpy.typing import NDArray
 
 from bearing_env.envs.bearing_slam import BEARING_FEATURES, ROBOT_FEATURES, observation_slices
 from bearing_env.envs.core import ENTITY_FEATURES
+from bearing_env.numerics import wrap
 from bearing_env.slam import PolygonSLAM
 
-from .base import Movement, wrap_angle
+from .base import Movement
 from .env_access import bearing_env_of
 
 #: Minimum bearing change (in units of epsilon) for a triangulation to give a scale sample.
@@ -146,7 +147,7 @@ def scale_sample(
     """Metres per FL unit from one movement of ``length`` metres (None if ill-conditioned)."""
     points = []
     for index in (0, 1):
-        parallax = abs(wrap_angle(float(bearings_end[index] - bearings_start[index])))
+        parallax = abs(wrap(float(bearings_end[index] - bearings_start[index])))
         if parallax < MIN_PARALLAX_EPSILONS * epsilon:
             return None
         point = triangulate_fr(float(bearings_start[index]), float(bearings_end[index]))
@@ -186,14 +187,14 @@ class RobotBelief:
             # The map now holds this movement's end point and direction.
             self._turn_since_fix = 0.0
             self._legs = []
-            start = np.array([wrap_angle(float(b) - movement.turn) for b in bearings_before])
+            start = np.array([wrap(float(b) - movement.turn) for b in bearings_before])
             sample = scale_sample(start, view.bearings, movement.length, self.epsilon)
             if sample is not None:
                 # A move stopped by the wall travelled less than commanded, so its sample
                 # overestimates the scale: kept apart, used only while there is no other.
                 (self._blocked_samples if view.blocked else self._scale_samples).append(sample)
         else:
-            self._turn_since_fix = wrap_angle(self._turn_since_fix + movement.turn)
+            self._turn_since_fix = wrap(self._turn_since_fix + movement.turn)
             if not view.blocked:
                 self._legs.append((self._turn_since_fix, movement.length))
 
@@ -220,7 +221,7 @@ class RobotBelief:
                 position += (length / scale) * complex(
                     math.cos(fix_heading + offset), math.sin(fix_heading + offset)
                 )
-        heading = wrap_angle(fix_heading + self._turn_since_fix)
+        heading = wrap(fix_heading + self._turn_since_fix)
         return PoseBelief(position=position, heading=heading, metres_per_unit=scale)
 
 

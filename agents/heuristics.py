@@ -13,9 +13,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env.envs.core import WorldView
+from bearing_env.numerics import wrap, wrap_angle
 from bearing_env.slam import PolygonSLAM, world_to_fl
 
-from .base import Action, ActionCodec, Movement, policy_rng, wrap_angle
+from .base import Action, ActionCodec, Movement, policy_rng
 from .belief import (
     ObservationReader,
     ObservationView,
@@ -79,7 +80,7 @@ def _bootstrap_turns(codec: ActionCodec) -> NDArray[np.float64]:
     if codec.discrete:
         return codec.turn_table.copy()
     turns = 2.0 * math.pi * np.arange(BOOTSTRAP_TURNS) / BOOTSTRAP_TURNS
-    return (turns + math.pi) % (2.0 * math.pi) - math.pi
+    return wrap_angle(turns)
 
 
 def landmark_direction(bearings: NDArray[np.float64]) -> float | None:
@@ -240,7 +241,7 @@ class Parallax(BeliefPolicy):
     def _turn(self, view: ObservationView, slam: PolygonSLAM, pose: PoseBelief) -> float:
         target = int(np.argmax(slam.areas))  # inf (uninitialised) first
         sight = float(view.bearings[2 + target])
-        options = np.array([wrap_angle(sight + math.pi / 2), wrap_angle(sight - math.pi / 2)])
+        options = np.array([wrap(sight + math.pi / 2), wrap(sight - math.pi / 2)])
         inward = landmark_direction(view.bearings)
         if view.blocked:
             allowed = _allowed_turns(options, view, fallback=False)

@@ -38,6 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env.slam import PolygonSLAM, world_to_fl
+from bearing_env.validation import int_at_least
 
 from .base import Movement
 from .belief import ObservationView
@@ -185,8 +186,7 @@ class Lookahead(GreedyOneStep):
         hypotheses: int = 4,
     ) -> None:
         for value, label in ((depth, "depth"), (width, "width"), (hypotheses, "hypotheses")):
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"{label} must be an int >= 1, got {value!r}")
+            int_at_least(value, 1, label)
         super().__init__(env, n_turns=n_turns, lengths=lengths)
         self.depth, self.width, self.hypotheses = depth, width, hypotheses
         self.min_baseline = float(bearing_env_of(env).arena.min_baseline)

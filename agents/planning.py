@@ -17,8 +17,8 @@ from numpy.typing import NDArray
 
 from bearing_env.envs.bearing_slam import AREA_FLOOR
 from bearing_env.envs.kernels import potential_of
+from bearing_env.numerics import wrap_angle
 from bearing_env.slam import PolygonSLAM
-from bearing_env.slam.geometry import wrap_angle
 
 
 def uncertainty_potential(

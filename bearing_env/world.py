@@ -23,8 +23,8 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
-from bearing_env.slam.geometry import wrap_angle
-from bearing_env.slam.kernels import wrap
+from bearing_env.numerics import JIT_OPTIONS, wrap, wrap_angle
+from bearing_env.validation import float_in, non_negative_float, positive_float
 
 FloatArray = NDArray[np.float64]
 
@@ -51,15 +51,6 @@ REFERENCE_MIN_BASELINE: float = 1e-4
 NOISE_KINDS: tuple[str, ...] = ("uniform", "gaussian", "none")
 
 
-def _check_finite_positive(value: Any, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TypeError(f"{name} must be a number, got {value!r}")
-    out = float(value)
-    if not math.isfinite(out) or out <= 0.0:
-        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
-    return out
-
-
 # --------------------------------------------------------------------------------------
 # Arena
 # --------------------------------------------------------------------------------------
@@ -73,8 +64,8 @@ class Arena:
     height: float
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "width", _check_finite_positive(self.width, "arena width"))
-        object.__setattr__(self, "height", _check_finite_positive(self.height, "arena height"))
+        object.__setattr__(self, "width", positive_float(self.width, "arena width"))
+        object.__setattr__(self, "height", positive_float(self.height, "arena height"))
 
     @property
     def scale(self) -> float:
@@ -159,27 +150,12 @@ class NoiseModel:
             raise ValueError(f"noise kind must be one of {NOISE_KINDS}, got {self.kind!r}")
         for name in ("bound_deg", "sigma_deg"):
             value = getattr(self, name)
-            if value is None:
-                continue
-            if isinstance(value, bool) or not isinstance(
-                value, (int, float, np.integer, np.floating)
-            ):
-                raise TypeError(f"noise {name} must be a number or None, got {value!r}")
-            if not math.isfinite(float(value)) or float(value) < 0.0:
-                raise ValueError(f"noise {name} must be finite and >= 0, got {value!r}")
-            object.__setattr__(self, name, float(value))
-        rate = self.outlier_rate
-        if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)):
-            raise TypeError(f"noise outlier_rate must be a number, got {rate!r}")
-        if not 0.0 <= float(rate) <= 1.0:
-            raise ValueError(f"noise outlier_rate must be in [0, 1], got {rate!r}")
-        object.__setattr__(self, "outlier_rate", float(rate))
-        rate = self.detection_rate
-        if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)):
-            raise TypeError(f"noise detection_rate must be a number, got {rate!r}")
-        if not 0.0 < float(rate) <= 1.0:
-            raise ValueError(f"noise detection_rate must be in (0, 1], got {rate!r}")
-        object.__setattr__(self, "detection_rate", float(rate))
+            if value is not None:
+                object.__setattr__(self, name, non_negative_float(value, f"noise {name}"))
+        rate = float_in(self.outlier_rate, "noise outlier_rate", 0.0, 1.0)
+        object.__setattr__(self, "outlier_rate", rate)
+        rate = float_in(self.detection_rate, "noise detection_rate", 0.0, 1.0, closed_low=False)
+        object.__setattr__(self, "detection_rate", rate)
 
     @classmethod
     def parse(cls, spec: NoiseModel | Mapping[str, Any] | str | None) -> NoiseModel:
@@ -295,14 +271,14 @@ def apply_noise(true_bearings: FloatArray, draws: NoiseDraws, out: FloatArray) -
         )
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(**JIT_OPTIONS)
 def _add_wrapped(true_bearings: FloatArray, offsets: FloatArray, out: FloatArray) -> None:
     for i in range(true_bearings.shape[0]):
         for j in range(true_bearings.shape[1]):
             out[i, j] = wrap(true_bearings[i, j] + offsets[i, j])
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(**JIT_OPTIONS)
 def _add_wrapped_with_outliers(
     true_bearings: FloatArray,
     offsets: FloatArray,
@@ -510,13 +486,13 @@ class World:
 # --------------------------------------------------------------------------------------
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(**JIT_OPTIONS)
 def bearing(landmark_x: float, landmark_y: float, x: float, y: float, heading: float) -> float:
     """The noise-free bearing of a landmark from a pose, radians CCW from the heading."""
     return wrap(math.atan2(landmark_y - y, landmark_x - x) - heading)
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(**JIT_OPTIONS)
 def straight_move(
     x: float,
     y: float,
@@ -547,7 +523,7 @@ def straight_move(
     return new_x, new_y, travelled, free < length
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(**JIT_OPTIONS)
 def _true_bearings_into(
     landmarks: FloatArray, positions: FloatArray, headings: FloatArray, out: FloatArray
 ) -> None:

@@ -645,8 +645,13 @@ def test_lookahead_options_and_planning_times() -> None:
     # Every move after the bootstrap is planned, and timed.
     assert 1 <= len(policy.planning_times) <= moves
     assert all(t > 0.0 for t in policy.planning_times)
-    for bad in ({"depth": 0}, {"width": -1}, {"hypotheses": 1.5}, {"depth": True}):
-        with pytest.raises(ValueError, match=next(iter(bad))):
+    for bad, error in (
+        ({"depth": 0}, ValueError),
+        ({"width": -1}, ValueError),
+        ({"hypotheses": 1.5}, TypeError),  # the project's rule: the wrong kind of value
+        ({"depth": True}, TypeError),
+    ):
+        with pytest.raises(error, match=next(iter(bad))):
             Lookahead(env, **bad)
     spec = make_policy("lookahead:depth=3,hypotheses=2", env)
     assert isinstance(spec, Lookahead) and (spec.depth, spec.hypotheses) == (3, 2)

@@ -453,7 +453,7 @@ def test_truncation_after_max_moves() -> None:
         ({"n_landmarks": 3.5}, TypeError, "3.5"),
         ({"epsilon_deg": 0.0}, ValueError, "epsilon_deg.*0.0"),
         ({"epsilon_deg": -2.0}, ValueError, "-2.0"),
-        ({"epsilon_deg": 45.0}, ValueError, "45.0"),
+        ({"epsilon_deg": 90.0}, ValueError, "90.0"),  # the world model's bound: (0, 90) degrees
         ({"epsilon_deg": math.nan}, ValueError, "nan"),
         ({"arena": (0.0, 1.0)}, ValueError, "arena width.*0.0"),
         ({"arena": (1.0, -0.5)}, ValueError, "arena height.*-0.5"),

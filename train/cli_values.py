@@ -22,7 +22,7 @@ import ast
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
-from bearing_env.envs.config import int_at_least, int_at_most, positive_float
+from bearing_env.validation import int_at_least, int_at_most, positive_float
 
 _T = TypeVar("_T")
 

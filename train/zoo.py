@@ -35,7 +35,7 @@ import numpy as np
 from bearing_env.train.conf_files import default_conf_file
 from stable_baselines3.common.base_class import BaseAlgorithm
 
-from bearing_env.envs.config import int_at_least
+from bearing_env.validation import int_at_least, is_integer
 
 #: The algorithms ``bearing-env train`` ships hyperparameters for, and the env id each
 #: trains on by default.
@@ -174,7 +174,7 @@ def check_hyperparameters(kwargs: Mapping[str, Any], algo: str) -> None:
         if key in kwargs:
             int_at_least(kwargs[key], minimum, f"hyperparameter {key}")
     train_freq = kwargs.get("train_freq")
-    if isinstance(train_freq, (int, np.integer)) and not isinstance(train_freq, bool):
+    if is_integer(train_freq):
         int_at_least(train_freq, 1, "hyperparameter train_freq")
     gradient_steps = kwargs.get("gradient_steps")
     if isinstance(gradient_steps, (int, np.integer)) and gradient_steps != -1:

@@ -281,7 +281,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
       across landmark counts); `max_landmarks` then defaults to `max(8, hi)`.
     - `landmarks`: explicit landmark positions `(n, 2)` in metres (L1 first, then L2).
     - `arena`: `(width, height)` in metres; default the scenario's (Khepera 1.05 x 0.68).
-    - `epsilon_deg`: the SLAM's bearing error bound in degrees, in (0, 45); default 2.
+    - `epsilon_deg`: the SLAM's bearing error bound in degrees, in (0, 90) (the world
+      model's own bound); default 2.
     - `noise`: the true sensor noise: a `NoiseModel`, a mapping of its fields
       (`kind` = `"uniform"` | `"gaussian"` | `"none"`, `bound_deg`, `sigma_deg`,
       `outlier_rate`, `detection_rate`: a missed landmark's bearing is NaN, and the map
@@ -549,7 +550,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     # ``max_episode_steps``, so the spec reads the env's own cap instead.
     _spec: EnvSpec | None = None
 
-    @property  # type: ignore[override]
+    @property
     def spec(self) -> EnvSpec | None:
         """The spec ``gym.make`` gave, whose ``max_episode_steps`` (unless the caller set
         one, which adds a ``TimeLimit``) is this env's ``max_moves``."""

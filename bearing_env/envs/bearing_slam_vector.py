@@ -22,6 +22,7 @@ from bearing_env.envs.bearing_slam import BearingSLAMEnv, Setting, check_reset_o
 from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
 from bearing_env.envs.config import MAX_N_LANDMARKS, EnvConfig
 from bearing_env.envs.core import BatchState, MapBank, WorldView
+from bearing_env.validation import int_at_least, is_integer
 
 AUTORESET_MODES = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP, AutoresetMode.DISABLED)
 #: The keys ``reset(options=...)`` takes (the sub-envs themselves take none).
@@ -134,19 +135,10 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         config: EnvConfig | None = None,
         **env_kwargs: Any,
     ) -> None:
-        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)):
-            raise TypeError(f"num_envs must be an int, got {num_envs!r}")
-        if num_envs < 1:
-            raise ValueError(f"num_envs must be >= 1, got {num_envs}")
+        num_envs = int_at_least(num_envs, 1, "num_envs")
         self.autoreset_mode = _autoreset_mode(autoreset_mode)
-        if max_episode_steps is not None and (
-            isinstance(max_episode_steps, bool)
-            or not isinstance(max_episode_steps, (int, np.integer))
-            or max_episode_steps < 1
-        ):
-            raise ValueError(
-                f"max_episode_steps must be None or an int >= 1, got {max_episode_steps!r}"
-            )
+        if max_episode_steps is not None:
+            max_episode_steps = int_at_least(max_episode_steps, 1, "max_episode_steps")
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(
                 f"unknown render_mode {render_mode!r}; expected None or one of "
@@ -434,7 +426,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         """One seed per sub-env from ``reset``'s ``seed`` (TypeError/ValueError naming it)."""
         if seed is None:
             return [None] * self.num_envs
-        if _is_int(seed):
+        if is_integer(seed):
             return [int(seed) + i for i in range(self.num_envs)]
         if isinstance(seed, (str, bytes)) or not isinstance(seed, (Sequence, np.ndarray)):
             raise TypeError(
@@ -447,7 +439,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
                 f"seed must be None, an int or {self.num_envs} seeds, got {len(seeds)}"
             )
         for value in seeds:
-            if value is not None and not _is_int(value):
+            if value is not None and not is_integer(value):
                 raise TypeError(f"each seed must be an int or None, got {value!r} in {seed!r}")
         return [None if value is None else int(value) for value in seeds]
 
@@ -588,10 +580,6 @@ def _select_rows(batched: dict[str, Any], rows: IntArray) -> dict[str, Any]:
         key: _select_rows(value, rows) if isinstance(value, dict) else value[rows]
         for key, value in batched.items()
     }
-
-
-def _is_int(value: Any) -> bool:
-    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
 def _autoreset_mode(value: AutoresetMode | str) -> AutoresetMode:

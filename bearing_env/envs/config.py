@@ -29,6 +29,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.slam import FUSIONS, INCONSISTENCY_POLICIES, TRANSFERS
 from bearing_env.slam.batch import DEFAULT_MAX_OUTLIERS, DEFAULT_WINDOW
+from bearing_env.validation import (
+    EPSILON_RANGE,
+    choice,
+    int_at_least,
+    int_at_most,
+    is_real,
+    non_negative_float,
+    positive_float,
+)
 from bearing_env.world import SCENARIOS, Arena, NoiseModel
 
 #: Default episode length in moves (``max_moves``, the one episode cap).
@@ -51,8 +60,9 @@ MAX_AREA_CAP = 1e6
 DEFAULT_TARGET_AREA = 0.05
 #: Areas are floored here before taking logs, so log-areas stay finite.
 AREA_FLOOR = 1e-10
-#: Bearing error bounds accepted for epsilon (degrees, exclusive).
-EPSILON_DEG_RANGE = (0.0, 45.0)
+#: Bearing error bounds accepted for epsilon (degrees, exclusive): the world model's own
+#: (``bearing_env.validation.EPSILON_RANGE``), in degrees.
+EPSILON_DEG_RANGE = (math.degrees(EPSILON_RANGE[0]), math.degrees(EPSILON_RANGE[1]))
 #: Default number of relative headings of the discrete env: every 45 degrees.
 DEFAULT_N_TURNS = 8
 #: Default number of move lengths of the discrete env when ``move_length`` is a range.
@@ -67,53 +77,6 @@ REWARDS: tuple[str, ...] = ("log_area", "area")
 #: Observation kinds: the flat Box (default) or a Dict of a robot block and a landmark
 #: table (``bearing_env.envs.core.entity_observations``).
 OBSERVATIONS: tuple[str, ...] = ("flat", "entities")
-
-
-def is_number(value: Any) -> bool:
-    """A real number (bools excluded: ``True`` is not a length)."""
-    return not isinstance(value, bool) and isinstance(
-        value, (int, float, np.integer, np.floating)
-    )
-
-
-def positive_float(value: Any, name: str) -> float:
-    if not is_number(value):
-        raise TypeError(f"{name} must be a number, got {value!r}")
-    out = float(value)
-    if not math.isfinite(out) or out <= 0.0:
-        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
-    return out
-
-
-def non_negative_float(value: Any, name: str) -> float:
-    if not is_number(value):
-        raise TypeError(f"{name} must be a number, got {value!r}")
-    out = float(value)
-    if not math.isfinite(out) or out < 0.0:
-        raise ValueError(f"{name} must be finite and >= 0, got {value!r}")
-    return out
-
-
-def int_at_least(value: Any, minimum: int, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{name} must be an int, got {value!r}")
-    if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value!r}")
-    return int(value)
-
-
-def int_at_most(value: int, maximum: int, name: str) -> int:
-    if value > maximum:
-        raise ValueError(f"{name} must be <= {maximum}, got {value!r}")
-    return value
-
-
-def choice(value: Any, choices: Sequence[str], name: str) -> str:
-    if not isinstance(value, str):
-        raise TypeError(f"{name} must be a str, one of {tuple(choices)}, got {value!r}")
-    if value not in choices:
-        raise ValueError(f"unknown {name} {value!r}; expected one of {tuple(choices)}")
-    return value
 
 
 #: ``EnvConfig.map_settings``: the world model's keyword settings as a hashable tuple.
@@ -250,7 +213,7 @@ class EnvConfig:
             _check_layout(points, self.arena)
             normalise("landmarks", tuple((float(x), float(y)) for x, y in points))
 
-        if not is_number(self.epsilon_deg):
+        if not is_real(self.epsilon_deg):
             raise TypeError(f"epsilon_deg must be a number, got {self.epsilon_deg!r}")
         lo_eps, hi_eps = EPSILON_DEG_RANGE
         if not lo_eps < float(self.epsilon_deg) < hi_eps:
@@ -441,7 +404,7 @@ def _resolve_landmark_counts(
 
 
 def _resolve_move_length(move_length: Any) -> tuple[float, float]:
-    if is_number(move_length):
+    if is_real(move_length):
         length = positive_float(move_length, "move_length")
         return (length, length)
     if not _is_pair_like(move_length):

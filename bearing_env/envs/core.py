@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 from bearing_env.envs import kernels
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig, MapSettings
 from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
+from bearing_env.numerics import wrap_angle
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
@@ -39,7 +40,7 @@ from bearing_env.slam.batch import (
     VERTEX_COUNTS,
     BatchedPolygonSLAM,
 )
-from bearing_env.slam.geometry import wrap_angle
+from bearing_env.validation import is_real
 from bearing_env.world import (
     Arena,
     NoiseDraws,
@@ -769,18 +770,12 @@ def _real_values(actions: Any, what: str) -> NDArray[Any]:
     values = np.asarray(actions)
     if values.dtype == object:
         flat = values.ravel().tolist()
-        if not all(_is_real(value) for value in flat):
+        if not all(is_real(value) for value in flat):
             raise ValueError(f"{what} must be real numbers, got {actions!r}")
         values = np.array(flat, dtype=np.float64).reshape(values.shape)
     elif values.dtype.kind not in "iuf":
         raise ValueError(f"{what} must be real numbers, got {actions!r} (dtype {values.dtype})")
     return values
-
-
-def _is_real(value: Any) -> bool:
-    return not isinstance(value, (bool, np.bool_)) and isinstance(
-        value, (int, float, np.integer, np.floating)
-    )
 
 
 def decode_continuous(config: EnvConfig, actions: Any) -> tuple[FloatArray, FloatArray]:

@@ -14,10 +14,10 @@ import math
 import numpy as np
 from numba import njit
 
-from bearing_env.slam.kernels import JitOptions, contains_point, wrap
+from bearing_env.numerics import JIT_OPTIONS as _JIT
+from bearing_env.numerics import wrap
+from bearing_env.slam.kernels import contains_point
 from bearing_env.world import bearing, straight_move
-
-_JIT: JitOptions = {"cache": True, "nogil": True, "error_model": "numpy"}
 
 #: Observation layout: the robot block first, then one block per mapped landmark slot
 #: (landmarks L3, L4, ...), then one block per bearing slot (L1, L2, L3, ...).

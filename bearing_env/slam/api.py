@@ -10,15 +10,15 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from bearing_env.slam.batch import checked_epsilon
 from bearing_env.slam.geometry import FR_BOUNDED, cone_region
 from bearing_env.slam.transfer import transfer_vertices
+from bearing_env.validation import epsilon_radians
 
 
 def fr_region(bearing_start: float, bearing_end: float, epsilon: float) -> shapely.Polygon | None:
     """Region of one landmark in FR (R1 = (0, 0), R2 = (1, 0)); None if unbounded or empty.
     ``epsilon`` (radians) must be in (0, pi/2), as for ``PolygonSLAM`` (ValueError)."""
-    verts, status = cone_region(bearing_start, bearing_end, checked_epsilon(epsilon))
+    verts, status = cone_region(bearing_start, bearing_end, epsilon_radians(epsilon))
     if status != FR_BOUNDED:
         return None
     return _polygon(verts)

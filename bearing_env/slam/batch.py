@@ -16,7 +16,6 @@ environment reproduce the single environment bit for bit.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.slam import kernels
 from bearing_env.slam.transfer import TRANSFERS
+from bearing_env.validation import epsilon_radians, int_at_least
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -124,9 +124,9 @@ class BatchedPolygonSLAM:
         max_outliers: int = DEFAULT_MAX_OUTLIERS,
         window: int = DEFAULT_WINDOW,
     ) -> None:
-        self.num_maps = _int_at_least(num_maps, 1, "num_maps")
-        self.n_landmarks = _int_at_least(n_landmarks, 3, "n_landmarks", "(L1, L2 and one more)")
-        epsilon = checked_epsilon(epsilon)
+        self.num_maps = int_at_least(num_maps, 1, "num_maps")
+        self.n_landmarks = int_at_least(n_landmarks, 3, "n_landmarks", "(L1, L2 and one more)")
+        epsilon = epsilon_radians(epsilon)
         if transfer not in TRANSFERS:
             raise ValueError(f"transfer must be one of {TRANSFERS}, got {transfer!r}")
         if on_inconsistency not in INCONSISTENCY_POLICIES:
@@ -136,7 +136,7 @@ class BatchedPolygonSLAM:
             )
         self.epsilon = epsilon
         self.transfer = transfer
-        self.edge_samples = _int_at_least(edge_samples, 1, "edge_samples")
+        self.edge_samples = int_at_least(edge_samples, 1, "edge_samples")
         if self.edge_samples > kernels.MAX_EDGE_SAMPLES:
             raise ValueError(
                 f"edge_samples must be <= {kernels.MAX_EDGE_SAMPLES}, got {edge_samples!r}"
@@ -145,10 +145,10 @@ class BatchedPolygonSLAM:
         if fusion not in FUSIONS:
             raise ValueError(f"fusion must be one of {FUSIONS}, got {fusion!r}")
         self.fusion = fusion
-        self.window = _int_at_least(window, 1, "window")
+        self.window = int_at_least(window, 1, "window")
         if self.window > kernels.MAX_WINDOW:
             raise ValueError(f"window must be <= {kernels.MAX_WINDOW}, got {window!r}")
-        self.max_outliers = _int_at_least(max_outliers, 0, "max_outliers")
+        self.max_outliers = int_at_least(max_outliers, 0, "max_outliers")
         if self.max_outliers >= self.window:
             raise ValueError(
                 f"max_outliers must be < window ({self.window}), got {max_outliers!r}"
@@ -440,23 +440,3 @@ def check_bearings(bearings: ArrayLike, shape: tuple[int, ...], name: str) -> Fl
             f"{name} must be finite or NaN (a missed reading), got {arr.tolist()}"
         )
     return np.ascontiguousarray(arr)
-
-
-def checked_epsilon(epsilon: object) -> float:
-    """The bearing error bound as a float in (0, pi/2) radians (TypeError or ValueError
-    naming the value otherwise): the one check of every map and of ``fr_region``."""
-    if isinstance(epsilon, bool) or not isinstance(epsilon, (float, int, np.number)):
-        raise TypeError(f"epsilon must be a number of radians, got {epsilon!r}")
-    value = float(epsilon)
-    if not 0.0 < value < math.pi / 2:
-        raise ValueError(f"epsilon must be in (0, pi/2) radians, got {epsilon!r}")
-    return value
-
-
-def _int_at_least(value: object, minimum: int, name: str, why: str = "") -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{name} must be an int, got {value!r}")
-    if value < minimum:
-        suffix = f" {why}" if why else ""
-        raise ValueError(f"{name} must be >= {minimum}{suffix}, got {value}")
-    return int(value)

@@ -10,8 +10,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from bearing_env.numerics import wrap_angle
 from bearing_env.slam import kernels
 from bearing_env.slam.kernels import FR_BOUNDED, FR_EMPTY, FR_UNBOUNDED, MAX_FR_EXTENT
+from bearing_env.validation import int_at_least
 
 ComplexArray = NDArray[np.complex128]
 
@@ -28,11 +30,6 @@ __all__ = [
     "relaxed_intersection",
     "wrap_angle",
 ]
-
-
-def wrap_angle(angle: NDArray[np.float64] | float) -> NDArray[np.float64]:
-    """Wrap angles to [-pi, pi)."""
-    return (np.asarray(angle, dtype=np.float64) + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def cone_region(
@@ -93,10 +90,7 @@ def relaxed_intersection(
     k = len(polygons)
     if not 1 <= k <= kernels.MAX_WINDOW:
         raise ValueError(f"relaxed_intersection needs 1..{kernels.MAX_WINDOW} polygons, got {k}")
-    if isinstance(max_outliers, bool) or not isinstance(max_outliers, (int, np.integer)):
-        raise TypeError(f"max_outliers must be an int, got {max_outliers!r}")
-    if max_outliers < 0:
-        raise ValueError(f"max_outliers must be >= 0, got {max_outliers!r}")
+    max_outliers = int_at_least(max_outliers, 0, "max_outliers")
     window = np.zeros((1, k, 1, kernels.CAPACITY), dtype=np.complex128)
     counts = np.zeros((1, k, 1), dtype=np.int64)
     for i, polygon in enumerate(polygons):

@@ -18,9 +18,9 @@ from bearing_env.slam.batch import (
     INCONSISTENCY_POLICIES,
     LANDMARK_STATUSES,
     BatchedPolygonSLAM,
-    _int_at_least,
     check_bearings,
 )
+from bearing_env.validation import int_at_least
 
 (
     FRAME_OK,
@@ -238,7 +238,7 @@ class PolygonSLAM:
         For planning: score many candidate movements with one batched
         :meth:`BatchedPolygonSLAM.update`, each candidate on its own copy.
         """
-        count = _int_at_least(count, 1, "replicate count")
+        count = int_at_least(count, 1, "replicate count")
         return self._batch.take(np.full(count, self._index, dtype=np.int64))
 
     @property
