@@ -7,13 +7,22 @@
   reduction, clipping and outward offsets.
 * :mod:`~bearing_env.slam.kernels.frames`: a landmark's cone region in the robot frame
   FR, and the change of frames FR -> FL (frame plan, hypotheses, transfer).
-* :mod:`~bearing_env.slam.kernels.fusion`: fusing a movement's regions into a map (the
-  relaxed fusion's window and bases).
+* :mod:`~bearing_env.slam.kernels.state`: the structures the update takes: ``State``
+  (the per-map state arrays, listed once; passed as a ``StateRef`` structref),
+  ``Params`` (the settings, with the transfer, inconsistency policy and fusion as
+  codes), ``Outputs`` (per-call statuses) and ``Scratch`` (a thread's buffers).
+* :mod:`~bearing_env.slam.kernels.fusion`: fusing a movement's region into a map: the
+  strict intersection, and the relaxed fusion's window and bases.
 * :mod:`~bearing_env.slam.kernels.update`: one movement per map for a batch of maps, in
   one compiled call (serial, or ``prange`` over blocks of maps), and batch helpers.
 
-Every name the rest of the package uses is re-exported here, so callers import
+Every public name of the topic modules is re-exported here, so callers import
 ``bearing_env.slam.kernels`` and never a topic module.
+
+numba's cache (``cache=True``) checks only the source file of the function it
+compiled, not the modules whose kernels that function calls: after editing one topic
+module, delete ``bearing_env/slam/kernels/__pycache__`` (or the ``NUMBA_CACHE_DIR``)
+so that the callers in the other modules are compiled again.
 """
 
 from __future__ import annotations
@@ -55,6 +64,7 @@ from bearing_env.slam.kernels.common import (
     wrap,
 )
 from bearing_env.slam.kernels.frames import (
+    FrameChange,
     boundary_samples,
     cone_region,
     frame_plan,
@@ -62,6 +72,8 @@ from bearing_env.slam.kernels.frames import (
     transfer_region,
 )
 from bearing_env.slam.kernels.fusion import (
+    age_out_oldest,
+    intersect_landmark,
     relaxed_movement,
     relaxed_region,
 )
@@ -76,6 +88,22 @@ from bearing_env.slam.kernels.polygons import (
     polygon_distance,
     simplify,
     small_convex_hull,
+)
+from bearing_env.slam.kernels.state import (
+    FUSION_INTERSECT,
+    FUSION_RELAXED,
+    INCONSISTENCY_KEEP,
+    INCONSISTENCY_RESTART,
+    TRANSFER_CONSERVATIVE,
+    TRANSFER_PAPER,
+    Outputs,
+    Params,
+    Scratch,
+    State,
+    StateRef,
+    StateType,
+    new_scratch,
+    state_ref,
 )
 from bearing_env.slam.kernels.update import (
     INDEX_OK,
@@ -103,6 +131,10 @@ __all__ = [
     "FR_MISSING",
     "FR_UNBOUNDED",
     "FR_VERTICES",
+    "FUSION_INTERSECT",
+    "FUSION_RELAXED",
+    "INCONSISTENCY_KEEP",
+    "INCONSISTENCY_RESTART",
     "INDEX_OK",
     "INDEX_OUT_OF_RANGE",
     "INDEX_REPEATED",
@@ -119,7 +151,17 @@ __all__ = [
     "MAX_WINDOW",
     "RELATIVE_TOLERANCE",
     "SCRATCH",
+    "TRANSFER_CONSERVATIVE",
+    "TRANSFER_PAPER",
+    "FrameChange",
     "JitOptions",
+    "Outputs",
+    "Params",
+    "Scratch",
+    "State",
+    "StateRef",
+    "StateType",
+    "age_out_oldest",
     "area_centroid",
     "boundary_samples",
     "check_indices",
@@ -132,7 +174,9 @@ __all__ = [
     "dot",
     "drop_edges_outward",
     "frame_plan",
+    "intersect_landmark",
     "longest_edge",
+    "new_scratch",
     "none_infinite",
     "offset_outward",
     "polygon_distance",
@@ -142,6 +186,7 @@ __all__ = [
     "scale_of",
     "simplify",
     "small_convex_hull",
+    "state_ref",
     "threads",
     "tolerance_of",
     "transfer_region",

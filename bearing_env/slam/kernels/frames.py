@@ -5,9 +5,11 @@
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from numpy.typing import NDArray
 
 from bearing_env.slam.kernels.common import (
     _JIT,
@@ -36,6 +38,9 @@ from bearing_env.slam.kernels.polygons import (
     simplify,
     small_convex_hull,
 )
+
+ComplexArray = NDArray[np.complex128]
+
 
 # --------------------------------------------------------------------------------------
 # Cones in the robot frame FR (R1 = 0, R2 = 1)
@@ -169,21 +174,29 @@ def sample_hypotheses(
     return k
 
 
+class FrameChange(NamedTuple):
+    """One movement's change of frames FR -> FL, as :func:`transfer_region` applies it:
+    the FR regions of L1 and L2, the hypothesis pairs of :func:`sample_hypotheses`, and
+    the conservative bound's terms from :func:`frame_plan`."""
+
+    a1: ComplexArray  #: the FR region of L1 (``a1[:n1]``)
+    n1: int
+    a2: ComplexArray  #: the FR region of L2 (``a2[:n2]``)
+    n2: int
+    h1: ComplexArray  #: hypotheses ``h1`` (``h1[:n_pairs]``)
+    inv_d: ComplexArray  #: their ``1 / (h2 - h1)``
+    n_pairs: int
+    conservative: bool  #: grow the hull by the bound (else the paper's hull)
+    distance: float  #: distance between the regions of L1 and L2
+    delta1: float  #: sample spacing on L1's edges
+    delta2: float  #: sample spacing on L2's edges
+
+
 @njit(**_JIT)
 def transfer_region(
     target: np.ndarray,
     n_target: int,
-    a1: np.ndarray,
-    n1: int,
-    a2: np.ndarray,
-    n2: int,
-    h1: np.ndarray,
-    inv_d: np.ndarray,
-    n_pairs: int,
-    conservative: bool,
-    distance: float,
-    delta1: float,
-    delta2: float,
+    frame: FrameChange,
     cloud: np.ndarray,
     hull: np.ndarray,
     out: np.ndarray,
@@ -196,6 +209,9 @@ def transfer_region(
     transfer, grown outward by the bound ``r`` of :mod:`bearing_env.slam.transfer`.
     ``cloud`` holds :data:`MAX_CLOUD` points, ``hull`` and ``out`` :data:`MAX_CLOUD` + 1.
     """
+    a1, n1, a2, n2 = frame.a1, frame.n1, frame.a2, frame.n2
+    h1, inv_d, n_pairs = frame.h1, frame.inv_d, frame.n_pairs
+    distance, delta1, delta2 = frame.distance, frame.delta1, frame.delta2
     k = 0
     for v in range(n_target):
         z = target[v]
@@ -207,7 +223,7 @@ def transfer_region(
     # edge directions would be noise, and the offset needs true ones.
     size, magnitude = scale_of(hull, n)
     n = simplify(hull, n, tolerance_of(size, magnitude))
-    if conservative:
+    if frame.conservative:
         v1 = 0.0
         v2 = 0.0
         for v in range(n_target):
