@@ -193,7 +193,7 @@ class BatchedPolygonSLAM:
         self.base_counts = np.zeros((n, m), dtype=np.int64)
         self.n_dropped = np.zeros((n, m), dtype=np.int64)
         self.outliers = np.zeros((n, m), dtype=np.int64)
-        self._state_ref: kernels.StateRef | None = None
+        self._state_ref: kernels.State | None = None
         self.reset()
 
     def empty_like(self, num_maps: int) -> BatchedPolygonSLAM:
@@ -336,10 +336,10 @@ class BatchedPolygonSLAM:
             return STATE_ARRAYS
         return tuple(name for name in STATE_ARRAYS if name not in RELAXED_STATE_ARRAYS)
 
-    def _kernel_state(self) -> kernels.StateRef:
-        """The state as the kernels take it: a reference to this batch's arrays, made on
-        first use and kept (the arrays are only ever written in place)."""
-        ref: kernels.StateRef | None = self._state_ref
+    def _kernel_state(self) -> kernels.State:
+        """The state as the kernels take it: a :class:`kernels.StateRef` to this batch's
+        arrays, made on first use and kept (the arrays are only ever written in place)."""
+        ref: kernels.State | None = self._state_ref
         if ref is None:
             d = self.__dict__
             ref = kernels.state_ref(kernels.State(*(d[name] for name in STATE_ARRAYS)))

@@ -30,7 +30,7 @@ from bearing_env.slam.kernels.state import (
     Outputs,
     Params,
     Scratch,
-    StateRef,
+    State,
 )
 
 
@@ -47,7 +47,7 @@ def _copy_polygon(source: np.ndarray, n: int, out: np.ndarray) -> None:
 
 @njit(**_JIT)
 def intersect_landmark(
-    state: StateRef, row: int, j: int, n_new: int, keep: bool, scratch: Scratch
+    state: State, row: int, j: int, n_new: int, keep: bool, scratch: Scratch
 ) -> bool:
     """Intersect the new region ``scratch.fresh[:n_new]`` into landmark ``j``'s region of
     map ``row``; returns False when they miss each other (the observations contradict
@@ -99,7 +99,7 @@ def _merge_hull(
 
 
 @njit(**_JIT)
-def _window_slots(state: StateRef, row: int, j: int, out: np.ndarray) -> int:
+def _window_slots(state: State, row: int, j: int, out: np.ndarray) -> int:
     """The window slots (oldest first) that hold a region of landmark ``j`` from a
     movement that was not rejected; returns how many."""
     window_counts, window_rejected = state.window_counts, state.window_rejected
@@ -116,7 +116,7 @@ def _window_slots(state: StateRef, row: int, j: int, out: np.ndarray) -> int:
 
 @njit(**_JIT)
 def _intersect_kept(
-    state: StateRef, row: int, j: int, k: int, discarded: np.ndarray, use_base: bool,
+    state: State, row: int, j: int, k: int, discarded: np.ndarray, use_base: bool,
     scratch: Scratch,
 ) -> tuple[int, bool]:
     """The intersection of the base (if used) and the kept regions of
@@ -157,7 +157,7 @@ def _intersect_kept(
 
 @njit(**_JIT)
 def _relaxed_union(
-    state: StateRef, row: int, j: int, k: int, use_base: bool, q: int, scratch: Scratch
+    state: State, row: int, j: int, k: int, use_base: bool, q: int, scratch: Scratch
 ) -> int:
     """The hull of the union, over every choice of ``q`` of ``scratch.slots[:k]`` to
     leave out, of the intersection of the base (if used) and the other regions, into
@@ -198,7 +198,7 @@ def _relaxed_union(
 
 @njit(**_JIT)
 def relaxed_region(
-    state: StateRef, row: int, j: int, k: int, use_base: bool, max_outliers: int,
+    state: State, row: int, j: int, k: int, use_base: bool, max_outliers: int,
     scratch: Scratch,
 ) -> tuple[int, int]:
     """The hull of the q-relaxed intersection of the base and the window slots
@@ -222,7 +222,7 @@ def relaxed_region(
 
 @njit(**_JIT)
 def _solve_landmark(
-    state: StateRef, row: int, j: int, params: Params, scratch: Scratch
+    state: State, row: int, j: int, params: Params, scratch: Scratch
 ) -> None:
     """Landmark ``j``'s region from its base and window, from scratch (see
     :func:`relaxed_movement`)."""
@@ -259,7 +259,7 @@ def _solve_landmark(
 
 
 @njit(**_JIT)
-def age_out_oldest(state: StateRef, row: int, scratch: Scratch) -> None:
+def age_out_oldest(state: State, row: int, scratch: Scratch) -> None:
     """Fold the oldest movement of a full window into the bases: each inlier region is
     intersected into its landmark's base for good, each outlier dropped for good."""
     window_counts, window_inlier = state.window_counts, state.window_inlier
@@ -292,7 +292,7 @@ def age_out_oldest(state: StateRef, row: int, scratch: Scratch) -> None:
 
 
 @njit(**_JIT)
-def _keeps_every_region(state: StateRef, row: int, j: int) -> bool:
+def _keeps_every_region(state: State, row: int, j: int) -> bool:
     """Whether landmark ``j``'s region leaves out none of its window regions (of movements
     not rejected): then it is the intersection of its base and all of them, and a new
     region is fused by one clip."""
@@ -313,7 +313,7 @@ def _keeps_every_region(state: StateRef, row: int, j: int) -> bool:
 
 @njit(**_JIT)
 def _reject_outlier_movements(
-    state: StateRef, row: int, params: Params, scratch: Scratch
+    state: State, row: int, params: Params, scratch: Scratch
 ) -> None:
     """Reject every window movement that is an outlier for more than half of the
     landmarks it has regions for, and solve again the landmarks it was kept by; repeat
@@ -347,7 +347,7 @@ def _reject_outlier_movements(
 
 @njit(**_JIT)
 def relaxed_movement(
-    state: StateRef, row: int, fresh_counts: np.ndarray, params: Params, out: Outputs,
+    state: State, row: int, fresh_counts: np.ndarray, params: Params, out: Outputs,
     i: int, scratch: Scratch,
 ) -> bool:
     """Fuse the movement just written into window slot ``window_next[row] - 1`` (its

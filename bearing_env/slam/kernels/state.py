@@ -72,27 +72,30 @@ class State(NamedTuple):
 
 
 @structref.register
-# why: numba ships no type information, so its classes are Any to mypy
-class StateType(types.StructRef):  # type: ignore[misc]
+class StateType(types.StructRef):
     """numba's type of a :class:`StateRef`: one field per :class:`State` field."""
 
     def preprocess_fields(self, fields: Any) -> tuple[tuple[str, Any], ...]:
-        return tuple((name, types.unliteral(typ)) for name, typ in fields)
+        # why (each ignore below): these numba functions carry no annotations
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)  # type: ignore[no-untyped-call]
 
 
-# why: numba ships no type information, so its classes are Any to mypy
-class StateRef(structref.StructRefProxy):  # type: ignore[misc]
+class StateRef(structref.StructRefProxy):
     """A :class:`State` as the kernels take it: one reference to the same arrays."""
 
 
-structref.define_constructor(StateRef, StateType, State._fields)
-structref.define_boxing(StateType, StateRef)
+structref.define_constructor(StateRef, StateType, State._fields)  # type: ignore[no-untyped-call]
+structref.define_boxing(StateType, StateRef)  # type: ignore[no-untyped-call]
 
 
 @njit(**_JIT)
-def state_ref(state: State) -> StateRef:
-    """The :class:`StateRef` of a state (the same arrays, not copies)."""
-    return StateRef(*state)
+def state_ref(state: State) -> State:
+    """The :class:`StateRef` of a state (the same arrays, not copies).
+
+    Annotated as :class:`State`, as the kernels' ``state`` parameters are: a StateRef
+    has exactly State's fields, and the kernels only read them.
+    """
+    return StateRef(*state)  # type: ignore[no-untyped-call, return-value]
 
 
 class Params(NamedTuple):

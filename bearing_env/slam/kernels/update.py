@@ -51,7 +51,7 @@ from bearing_env.slam.kernels.state import (
     Outputs,
     Params,
     Scratch,
-    StateRef,
+    State,
     new_scratch,
 )
 
@@ -81,7 +81,7 @@ def _frame_of(
 
 
 @njit(**_JIT)
-def _open_window_slot(state: StateRef, row: int, scratch: Scratch) -> int:
+def _open_window_slot(state: State, row: int, scratch: Scratch) -> int:
     """Make room in map ``row``'s window for a new movement (ageing out the oldest when
     it is full); returns the new movement's slot."""
     window = state.window_counts.shape[1]
@@ -97,7 +97,7 @@ def _open_window_slot(state: StateRef, row: int, scratch: Scratch) -> int:
 
 @njit(**_JIT)
 def _transfer_robot(
-    state: StateRef, row: int, frame: FrameChange, scratch: Scratch, robot_point: np.ndarray
+    state: State, row: int, frame: FrameChange, scratch: Scratch, robot_point: np.ndarray
 ) -> None:
     """Map ``row``'s robot region (the FR point R2 = 1 in FL) and heading."""
     fresh = scratch.fresh
@@ -153,7 +153,7 @@ def _update_rows(
     bearings_end: np.ndarray,
     rows: np.ndarray,
     params: Params,
-    state: StateRef,
+    state: State,
     out: Outputs,
 ) -> None:
     """:func:`update_maps` for bearings rows ``first`` to ``stop``, with scratch of its own."""
@@ -238,7 +238,7 @@ def update_maps(
     bearings_end: np.ndarray,
     rows: np.ndarray,
     params: Params,
-    state: StateRef,
+    state: State,
     out: Outputs,
 ) -> None:
     """Fuse one movement into each map ``rows[i]`` (bearings row ``i``), in place.
@@ -260,7 +260,7 @@ def update_maps_parallel(
     bearings_end: np.ndarray,
     rows: np.ndarray,
     params: Params,
-    state: StateRef,
+    state: State,
     out: Outputs,
 ) -> None:
     """:func:`update_maps` with the maps split into ``blocks`` blocks, one per thread.
