@@ -347,16 +347,21 @@ class BatchedPolygonSLAM:
         return ref
 
     def _kernel_params(self, with_robot: bool) -> kernels.Params:
-        """The kernels' settings for one update (see :class:`kernels.Params`)."""
-        return kernels.Params(
-            self.epsilon,
-            TRANSFERS.index(self.transfer),
-            self.edge_samples,
-            INCONSISTENCY_POLICIES.index(self.on_inconsistency),
-            FUSIONS.index(self.fusion),
-            self.max_outliers,
-            with_robot,
-        )
+        """The kernels' settings for one update (see :class:`kernels.Params`), made once
+        per batch (its settings never change) rather than on every call."""
+        both: tuple[kernels.Params, kernels.Params] | None = self.__dict__.get("_params")
+        if both is None:
+            settings = (
+                self.epsilon,
+                TRANSFERS.index(self.transfer),
+                self.edge_samples,
+                INCONSISTENCY_POLICIES.index(self.on_inconsistency),
+                FUSIONS.index(self.fusion),
+                self.max_outliers,
+            )
+            both = (kernels.Params(*settings, False), kernels.Params(*settings, True))
+            self._params = both
+        return both[with_robot]
 
     def _check_maps(self, maps: ArrayLike | None, distinct: bool = True) -> IntArray:
         if maps is None:
