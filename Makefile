@@ -17,8 +17,9 @@ $(STAMP): pyproject.toml constraints.txt
 	$(PY) -m pip install --quiet -c constraints.txt -e ".[render,train,dev,ray]"
 	touch $(STAMP)
 
+# Two workers, one per core; a test module stays on one worker (its fixtures run once).
 test: lint typecheck
-	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m "not slow"
+	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m "not slow" -n 2 --dist loadfile
 
 demo: $(STAMP)
 	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.demo

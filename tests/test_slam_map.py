@@ -752,18 +752,17 @@ def test_the_threaded_kernel_gives_the_serial_kernels_maps_bit_for_bit(transfer,
         b2 = np.array([r[move][1] for r in readings])
         outputs = []
         for batch, threads in ((serial, 0), (threaded, 4)):
-            frame = np.empty(16, dtype=np.int8)
-            landmark = np.empty((16, 3), dtype=np.int8)
-            bad = np.empty(16, dtype=np.int64)
-            arguments = (
-                b1, b2, rows, EPS, transfer == "conservative", 3, False, True,
-                batch.max_outliers, *(getattr(batch, name) for name in STATE_ARRAYS),
-                frame, landmark, bad,
+            out = kernels.Outputs(
+                np.empty(16, dtype=np.int8),
+                np.empty((16, 3), dtype=np.int8),
+                np.empty(16, dtype=np.int64),
             )
+            arguments = (b1, b2, rows, batch._kernel_params(True), batch._kernel_state(), out)
             if threads:
                 kernels.update_maps_parallel(threads, *arguments)  # 4 blocks, any cores
             else:
                 kernels.update_maps(*arguments)
+            frame, landmark, bad = out
             outputs.append((frame, landmark, bad))
         for mine, theirs in zip(*outputs, strict=True):
             np.testing.assert_array_equal(mine, theirs)

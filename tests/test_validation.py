@@ -37,7 +37,7 @@ def test_each_check_names_the_value_and_normalises_it():
         validation.int_at_least(2, 3, "n", "(L1, L2 and one more)")
     with pytest.raises(TypeError, match="n must be an int, got True"):
         validation.int_at_least(True, 1, "n")
-    with pytest.raises(ValueError, match="rate must be in \\(0, 1\\], got 0.0"):
+    with pytest.raises(ValueError, match=r"rate must be in \(0, 1\], got 0.0"):
         validation.float_in(0.0, "rate", 0.0, 1.0, closed_low=False)
     assert validation.float_in(0.0, "rate", 0.0, 1.0) == 0.0
     with pytest.raises(ValueError, match="finite and >= 0, got nan"):
@@ -76,7 +76,7 @@ def package_functions() -> list[tuple[Path, ast.FunctionDef]]:
 
 
 def test_angle_wrapping_and_value_checks_have_one_home_each():
-    wraps = [str(p) for p, f in package_functions() if "wrap" in f.name and "angle" in f.name
+    wraps = [str(p) for p, f in package_functions() if ("wrap" in f.name and "angle" in f.name)
              or f.name == "wrap"]
     assert sorted(wraps) == ["bearing_env/numerics.py", "bearing_env/numerics.py"]
     checks = {"is_real", "is_number", "is_integer", "int_at_least", "positive_float",

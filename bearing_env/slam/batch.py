@@ -71,6 +71,17 @@ INCONSISTENCY_POLICIES = ("restart", "keep")
 #: paper's intersection, or ``"relaxed"``, the q-relaxed intersection over a window.
 FUSIONS = ("intersect", "relaxed")
 
+# The kernels take the transfer, the policy and the fusion as indices into these tuples.
+if (
+    TRANSFERS.index("conservative") != kernels.TRANSFER_CONSERVATIVE
+    or TRANSFERS.index("paper") != kernels.TRANSFER_PAPER
+    or INCONSISTENCY_POLICIES.index("restart") != kernels.INCONSISTENCY_RESTART
+    or INCONSISTENCY_POLICIES.index("keep") != kernels.INCONSISTENCY_KEEP
+    or FUSIONS.index("intersect") != kernels.FUSION_INTERSECT
+    or FUSIONS.index("relaxed") != kernels.FUSION_RELAXED
+):
+    raise ImportError("the kernels' transfer, policy or fusion codes disagree with the names")
+
 #: The relaxed fusion's defaults: movements kept per map, and the most regions per
 #: landmark it may leave out of the window.
 DEFAULT_WINDOW = 8
@@ -178,6 +189,7 @@ class BatchedPolygonSLAM:
         self.base_counts = np.zeros((n, m), dtype=np.int64)
         self.n_dropped = np.zeros((n, m), dtype=np.int64)
         self.outliers = np.zeros((n, m), dtype=np.int64)
+        self._state_ref: kernels.State | None = None
         self.reset()
 
     def empty_like(self, num_maps: int) -> BatchedPolygonSLAM:
@@ -257,30 +269,20 @@ class BatchedPolygonSLAM:
     ) -> BatchUpdateResult:
         """:meth:`update` on checked input (float arrays (len(rows), n), distinct rows)."""
         n_rows, n_mapped = rows.size, self.n_landmarks - 2
-        frame = np.empty(n_rows, dtype=np.int8)
-        landmark = np.empty((n_rows, n_mapped), dtype=np.int8)
-        bad = np.empty(n_rows, dtype=np.int64)
-        # Any: the kernels take these mixed arguments (and the state arrays) positionally.
-        arguments: tuple[Any, ...] = (
-            b1,
-            b2,
-            rows,
-            self.epsilon,
-            self.transfer == "conservative",
-            self.edge_samples,
-            self.on_inconsistency == "keep",
-            bool(robot),
-            self.max_outliers,
-            *self._state_arrays(),
-            frame,
-            landmark,
-            bad,
+        out = kernels.Outputs(
+            np.empty(n_rows, dtype=np.int8),
+            np.empty((n_rows, n_mapped), dtype=np.int8),
+            np.empty(n_rows, dtype=np.int64),
         )
+        params = self._kernel_params(bool(robot))
         threads = kernels.threads() if n_rows >= PARALLEL_MIN_MAPS else 1
         if threads > 1:
-            kernels.update_maps_parallel(min(n_rows, threads), *arguments)
+            kernels.update_maps_parallel(
+                min(n_rows, threads), b1, b2, rows, params, self._kernel_state(), out
+            )
         else:
-            kernels.update_maps(*arguments)
+            kernels.update_maps(b1, b2, rows, params, self._kernel_state(), out)
+        frame, landmark, bad = out
         return BatchUpdateResult(frame == FRAME_CODE["ok"], frame, landmark, bad)
 
     def contains(self, points: ArrayLike, maps: ArrayLike | None = None) -> NDArray[np.bool_]:
@@ -330,10 +332,32 @@ class BatchedPolygonSLAM:
             return STATE_ARRAYS
         return tuple(name for name in STATE_ARRAYS if name not in RELAXED_STATE_ARRAYS)
 
-    def _state_arrays(self) -> tuple[NDArray[Any], ...]:
-        """The state in the kernels' argument order (see :data:`STATE_ARRAYS`)."""
-        d = self.__dict__
-        return tuple(d[name] for name in STATE_ARRAYS)
+    def _kernel_state(self) -> kernels.State:
+        """The state as the kernels take it: a :class:`kernels.StateRef` to this batch's
+        arrays, made on first use and kept (the arrays are only ever written in place)."""
+        ref: kernels.State | None = self._state_ref
+        if ref is None:
+            d = self.__dict__
+            ref = kernels.state_ref(kernels.State(*(d[name] for name in STATE_ARRAYS)))
+            self._state_ref = ref
+        return ref
+
+    def _kernel_params(self, with_robot: bool) -> kernels.Params:
+        """The kernels' settings for one update (see :class:`kernels.Params`), made once
+        per batch (its settings never change) rather than on every call."""
+        both: tuple[kernels.Params, kernels.Params] | None = self.__dict__.get("_params")
+        if both is None:
+            settings = (
+                self.epsilon,
+                TRANSFERS.index(self.transfer),
+                self.edge_samples,
+                INCONSISTENCY_POLICIES.index(self.on_inconsistency),
+                FUSIONS.index(self.fusion),
+                self.max_outliers,
+            )
+            both = (kernels.Params(*settings, False), kernels.Params(*settings, True))
+            self._params = both
+        return both[with_robot]
 
     def _check_maps(self, maps: ArrayLike | None, distinct: bool = True) -> IntArray:
         if maps is None:
@@ -354,41 +378,25 @@ class BatchedPolygonSLAM:
     def _check_bearings(self, bearings: ArrayLike, n_rows: int, name: str) -> FloatArray:
         return check_bearings(bearings, (n_rows, self.n_landmarks), name)
 
+    def __getstate__(self) -> dict[str, Any]:
+        # The kernels' reference to the arrays cannot be pickled; it is made again.
+        state = self.__dict__.copy()
+        state["_state_ref"] = None
+        return state
+
     def __setstate__(self, state: dict[str, Any]) -> None:
         # Out-of-band pickles (Ray's object store) hand back read-only buffers; the
         # kernel writes the state in place.
         for key, value in state.items():
             if isinstance(value, np.ndarray) and not value.flags.writeable:
                 state[key] = value.copy()
+        state["_state_ref"] = None
         self.__dict__.update(state)
 
 
-#: The per-map state, every array with the map axis first, in the order the kernels of
-#: :mod:`bearing_env.slam.kernels` take them.
-STATE_ARRAYS = (
-    "vertices",
-    "counts",
-    "areas",
-    "centroids",
-    "robot_vertices",
-    "robot_counts",
-    "robot_area",
-    "robot_centroid",
-    "robot_heading",
-    "n_updates",
-    "n_frame_changes",
-    "n_inconsistent",
-    "window_vertices",
-    "window_counts",
-    "window_inlier",
-    "window_rejected",
-    "window_length",
-    "window_next",
-    "base_vertices",
-    "base_counts",
-    "n_dropped",
-    "outliers",
-)
+#: The per-map state, every array with the map axis first: the fields of
+#: :class:`bearing_env.slam.kernels.State`, in its order.
+STATE_ARRAYS: tuple[str, ...] = kernels.State._fields
 
 
 #: The part of the state only the relaxed fusion uses (its window and bases).

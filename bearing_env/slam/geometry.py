@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.numerics import wrap_angle
 from bearing_env.slam import kernels
+from bearing_env.slam.batch import BatchedPolygonSLAM
 from bearing_env.slam.kernels import FR_BOUNDED, FR_EMPTY, FR_UNBOUNDED, MAX_FR_EXTENT
 from bearing_env.validation import int_at_least
 
@@ -91,24 +92,23 @@ def relaxed_intersection(
     if not 1 <= k <= kernels.MAX_WINDOW:
         raise ValueError(f"relaxed_intersection needs 1..{kernels.MAX_WINDOW} polygons, got {k}")
     max_outliers = int_at_least(max_outliers, 0, "max_outliers")
-    window = np.zeros((1, k, 1, kernels.CAPACITY), dtype=np.complex128)
-    counts = np.zeros((1, k, 1), dtype=np.int64)
+    # One map of one landmark whose window holds the polygons (the map's own limit on
+    # max_outliers does not apply: the kernel takes the cap as an argument).
+    maps = BatchedPolygonSLAM(1, 3, 0.1, fusion="relaxed", max_outliers=0, window=k)
     for i, polygon in enumerate(polygons):
         vertices = _polygon(polygon)
         if not 3 <= vertices.size <= kernels.CAPACITY:
             raise ValueError(
                 f"polygon {i} must have 3..{kernels.CAPACITY} vertices, got {vertices.size}"
             )
-        window[0, i, 0, : vertices.size] = vertices
-        counts[0, i, 0] = vertices.size
-    inlier = np.zeros((1, k, 1), dtype=bool)
-    scratch = [np.empty(kernels.MAX_CLOUD + 1, dtype=np.complex128) for _ in range(6)]
+        maps.window_vertices[0, i, 0, : vertices.size] = vertices
+        maps.window_counts[0, i, 0] = vertices.size
+    scratch = kernels.new_scratch()
+    scratch.slots[:k] = np.arange(k)
     n, q = kernels.relaxed_region(
-        0, 0, np.arange(k, dtype=np.int64), k, False, int(max_outliers), window, counts,
-        inlier, np.zeros((1, 1, 0), dtype=np.complex128), np.zeros((1, 1), dtype=np.int64),
-        *scratch,
+        maps._kernel_state(), 0, 0, k, False, int(max_outliers), scratch
     )
-    return scratch[0][:n].copy(), int(q), inlier[0, :, 0].copy()
+    return scratch.acc[:n].copy(), int(q), maps.window_inlier[0, :, 0].copy()
 
 
 def _polygon(points: ArrayLike) -> ComplexArray:

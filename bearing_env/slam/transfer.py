@@ -94,10 +94,11 @@ def transfer_vertices(
     cloud = np.empty(target.size * n_pairs, dtype=np.complex128)
     hull = np.empty(cloud.size + 1, dtype=np.complex128)
     out = np.empty(max(cloud.size + 1, kernels.SCRATCH), dtype=np.complex128)
-    n = kernels.transfer_region(
-        target, target.size, p1, p1.size, p2, p2.size, h1, inv_d, n_pairs, conservative,
-        distance, delta1, delta2, cloud, hull, out,
+    frame = kernels.FrameChange(
+        p1, int(p1.size), p2, int(p2.size), h1, inv_d, int(n_pairs), conservative,
+        float(distance), float(delta1), float(delta2),
     )
+    n = kernels.transfer_region(target, target.size, frame, cloud, hull, out)
     return out[:n].copy()
 
 
