@@ -125,7 +125,7 @@ def test_quick_ppo_subproc(tmp_path: Path) -> None:
     assert row["ratio_to_subproc"] == pytest.approx(1.0)
 
 
-def stand_in_vector_env(num_envs: int, max_episode_steps: int, **env_kwargs: Any) -> Any:
+def stand_in_vector_env(num_envs: int, **env_kwargs: Any) -> Any:
     """A vector entry point for the test (SAME_STEP autoreset, unlike the default)."""
     factories = [lambda: gym.make(bench_timing.ENV_ID, **env_kwargs)] * num_envs
     return gym.vector.SyncVectorEnv(factories, autoreset_mode=AutoresetMode.SAME_STEP)
