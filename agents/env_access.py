@@ -18,15 +18,14 @@ from collections.abc import Mapping
 from typing import Any
 
 import gymnasium as gym
-import numpy as np
 
+from bearing_env.envs import robot_map
 from bearing_env.envs.bearing_slam import BearingSLAMEnv
-from bearing_env.envs.core import ROBOT_MAP_UNKNOWN_AS_INF, WorldView
+from bearing_env.envs.core import WorldView
 from bearing_env.slam import PolygonSLAM
-from bearing_env.slam.batch import LANDMARK_AXES
 
 #: The one key of an info that robot policies read: the robot's own map.
-ROBOT_MAP_KEY = "robot_map"
+ROBOT_MAP_KEY = robot_map.KEY
 
 
 def bearing_env_of(env: gym.Env) -> BearingSLAMEnv:
@@ -69,20 +68,4 @@ class MapReader:
                 f"the info has no {ROBOT_MAP_KEY!r} (keys: {sorted(info)}): pass the info "
                 "the env returned with this observation"
             )
-        state = info[ROBOT_MAP_KEY]
-        slam = PolygonSLAM(int(n_landmarks), **self.map_settings)
-        batch, mapped = slam.batch, int(n_landmarks) - 2
-        for name in batch.state_names:
-            target = getattr(batch, name)
-            values = np.array(state[name])
-            if name in LANDMARK_AXES:  # the info's arrays have no map axis
-                values = np.take(values, np.arange(mapped), axis=LANDMARK_AXES[name] - 1)
-            if target.dtype.kind == "c":  # (x, y) pairs back to complex
-                points = np.asarray(values[..., 0], dtype=np.complex128)
-                points.imag = values[..., 1]
-                values = points
-            if name in ROBOT_MAP_UNKNOWN_AS_INF:
-                unknown = complex(np.nan, np.nan) if values.dtype.kind == "c" else np.nan
-                values[np.isinf(values)] = unknown  # back to the map's "unknown"
-            target[0] = values
-        return slam
+        return robot_map.decode(info[ROBOT_MAP_KEY], n_landmarks, self.map_settings)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from bearing_env.envs import core
 from bearing_env.envs.config import EnvConfig
@@ -71,3 +72,27 @@ def test_the_trajectory_grows_past_its_first_capacity() -> None:
         visited.append(state.positions.copy())
     assert np.all(state.trajectory_length == steps + 1)
     assert np.array_equal(state.trajectory[:, : steps + 1], np.stack(visited, axis=1))
+
+
+@pytest.mark.parametrize("fusion", ["intersect", "relaxed"])
+def test_the_robot_map_codec_round_trips_a_map_through_an_info(fusion: str) -> None:
+    """encode (the env's side) then decode (the policies') gives the same map state, with
+    the per-landmark arrays padded to the env's slots in between."""
+    from bearing_env.envs import robot_map
+    from bearing_env.slam import PolygonSLAM
+
+    rng = np.random.default_rng(8)
+    slam = PolygonSLAM(5, np.deg2rad(3.0), fusion=fusion)
+    for _ in range(6):
+        slam.update(rng.uniform(-np.pi, np.pi, 5), rng.uniform(-np.pi, np.pi, 5))
+    batch = slam.batch
+    data = robot_map.encode(batch, np.array([0]), slots=8)
+    one_env = {name: values[0] for name, values in data.items()}
+    assert one_env["counts"].shape == (8,) and np.all(one_env["counts"][3:] == 0)
+    assert np.all(np.isinf(one_env["areas"][3:]))
+    settings = {"epsilon": batch.epsilon, "transfer": batch.transfer, "fusion": fusion}
+    back = robot_map.decode(one_env, 5, settings).batch
+    for name in batch.state_names:
+        np.testing.assert_array_equal(
+            np.nan_to_num(getattr(back, name)), np.nan_to_num(getattr(batch, name)), err_msg=name
+        )

@@ -29,15 +29,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from bearing_env.envs import kernels
+from bearing_env.envs import kernels, robot_map
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig, MapSettings
 from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
 from bearing_env.numerics import wrap_angle
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
-    LANDMARK_AXES,
-    VERTEX_COUNTS,
     BatchedPolygonSLAM,
 )
 from bearing_env.validation import is_real
@@ -688,62 +686,13 @@ def infos(
         "inconsistent": outcome.inconsistent,
         "outliers": batch.outliers[rows],
         "path_length": outcome.travelled,
-        "robot_map": robot_map_info(batch, rows, config.max_landmarks - 2),
+        robot_map.KEY: robot_map.encode(batch, rows, config.max_landmarks - 2),
         "rewards": {
             "uncertainty": outcome.uncertainty,
             "path_cost": outcome.path_cost,
             "move_cost": outcome.move_cost,
         },
     }
-
-
-#: Fill of the empty landmark slots of ``info["robot_map"]`` (default 0: count 0 is a
-#: landmark without a region), as the map itself holds an uninitialised landmark.
-ROBOT_MAP_PADDING: dict[str, Any] = {"areas": np.inf, "centroids": complex(np.inf, np.inf)}
-#: The arrays of ``info["robot_map"]`` whose unknown values (NaN in the map: the centroid
-#: of a landmark without a region, the robot's centroid and heading before it has them)
-#: are written as inf, so that equal maps give equal infos (NaN != NaN).
-ROBOT_MAP_UNKNOWN_AS_INF: tuple[str, ...] = ("centroids", "robot_centroid", "robot_heading")
-
-
-def robot_map_info(batch: BatchedPolygonSLAM, rows: IntArray, slots: int) -> dict[str, Any]:
-    """The robot's own map state of the rows, as data (``info["robot_map"]``).
-
-    One array per state array the map's fusion uses (``BatchedPolygonSLAM.state_names``),
-    restricted to the rows; complex FL points are (x, y) pairs on a last axis of 2. It has
-    a canonical form so that equal maps give equal infos:
-    vertex slots beyond a region's count are 0, and unknown values are inf (see
-    :data:`ROBOT_MAP_UNKNOWN_AS_INF`). The per-landmark arrays
-    (``bearing_env.slam.batch.LANDMARK_AXES``) are padded to ``slots`` landmark slots
-    (``max_landmarks - 2``), so that every episode's info has the same shapes whatever
-    its landmark count.
-    It is what the robot knows, never ground truth.
-    """
-    mapped = batch.n_landmarks - 2
-    out: dict[str, Any] = {}
-    for name in batch.state_names:
-        values = getattr(batch, name)[rows]
-        if name in VERTEX_COUNTS:
-            used = getattr(batch, VERTEX_COUNTS[name])[rows]
-            values[np.arange(values.shape[-1]) >= used[..., None]] = 0
-        elif name in ROBOT_MAP_UNKNOWN_AS_INF:
-            unknown = np.isnan(values)
-            values[unknown] = complex(np.inf, np.inf) if values.dtype.kind == "c" else np.inf
-        axis = LANDMARK_AXES.get(name)
-        if axis is not None and slots > mapped:
-            shape = list(values.shape)
-            shape[axis] = slots
-            padded = np.full(shape, ROBOT_MAP_PADDING.get(name, 0), dtype=values.dtype)
-            used_slots = [slice(None)] * values.ndim
-            used_slots[axis] = slice(0, mapped)
-            padded[tuple(used_slots)] = values
-            values = padded
-        if values.dtype.kind == "c":
-            # FL points as (x, y) pairs on a last axis: Gymnasium batches real arrays and
-            # scalars only (a complex scalar would become an object array).
-            values = values.view(np.float64).reshape(*values.shape, 2)
-        out[name] = values
-    return out
 
 
 def row_info(batched: dict[str, Any], row: int) -> dict[str, Any]:
