@@ -16,19 +16,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol, cast, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import gymnasium as gym
 import numpy as np
-from gymnasium import spaces
 from numpy.typing import NDArray
 
-from bearing_env.numerics import wrap, wrap_angle
+from bearing_env.envs.actions import DISCRETE, ActionSpec
+from bearing_env.numerics import wrap
 
 from .env_access import bearing_env_of
-
-if TYPE_CHECKING:
-    from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
 
 #: Policies draw their own random numbers from ``default_rng([seed, POLICY_STREAM])``,
 #: not ``default_rng(seed)``: the env seeds its generator from the same episode seed, and
@@ -69,7 +66,9 @@ class Movement:
 
 
 class ActionCodec:
-    """Maps movements to the actions of one env (continuous or discrete), and back.
+    """Maps movements to the actions of one env (continuous or discrete), and back,
+    through the env's own action spec (:mod:`bearing_env.envs.actions`: the one home of
+    decoding and encoding).
 
     Continuous: ``a[0] = turn / pi``, ``a[1]`` maps linearly onto the env's
     ``move_length`` range ``(lo, hi)``; lengths outside the range are clipped to it.
@@ -79,21 +78,15 @@ class ActionCodec:
 
     def __init__(self, env: gym.Env) -> None:
         base = bearing_env_of(env)
+        self.spec: ActionSpec = base.action_spec
+        self.config = base.config
         self.length_range: tuple[float, float] = (
             float(base.move_length[0]),
             float(base.move_length[1]),
         )
-        self.discrete = isinstance(env.action_space, spaces.Discrete)
+        self.discrete = self.spec.kind == "discrete"
         if self.discrete:
-            # The action tables are the discrete env's (the env a Discrete space implies).
-            grid = cast("BearingSLAMDiscreteEnv", base)
-            self.turn_table = np.asarray(grid.turn_angles, dtype=np.float64)
-            self.length_table = np.asarray(grid.move_lengths, dtype=np.float64)
-        elif not isinstance(env.action_space, spaces.Box) or env.action_space.shape != (2,):
-            raise TypeError(
-                f"unsupported action space {env.action_space!r}: expected the Box(2,) of "
-                "BearingSLAM-v0 or the Discrete of BearingSLAMDiscrete-v0"
-            )
+            self.turn_table, self.length_table = DISCRETE.tables(self.config)
 
     @property
     def max_length(self) -> float:
@@ -101,24 +94,12 @@ class ActionCodec:
 
     def encode(self, turn: float, length: float) -> Action:
         """The env action closest to "turn by ``turn`` radians, move ``length`` metres"."""
-        if self.discrete:
-            turn_gap = np.abs(wrap_angle(self.turn_table - turn))
-            turn_index = int(np.argmin(turn_gap))
-            length_index = int(np.argmin(np.abs(self.length_table - length)))
-            return int(turn_index * self.length_table.size + length_index)
-        lo, hi = self.length_range
-        turn_unit = wrap(turn) / math.pi
-        length_unit = 1.0 if hi <= lo else 2.0 * (length - lo) / (hi - lo) - 1.0
-        return np.clip(np.array([turn_unit, length_unit]), -1.0, 1.0).astype(np.float32)
+        return self.spec.encode(self.config, turn, length)
 
     def decode(self, action: Action) -> tuple[float, float]:
         """(turn in radians, length in metres) that ``action`` commands, as the env reads it."""
-        if self.discrete:
-            turn_index, length_index = divmod(int(action), self.length_table.size)
-            return float(self.turn_table[turn_index]), float(self.length_table[length_index])
-        values = np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0)
-        lo, hi = self.length_range
-        return math.pi * float(values[0]), lo + 0.5 * (float(values[1]) + 1.0) * (hi - lo)
+        turns, lengths = self.spec.decode(self.config, np.asarray([action]))
+        return float(turns[0]), float(lengths[0])
 
     def movement(self, turn: float, length: float) -> Movement:
         """The movement the env will actually perform for the nearest action."""

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from bearing_env.envs import core
+from bearing_env.envs.actions import CONTINUOUS
 from bearing_env.envs.config import EnvConfig
 from bearing_env.envs.core import BatchState, MapBank
 
@@ -28,7 +29,7 @@ def test_a_batch_steps_as_its_rows_one_at_a_time() -> None:
     actions = np.random.default_rng(0).uniform(-1, 1, (6, n, 2))
     all_rows, one = np.arange(n), np.array([0])
     for step_actions in actions:
-        turns, lengths = core.decode_continuous(config, step_actions)
+        turns, lengths = CONTINUOUS.decode(config, step_actions)
         outcome = core.step(batch, all_rows, config, turns, lengths, batch_rngs, batch_maps)
         observations = core.observations(batch, all_rows, config, batch_maps)
         for row, (state, maps, rngs) in enumerate(singles):
@@ -48,7 +49,7 @@ def test_a_group_step_leaves_the_other_rows_untouched() -> None:
     before = {name: np.copy(value) for name, value in vars(state).items()}
     areas_before = maps.batch(4, config).areas.copy()
     group = np.array([1, 3])
-    turns, lengths = core.decode_continuous(config, np.array([[0.3, 1.0], [-0.2, 1.0]]))
+    turns, lengths = CONTINUOUS.decode(config, np.array([[0.3, 1.0], [-0.2, 1.0]]))
     core.step(state, group, config, turns, lengths, [rngs[1], rngs[3]], maps)
     others = np.array([0, 2])
     for name, value in vars(state).items():
@@ -67,7 +68,7 @@ def test_the_trajectory_grows_past_its_first_capacity() -> None:
     visited = [state.positions.copy()]
     steps = 2 * core.INITIAL_TRAJECTORY_SLOTS + 3
     for action in np.random.default_rng(1).uniform(-1, 1, (steps, 2, 2)):
-        turns, lengths = core.decode_continuous(config, action)
+        turns, lengths = CONTINUOUS.decode(config, action)
         core.step(state, rows, config, turns, lengths, rngs, maps)
         visited.append(state.positions.copy())
     assert np.all(state.trajectory_length == steps + 1)
@@ -96,3 +97,35 @@ def test_the_robot_map_codec_round_trips_a_map_through_an_info(fusion: str) -> N
         np.testing.assert_array_equal(
             np.nan_to_num(getattr(back, name)), np.nan_to_num(getattr(batch, name)), err_msg=name
         )
+
+
+@pytest.mark.parametrize("env_id", ["BearingSLAM-v0", "BearingSLAMDiscrete-v0"])
+def test_the_action_spec_is_the_one_home_of_spaces_decoding_and_encoding(env_id: str) -> None:
+    """The env, its vector env and the agents' codec share one action spec: encode gives
+    an action of the env's space that decodes to the nearest movement on its grid."""
+    import gymnasium as gym
+    from bearing_env.agents import ActionCodec
+
+    from bearing_env.envs.bearing_slam_vector import (
+        BearingSLAMDiscreteVectorEnv,
+        BearingSLAMVectorEnv,
+    )
+
+    env = gym.make(env_id, scenario="khepera")
+    base = env.unwrapped
+    spec = base.action_spec
+    vector = BearingSLAMDiscreteVectorEnv if spec.grid_fixed else BearingSLAMVectorEnv
+    assert vector.action_spec is spec and ActionCodec(env).spec is spec
+    assert env.action_space == spec.space(base.config)
+    rng = np.random.default_rng(2)
+    lo, hi = base.config.move_length
+    for turn, length in zip(rng.uniform(-3.0, 3.0, 20), rng.uniform(lo, hi, 20), strict=True):
+        action = spec.encode(base.config, turn, length)
+        assert env.action_space.contains(action)
+        turns, lengths = spec.decode(base.config, np.asarray([action]))
+        gap = abs((turns[0] - turn + np.pi) % (2 * np.pi) - np.pi)
+        if spec.grid_fixed:  # the nearest of n_turns turns, of n_move_lengths lengths
+            assert gap <= np.pi / base.config.n_turns + 1e-12
+            assert abs(lengths[0] - length) <= (hi - lo) / 4 + 1e-12
+        else:  # float32 rounding only
+            assert gap < 1e-6 and abs(lengths[0] - length) < 1e-6

@@ -9,7 +9,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Collection, Mapping
-from typing import Any, Generic, SupportsFloat, TypeVar, cast
+from typing import Any, ClassVar, Generic, SupportsFloat, TypeVar, cast
 
 import gymnasium as gym
 import numpy as np
@@ -18,6 +18,7 @@ from gymnasium.envs.registration import EnvSpec
 from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.envs import core
+from bearing_env.envs.actions import CONTINUOUS, ActionSpec
 from bearing_env.envs.config import (
     AREA_FLOOR,
     DEFAULT_AREA_CAP,
@@ -326,6 +327,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     * v0: Initial version.
     """
 
+    #: The action kind: its space, decoding and encoding (:mod:`bearing_env.envs.actions`).
+    action_spec: ClassVar[ActionSpec] = CONTINUOUS
     metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 4}  # noqa: RUF012
 
     # Every setting is an attribute backed by the config (see the Arguments section).
@@ -422,7 +425,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         self._renderer: Any = None
 
     def _make_action_space(self) -> spaces.Space[Any]:
-        return spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
+        return self.action_spec.space(self.config)
 
     # ------------------------------------------------------------------------------------
     # Settings and read-only views
@@ -435,7 +438,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     @config.setter
     def config(self, config: EnvConfig) -> None:
-        grid_fixed = isinstance(self.action_space, spaces.Discrete)
+        grid_fixed = self.action_spec.grid_fixed
         core.check_config_switch(self._config, config, action_grid_fixed=grid_fixed)
         core.switch_maps(self._state, self._maps, 0, self._config, config)
         self._config = config
@@ -580,18 +583,12 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     # ------------------------------------------------------------------------------------
 
     def _checked_action(self, action: Any) -> NDArray[Any]:
-        """One continuous action as an array of shape (2,) (ValueError otherwise)."""
-        try:
-            values = np.asarray(action)
-        except (TypeError, ValueError) as error:
-            raise ValueError(f"action must be 2 numbers in [-1, 1], got {action!r}") from error
-        if values.shape != (2,):
-            raise ValueError(f"action must have shape (2,), got shape {values.shape}: {action!r}")
-        return values
+        """One action, checked by the env's action spec (ValueError otherwise)."""
+        return self.action_spec.check_one(self.config, action)
 
     def _decode_batch(self, actions: NDArray[Any]) -> tuple[FloatArray, FloatArray]:
         """(turn angles, move lengths) of a batch of checked actions."""
-        return core.decode_continuous(self.config, actions)
+        return self.action_spec.decode(self.config, actions)
 
     def _decode_action(self, action: Any) -> tuple[float, float]:
         """(turn angle in radians, requested move length in metres) from an action."""

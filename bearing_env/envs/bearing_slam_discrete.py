@@ -2,13 +2,9 @@
 
 from __future__ import annotations
 
-from typing import Any, cast
+from typing import Any, ClassVar
 
-import numpy as np
-from gymnasium import spaces
-from numpy.typing import NDArray
-
-from bearing_env.envs import core
+from bearing_env.envs.actions import DISCRETE, ActionSpec
 from bearing_env.envs.bearing_slam import (
     FIXES_THE_SPACES,
     BearingSLAMEnv,
@@ -81,6 +77,8 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
     n_turns: Setting[int] = Setting("n_turns", read_only=FIXES_THE_SPACES)
     n_move_lengths: Setting[int] = Setting("n_move_lengths", read_only=FIXES_THE_SPACES)
 
+    action_spec: ClassVar[ActionSpec] = DISCRETE
+
     def __init__(
         self,
         *,
@@ -99,26 +97,12 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
             config = settings_from(config, {**settings, **grid}, defaults)
         super().__init__(render_mode=render_mode, config=config)
 
-    def _make_action_space(self) -> spaces.Space[Any]:
-        return spaces.Discrete(self.config.n_turns * self.config.n_move_lengths)
-
     @property
     def turn_angles(self) -> FloatArray:
         """The relative turns of the action grid, radians."""
-        return core.discrete_tables(self.config)[0]
+        return DISCRETE.tables(self.config)[0]
 
     @property
     def move_lengths(self) -> FloatArray:
         """The move lengths of the action grid, metres."""
-        return core.discrete_tables(self.config)[1]
-
-    def _checked_action(self, action: Any) -> NDArray[Any]:
-        """One action index as an array of shape () (ValueError otherwise)."""
-        values = np.asarray(action)
-        if values.shape != ():
-            n = cast(spaces.Discrete, self.action_space).n  # this env's space is Discrete
-            raise ValueError(f"action must be an integer in [0, {n}), got {action!r}")
-        return values
-
-    def _decode_batch(self, actions: NDArray[Any]) -> tuple[FloatArray, FloatArray]:
-        return core.decode_discrete(self.config, actions)
+        return DISCRETE.tables(self.config)[1]

@@ -7,9 +7,9 @@ returns :class:`BearingSLAMVectorEnv`. It steps the functional core of
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from types import SimpleNamespace
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from gymnasium.utils import seeding
@@ -18,6 +18,7 @@ from gymnasium.vector.utils import batch_space
 from numpy.typing import NDArray
 
 from bearing_env.envs import core
+from bearing_env.envs.actions import CONTINUOUS, DISCRETE, ActionSpec
 from bearing_env.envs.bearing_slam import BearingSLAMEnv, Setting, check_reset_options
 from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
 from bearing_env.envs.config import MAX_N_LANDMARKS, EnvConfig
@@ -37,7 +38,6 @@ LANDMARK_INFO_PADDING: dict[str, Any] = {
 }
 
 IntArray = NDArray[np.int64]
-Decoder = Callable[[EnvConfig, Any], tuple[NDArray[np.float64], NDArray[np.float64]]]
 
 
 class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[Any]]):
@@ -122,8 +122,8 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
     }
     #: The single env this batches: it validates the settings and defines the spaces.
     single_env_class: type[BearingSLAMEnv] = BearingSLAMEnv
-    #: Actions (num_envs, ...) of one group to (turn angles, move lengths).
-    decode_actions: Decoder = staticmethod(core.decode_continuous)
+    #: The action kind (its decoding), as the single env's.
+    action_spec: ClassVar[ActionSpec] = CONTINUOUS
 
     def __init__(
         self,
@@ -244,7 +244,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         resetting = self._autoreset_envs & (self.autoreset_mode == AutoresetMode.NEXT_STEP)
         # Every group's actions are decoded (and checked) before anything moves.
         groups = [
-            (config, rows, *self.decode_actions(config, actions[rows]))
+            (config, rows, *self.action_spec.decode(config, actions[rows]))
             for config, rows in self._groups(np.flatnonzero(~resetting))
         ]
 
@@ -355,7 +355,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
                 f"the sub-envs have no attribute {name!r} to set; set_attr sets 'config', "
                 "'np_random' and the settings (see EnvConfig)"
             )
-        grid_fixed = self.decode_actions is not core.decode_continuous
+        grid_fixed = self.action_spec.grid_fixed
         for row, config in enumerate(configs):
             core.check_config_switch(self._row_config(row), config, grid_fixed)
         for row, config in enumerate(configs):
@@ -565,7 +565,7 @@ class BearingSLAMDiscreteVectorEnv(BearingSLAMVectorEnv):
     (actions are an array of ``num_envs`` discrete action indices)."""
 
     single_env_class = BearingSLAMDiscreteEnv
-    decode_actions: Decoder = staticmethod(core.decode_discrete)
+    action_spec: ClassVar[ActionSpec] = DISCRETE
 
 
 #: Sub-env attributes the vector env serves itself (see ``_row_attribute``).

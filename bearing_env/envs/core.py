@@ -38,7 +38,6 @@ from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
     BatchedPolygonSLAM,
 )
-from bearing_env.validation import is_real
 from bearing_env.world import (
     Arena,
     NoiseDraws,
@@ -706,68 +705,6 @@ def row_info(batched: dict[str, Any], row: int) -> dict[str, Any]:
         else:
             info[key] = value[row].item()
     return info
-
-
-# ----------------------------------------------------------------------------------------
-# Actions
-# ----------------------------------------------------------------------------------------
-
-
-def _real_values(actions: Any, what: str) -> NDArray[Any]:
-    """``actions`` as a numeric array; strings, bools, complex numbers and other objects
-    are refused (numpy would quietly turn ``"0.5"`` or ``True`` into a float)."""
-    values = np.asarray(actions)
-    if values.dtype == object:
-        flat = values.ravel().tolist()
-        if not all(is_real(value) for value in flat):
-            raise ValueError(f"{what} must be real numbers, got {actions!r}")
-        values = np.array(flat, dtype=np.float64).reshape(values.shape)
-    elif values.dtype.kind not in "iuf":
-        raise ValueError(f"{what} must be real numbers, got {actions!r} (dtype {values.dtype})")
-    return values
-
-
-def decode_continuous(config: EnvConfig, actions: Any) -> tuple[FloatArray, FloatArray]:
-    """(turn angles, move lengths) from continuous actions (N, 2) in [-1, 1]^2."""
-    values = _real_values(actions, "actions")
-    if values.ndim != 2 or values.shape[1] != 2:
-        raise ValueError(f"actions must have shape (N, 2), got shape {values.shape}")
-    if values.dtype != np.float32 and values.dtype != np.float64:
-        # float16, longdouble and integer actions: the compiled decoder takes float32 or
-        # float64 only (numba has no float16 or longdouble). Cast; the range check follows.
-        values = values.astype(np.float64)
-    turns, lengths = np.empty(values.shape[0]), np.empty(values.shape[0])
-    lo, hi = config.move_length
-    outcome = kernels.decode_continuous(values, lo, hi, turns, lengths)
-    if outcome == kernels.ACTIONS_NOT_FINITE:
-        raise ValueError(f"actions must be finite, got {actions!r}")
-    if outcome == kernels.ACTIONS_OUTSIDE:
-        raise ValueError(f"actions {actions!r} are outside the action space [-1, 1]^2")
-    return turns, lengths
-
-
-def discrete_tables(config: EnvConfig) -> tuple[FloatArray, FloatArray]:
-    """The discrete action grid: (turn angles (n_turns,), move lengths (n_move_lengths,))."""
-    lo, hi = config.move_length
-    turns = wrap_angle(2.0 * math.pi * np.arange(config.n_turns) / config.n_turns)
-    return turns, np.linspace(lo, hi, config.n_move_lengths)
-
-
-def decode_discrete(config: EnvConfig, actions: Any) -> tuple[FloatArray, FloatArray]:
-    """(turn angles, move lengths) from discrete action indices (N,)."""
-    n_actions = config.n_turns * config.n_move_lengths
-    values = _real_values(actions, f"actions (integers in [0, {n_actions}))")
-    if values.dtype.kind == "f":
-        if not np.all(np.isfinite(values)) or np.any(values != np.round(values)):
-            raise ValueError(f"actions must be integers in [0, {n_actions}), got {actions!r}")
-    index = values.astype(np.int64)
-    if np.any((index < 0) | (index >= n_actions)):
-        raise ValueError(
-            f"actions {actions!r} are outside the action space Discrete({n_actions})"
-        )
-    turns, lengths = discrete_tables(config)
-    turn_index, length_index = np.divmod(index, config.n_move_lengths)
-    return turns[turn_index], lengths[length_index]
 
 
 # ----------------------------------------------------------------------------------------
