@@ -139,7 +139,26 @@ def test_a_config_and_keywords_together_are_refused() -> None:
         BearingSLAMDiscreteEnv(config=config, n_turns=4)
     with pytest.raises(TypeError, match="config"):
         BearingSLAMEnv(config={"scenario": "khepera"})  # type: ignore[arg-type]
-    BearingSLAMEnv(config=config, epsilon_deg=2.0)  # a default is not a conflict
+    # A keyword equal to its default conflicts too: config's epsilon_deg might not be 2.
+    with pytest.raises(TypeError, match="epsilon_deg"):
+        BearingSLAMEnv(config=EnvConfig.create(epsilon_deg=5.0), epsilon_deg=2.0)
+    with pytest.raises(TypeError, match="n_turns.*discrete action grid"):
+        BearingSLAMEnv(n_turns=4)
+
+
+def test_the_constructors_show_the_settings_of_envconfig_create() -> None:
+    """The settings are written once (EnvConfig.create); the envs' signatures are made
+    from it, so help() and inspect show every setting with its default."""
+    import inspect
+
+    create = inspect.signature(EnvConfig.create).parameters
+    continuous = inspect.signature(BearingSLAMEnv).parameters
+    discrete = inspect.signature(BearingSLAMDiscreteEnv).parameters
+    assert list(discrete) == ["render_mode", "config", *create]
+    assert list(continuous) == [
+        name for name in discrete if name not in ("n_turns", "n_move_lengths")
+    ]
+    assert continuous["max_moves"].default == create["max_moves"].default == 20
 
 
 def test_the_discrete_grid_lives_in_the_config() -> None:

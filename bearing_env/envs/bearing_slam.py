@@ -7,6 +7,7 @@ settings are one :class:`~bearing_env.envs.config.EnvConfig`.
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import math
 from collections.abc import Collection, Mapping
 from typing import Any, ClassVar, Generic, SupportsFloat, TypeVar, cast
@@ -26,10 +27,12 @@ from bearing_env.envs.config import (
     DEFAULT_MAX_MOVES,
     DEFAULT_TARGET_AREA,
     EPSILON_DEG_RANGE,
+    GRID_SETTINGS,
     MAX_AREA_CAP,
     MAX_N_LANDMARKS,
     REWARDS,
     EnvConfig,
+    settings_signature,
 )
 from bearing_env.envs.core import (
     FL_COORD_LIMIT,
@@ -41,7 +44,6 @@ from bearing_env.envs.core import (
 )
 from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
 from bearing_env.slam import PolygonSLAM
-from bearing_env.slam.batch import DEFAULT_MAX_OUTLIERS
 from bearing_env.world import Arena, NoiseModel
 
 __all__ = [
@@ -96,35 +98,27 @@ class Setting(Generic[T]):
 FIXES_THE_SPACES = "it fixes the observation space; make a new env"
 
 
-def settings_from(
-    config: EnvConfig | None, settings: Mapping[str, Any], defaults: Mapping[str, Any]
-) -> EnvConfig:
-    """The env's config: ``config`` itself, or one built from the keyword settings.
+def settings_from(config: EnvConfig | None, settings: Mapping[str, Any], grid: bool) -> EnvConfig:
+    """The env's config: ``config`` itself, or one built from the keyword settings by
+    :meth:`EnvConfig.create` (which names an unknown one).
 
-    Giving both is ambiguous (which wins?), so it is refused: a keyword counts as given
-    when it differs from its default.
+    Giving both is ambiguous (which wins?), so it is refused, and so are the discrete
+    grid's settings on an env without a grid (``grid`` False).
     """
+    if not grid and (given := sorted(set(settings) & set(GRID_SETTINGS))):
+        raise TypeError(
+            f"unexpected keyword argument(s) {given}: they set the discrete action grid of "
+            "BearingSLAMDiscrete-v0"
+        )
     if config is None:
         return EnvConfig.create(**settings)
     if not isinstance(config, EnvConfig):
         raise TypeError(f"config must be an EnvConfig or None, got {config!r}")
-    given = sorted(
-        name for name, value in settings.items() if _differs(value, defaults.get(name))
-    )
-    if given:
-        raise TypeError(f"pass the settings either as config or as keywords, not both: {given}")
+    if settings:
+        raise TypeError(
+            f"pass the settings either as config or as keywords, not both: {sorted(settings)}"
+        )
     return config
-
-
-def _differs(value: Any, default: Any) -> bool:
-    if value is default:
-        return False
-    if default is None or isinstance(value, np.ndarray):
-        return True
-    try:
-        return bool(value != default)
-    except (TypeError, ValueError):
-        return True
 
 
 class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
@@ -313,8 +307,12 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     - `render_mode`: `None`, `"human"` or `"rgb_array"`.
     - `config`: an `EnvConfig` (`bearing_env.envs.config`) holding all the settings
       above but `render_mode`, instead of the keywords (`EnvConfig.create(...)` takes
-      the same keywords). Invalid settings raise `TypeError` or `ValueError` naming the
-      value.
+      the same keywords; giving both is refused). Invalid settings raise `TypeError` or
+      `ValueError` naming the value.
+
+    The settings are written once, as `EnvConfig.create`'s parameters: the constructor
+    takes `**settings` and its signature (`inspect.signature(BearingSLAMEnv)`, `help()`)
+    is generated from `EnvConfig.create`'s.
 
     Every setting is also an attribute (`env.area_cap`, `env.path_cost`, ...; `reward`
     is `env.reward_kind`); assigning one replaces `env.config` with a validated copy.
@@ -329,6 +327,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     #: The action kind: its space, decoding and encoding (:mod:`bearing_env.envs.actions`).
     action_spec: ClassVar[ActionSpec] = CONTINUOUS
+    #: The constructor's keywords, generated from ``EnvConfig.create`` below the class.
+    __signature__: ClassVar[inspect.Signature]
     metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 4}  # noqa: RUF012
 
     # Every setting is an attribute backed by the config (see the Arguments section).
@@ -352,52 +352,13 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     observation_kind: Setting[str] = Setting("observation", read_only=FIXES_THE_SPACES)
 
     def __init__(
-        self,
-        scenario: str | None = None,
-        n_landmarks: int | tuple[int, int] | None = None,
-        landmarks: ArrayLike | None = None,
-        arena: tuple[float, float] | Arena | None = None,
-        epsilon_deg: float = 2.0,
-        noise: NoiseModel | Mapping[str, Any] | str | None = None,
-        transfer: str = "conservative",
-        reward: str = "log_area",
-        target_area: float = DEFAULT_TARGET_AREA,
-        max_moves: int = DEFAULT_MAX_MOVES,
-        move_length: float | tuple[float, float] | None = None,
-        path_cost: float = 0.0,
-        move_cost: float = 0.0,
-        area_cap: float = DEFAULT_AREA_CAP,
-        max_landmarks: int | None = None,
-        fusion: str = "intersect",
-        max_outliers: int = DEFAULT_MAX_OUTLIERS,
-        on_inconsistency: str = "restart",
-        render_mode: str | None = None,
-        config: EnvConfig | None = None,
-        observation: str = "flat",
+        self, *, render_mode: str | None = None, config: EnvConfig | None = None, **settings: Any
     ) -> None:
+        # The settings' one signature is EnvConfig.create's: the keywords go there
+        # (``__init__.__signature__``, set below the class, shows them all).
         super().__init__()
-        settings = {
-            "scenario": scenario,
-            "n_landmarks": n_landmarks,
-            "landmarks": landmarks,
-            "arena": arena,
-            "epsilon_deg": epsilon_deg,
-            "noise": noise,
-            "transfer": transfer,
-            "reward": reward,
-            "target_area": target_area,
-            "max_moves": max_moves,
-            "move_length": move_length,
-            "path_cost": path_cost,
-            "move_cost": move_cost,
-            "area_cap": area_cap,
-            "max_landmarks": max_landmarks,
-            "fusion": fusion,
-            "max_outliers": max_outliers,
-            "on_inconsistency": on_inconsistency,
-            "observation": observation,
-        }
-        self._setup(settings_from(config, settings, _CONTINUOUS_DEFAULTS), render_mode)
+        grid = self.action_spec.grid_fixed
+        self._setup(settings_from(config, settings, grid), render_mode)
 
     def _setup(self, config: EnvConfig, render_mode: str | None) -> None:
         """Everything but the config's construction: spaces, state, maps."""
@@ -655,15 +616,16 @@ def entity_observation_space(config: EnvConfig) -> spaces.Dict:
     )
 
 
-def _keyword_defaults(function: Any) -> dict[str, Any]:
-    import inspect
+def constructor_signature(env_class: type[BearingSLAMEnv]) -> inspect.Signature:
+    """The signature ``inspect.signature(env_class)`` and ``help()`` show: ``render_mode``
+    and ``config``, then every setting of :meth:`EnvConfig.create` the class takes
+    (generated, so the settings are written once)."""
+    keyword = inspect.Parameter.KEYWORD_ONLY
+    leading = [
+        inspect.Parameter("render_mode", keyword, default=None, annotation="str | None"),
+        inspect.Parameter("config", keyword, default=None, annotation="EnvConfig | None"),
+    ]
+    return settings_signature(grid=env_class.action_spec.grid_fixed, leading=leading)
 
-    return {
-        name: parameter.default
-        for name, parameter in inspect.signature(function).parameters.items()
-        if parameter.default is not inspect.Parameter.empty
-    }
 
-
-#: The defaults of the keyword settings (to tell given keywords from left-out ones).
-_CONTINUOUS_DEFAULTS = _keyword_defaults(BearingSLAMEnv.__init__)
+BearingSLAMEnv.__signature__ = constructor_signature(BearingSLAMEnv)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import ClassVar
 
 from bearing_env.envs.actions import DISCRETE, ActionSpec
 from bearing_env.envs.bearing_slam import (
@@ -10,9 +10,9 @@ from bearing_env.envs.bearing_slam import (
     BearingSLAMEnv,
     FloatArray,
     Setting,
-    settings_from,
+    constructor_signature,
 )
-from bearing_env.envs.config import DEFAULT_N_MOVE_LENGTHS, DEFAULT_N_TURNS, EnvConfig
+from bearing_env.envs.config import DEFAULT_N_MOVE_LENGTHS, DEFAULT_N_TURNS
 
 __all__ = ["DEFAULT_N_MOVE_LENGTHS", "DEFAULT_N_TURNS", "BearingSLAMDiscreteEnv"]
 
@@ -79,24 +79,6 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
 
     action_spec: ClassVar[ActionSpec] = DISCRETE
 
-    def __init__(
-        self,
-        *,
-        n_turns: int = DEFAULT_N_TURNS,
-        n_move_lengths: int | None = None,
-        render_mode: str | None = None,
-        config: EnvConfig | None = None,
-        **settings: Any,
-    ) -> None:
-        # The keyword settings are BearingSLAMEnv's; EnvConfig.create names any unknown one.
-        grid: dict[str, Any] = {"n_turns": n_turns, "n_move_lengths": n_move_lengths}
-        defaults = {"n_turns": DEFAULT_N_TURNS, "n_move_lengths": None}
-        if config is None:
-            config = EnvConfig.create(**settings, **grid)
-        else:
-            config = settings_from(config, {**settings, **grid}, defaults)
-        super().__init__(render_mode=render_mode, config=config)
-
     @property
     def turn_angles(self) -> FloatArray:
         """The relative turns of the action grid, radians."""
@@ -106,3 +88,7 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
     def move_lengths(self) -> FloatArray:
         """The move lengths of the action grid, metres."""
         return DISCRETE.tables(self.config)[1]
+
+
+
+BearingSLAMDiscreteEnv.__signature__ = constructor_signature(BearingSLAMDiscreteEnv)

@@ -19,6 +19,7 @@ the value.
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -77,6 +78,28 @@ REWARDS: tuple[str, ...] = ("log_area", "area")
 #: Observation kinds: the flat Box (default) or a Dict of a robot block and a landmark
 #: table (``bearing_env.envs.core.entity_observations``).
 OBSERVATIONS: tuple[str, ...] = ("flat", "entities")
+
+
+#: The settings of the discrete action grid, which only the discrete env takes.
+GRID_SETTINGS: tuple[str, ...] = ("n_turns", "n_move_lengths")
+
+
+def settings_signature(
+    *, grid: bool, leading: Sequence[inspect.Parameter] = ()
+) -> inspect.Signature:
+    """The keyword signature of an env constructor, generated from
+    :meth:`EnvConfig.create`'s, the one home of the settings, their types and defaults
+    (less :data:`GRID_SETTINGS` unless ``grid``), after the ``leading`` parameters.
+
+    The envs take ``**settings`` and set this as their ``__init__.__signature__``, so
+    ``help()``, ``inspect.signature`` and IDEs that run the code show every setting.
+    """
+    settings = [
+        parameter.replace(kind=inspect.Parameter.KEYWORD_ONLY)
+        for name, parameter in inspect.signature(EnvConfig.create).parameters.items()
+        if grid or name not in GRID_SETTINGS
+    ]
+    return inspect.Signature([*leading, *settings])
 
 
 #: ``EnvConfig.map_settings``: the world model's keyword settings as a hashable tuple.
