@@ -142,7 +142,7 @@ def test_a_config_and_keywords_together_are_refused() -> None:
     # A keyword equal to its default conflicts too: config's epsilon_deg might not be 2.
     with pytest.raises(TypeError, match="epsilon_deg"):
         BearingSLAMEnv(config=EnvConfig.create(epsilon_deg=5.0), epsilon_deg=2.0)
-    with pytest.raises(TypeError, match="n_turns.*discrete action grid"):
+    with pytest.raises(TypeError, match=r"n_turns.*discrete action grid"):
         BearingSLAMEnv(n_turns=4)
 
 
