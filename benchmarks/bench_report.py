@@ -20,7 +20,7 @@ from bearing_env.benchmarks.bench_timing import (
     ppo_label,
     vector_label,
 )
-from bearing_env.train.files import atomic_write_text
+from bearing_env.train.common.files import atomic_write_text
 
 import bearing_env
 

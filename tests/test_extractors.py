@@ -10,8 +10,8 @@ import pytest
 import torch
 from bearing_env.agents import SB3Policy
 from bearing_env.agents.extractors import LandmarkSetExtractor, LandmarkSetPolicy
-from bearing_env.train.train import train
-from bearing_env.train.zoo import parse_hyperparameters, read_hyperparameters
+from bearing_env.train.sb3.train import train
+from bearing_env.train.sb3.zoo import parse_hyperparameters, read_hyperparameters
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.envs.core import ENTITY_FEATURES

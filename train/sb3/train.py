@@ -1,7 +1,7 @@
 """The training loop of ``bearing-env train``: :func:`train` trains (or resumes) PPO, SAC or
 DQN with stable-baselines3 as :class:`TrainSettings` say. Its command line is
-:mod:`bearing_env.train.train_cli`, ``run.json`` and resuming
-:mod:`bearing_env.train.run_record`.
+:mod:`bearing_env.train.sb3.train_cli`, ``run.json`` and resuming
+:mod:`bearing_env.train.sb3.run_record`.
 
     bearing-env train --algo ppo                                   # PPO, Khepera scenario
     bearing-env train --algo sac --env BearingSLAM-v0 --timesteps 200000
@@ -25,8 +25,8 @@ instead), and ``--hyperparams k=v ...`` over the entry itself. Values are Python
 when they parse as one, strings otherwise.
 
 **Vectorisation** (``--vec-env``). ``batched`` runs the ``n_envs`` training envs as one
-Gymnasium vector env in this process, through ``bearing_env.train.vec_env``'s SB3 adapter: the id's
-natively batched ``vector_entry_point`` when it registers one (one batched
+Gymnasium vector env in this process, through ``bearing_env.train.sb3.vec_env``'s SB3 adapter:
+the id's natively batched ``vector_entry_point`` when it registers one (one batched
 computation steps every env), else a ``SyncVectorEnv`` of single envs. ``subproc`` runs
 one single env per worker process (spawn), ``dummy`` all of them in this process.
 ``auto``, the default, is ``batched`` when the id registers a batched vector env and
@@ -42,7 +42,7 @@ n_envs)`` for a segment resumed at timestep ``t``: every training seed is below
 plays validation episode ``k`` with seed ``900000 + k`` (``k < --eval-episodes``), the
 same episodes at every evaluation. Both ranges lie below ``compare``'s test seeds
 (1000000 and up), so neither training nor model selection ever sees a test episode;
-``bearing_env.train.seeds`` defines every range.
+``bearing_env.train.common.seeds`` defines every range.
 
 **Run folder** (``--output``, default ``runs/<algo>_<env>_seed<seed>``)::
 
@@ -94,7 +94,11 @@ from typing import Any
 
 import torch
 from bearing_env.agents.sb3 import load_model, load_vecnormalize
-from bearing_env.train.callbacks import (
+from bearing_env.train.common.files import write_json_atomically
+from bearing_env.train.common.seeds import (
+    training_seed_start,
+)
+from bearing_env.train.sb3.callbacks import (
     Checkpoint,
     CheckpointStore,
     FixedSeedEvalCallback,
@@ -106,26 +110,22 @@ from bearing_env.train.callbacks import (
     save_model_atomically,
     save_vecnormalize_atomically,
 )
-from bearing_env.train.files import write_json_atomically
-from bearing_env.train.run_folder import (
+from bearing_env.train.sb3.run_folder import (
     RunFiles,
     read_run_record,
 )
-from bearing_env.train.run_record import (
+from bearing_env.train.sb3.run_record import (
     new_run_record,
     resolve_run,
     running_segment,
     segments_after_a_kill,
 )
-from bearing_env.train.seeds import (
-    training_seed_start,
-)
-from bearing_env.train.training_envs import (
+from bearing_env.train.sb3.training_envs import (
     make_training_env,
     make_validation_env,
     resolve_vec_env_kind,
 )
-from bearing_env.train.zoo import (
+from bearing_env.train.sb3.zoo import (
     algorithm_class_for,
     parse_hyperparameters,
 )

@@ -49,11 +49,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bearing_env.train.cli_values import COUNT, SEED
-from bearing_env.train.compare_runner import make_env
-from bearing_env.train.errors import exit_on_output_errors, fail
-from bearing_env.train.files import atomic_save_figure, atomic_write_text
-from bearing_env.train.seeds import EVAL_SEED_START
+from bearing_env.train.common.cli_values import COUNT, SEED
+from bearing_env.train.common.errors import exit_on_output_errors, fail
+from bearing_env.train.common.files import atomic_save_figure, atomic_write_text
+from bearing_env.train.common.seeds import EVAL_SEED_START
+from bearing_env.train.compare.runner import make_env
 from numpy.typing import NDArray
 
 from bearing_env.extras import MissingExtraError, available

@@ -45,7 +45,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.compare_runner import EpisodeTask, run_task
+from bearing_env.train.compare.runner import EpisodeTask, run_task
 
 from bearing_env.extras import require
 

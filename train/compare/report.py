@@ -14,12 +14,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bearing_env.train.compare_config import CompareConfig
-from bearing_env.train.errors import (
+from bearing_env.train.common.errors import (
     MissingExtraError,
     available,
 )
-from bearing_env.train.files import atomic_save_figure, atomic_write_text
+from bearing_env.train.common.files import atomic_save_figure, atomic_write_text
+from bearing_env.train.compare.config import CompareConfig
 from numpy.typing import NDArray
 
 

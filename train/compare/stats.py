@@ -14,7 +14,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
-from bearing_env.train.compare_config import CompareConfig
+from bearing_env.train.compare.config import CompareConfig
 from numpy.typing import NDArray
 
 #: Move counts at which the total area is reported.
