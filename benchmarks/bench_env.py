@@ -99,6 +99,7 @@ from bearing_env.benchmarks.bench_timing import (
     log,
     profile,
 )
+from bearing_env.envs.config import MAX_N_LANDMARKS
 from bearing_env.train.common.cli_values import (
     COUNT,
     at_least,
@@ -107,8 +108,6 @@ from bearing_env.train.common.cli_values import (
     seconds,
 )
 from bearing_env.train.common.errors import exit_on_output_errors
-
-from bearing_env.envs.config import MAX_N_LANDMARKS
 
 # --------------------------------------------------------------------------------------
 # Command line

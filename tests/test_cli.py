@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import pytest
+
 from bearing_env.train.cli import SUBCOMMANDS
 
 

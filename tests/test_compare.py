@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+
 from bearing_env.train import cli
 from bearing_env.train.common.cli_values import format_key_values, parse_key_values
 from bearing_env.train.common.seeds import EVAL_SEED_START

@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
+
 from bearing_env.train.compare.log import LOG_NAME
 
 REPO_ROOT = Path(__file__).resolve().parents[1]

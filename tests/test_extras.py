@@ -16,7 +16,6 @@ from pathlib import Path
 
 import gymnasium as gym
 import pytest
-from bearing_env.train.common.errors import EXIT_ERROR, exit_on_missing_extra
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.extras import (
@@ -27,6 +26,7 @@ from bearing_env.extras import (
     missing_extra,
     require,
 )
+from bearing_env.train.common.errors import EXIT_ERROR, exit_on_missing_extra
 
 ROOT = Path(__file__).resolve().parents[1]
 RENDER = 'pip install "bearing_env[render]"'

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+
 from bearing_env.train.common.errors import (
     EXIT_ERROR,
     exit_on_output_errors,

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from bearing_env.train import cli
 from bearing_env.train.studies.figures import (
     FIG7_MOVEMENTS,

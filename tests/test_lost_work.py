@@ -18,8 +18,9 @@ import time
 from pathlib import Path
 from typing import Any
 
-import bearing_env.train.sb3.train as train_module
 import pytest
+
+import bearing_env.train.sb3.train as train_module
 from bearing_env.agents.sb3 import load_model
 from bearing_env.train.sb3 import train_cli
 from bearing_env.train.sb3.callbacks import CheckpointStore, StopOnRequestCallback

@@ -8,9 +8,9 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
-from bearing_env.agents import SB3Policy, pretrained_names, pretrained_record
 
 import bearing_env  # noqa: F401  (registers the ids)
+from bearing_env.agents import SB3Policy, pretrained_names, pretrained_record
 
 SHIPPED = ("ppo_khepera", "ppo_random", "ppo_generalist")
 

@@ -22,7 +22,9 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import ray
+
 from bearing_env.agents.registry import make_policy, spec_files, with_files
+from bearing_env.registration import ENV_IDS
 from bearing_env.train.compare.cli import main, reproducing_command
 from bearing_env.train.compare.comparison import run_comparison
 from bearing_env.train.compare.config import CompareConfig, policies_from_specs
@@ -31,8 +33,6 @@ from bearing_env.train.compare.runner import executor_named
 from bearing_env.train.ray.ray_executor import materialise, read_bundle, run_on_ray
 from bearing_env.train.ray.rllib import PROGRESS_NAME, RLlibSettings, train_rllib
 from bearing_env.train.ray.sweep import SweepSettings, parse_grid, run_sweep
-
-from bearing_env.registration import ENV_IDS
 from tests.test_extras import error_line, plain_cli
 
 ROOT = Path(__file__).resolve().parents[1]

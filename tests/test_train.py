@@ -22,12 +22,15 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-import bearing_env.train.sb3.train as train_module
 import gymnasium as gym
 import numpy as np
 import pytest
 import torch
 import yaml
+from stable_baselines3 import PPO
+from stable_baselines3.common.utils import ConstantSchedule
+
+import bearing_env.train.sb3.train as train_module
 from bearing_env.agents import SB3Policy
 from bearing_env.agents.sb3 import ModelLoadError, load_model, load_vecnormalize
 from bearing_env.train.common.cli_values import parse_key_values
@@ -54,8 +57,6 @@ from bearing_env.train.sb3.zoo import (
     read_hyperparameters,
     rl_zoo3_module,
 )
-from stable_baselines3 import PPO
-from stable_baselines3.common.utils import ConstantSchedule
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 ALGOS = ("ppo", "sac", "dqn")
@@ -668,8 +669,9 @@ def test_train_is_a_bearing_env_subcommand() -> None:
 
 
 def test_checkpoints_keep_sb3_checkpoint_callback_names(tmp_path: Path) -> None:
-    from bearing_env.train.sb3.callbacks import PeriodicCheckpointCallback
     from stable_baselines3.common.callbacks import CheckpointCallback
+
+    from bearing_env.train.sb3.callbacks import PeriodicCheckpointCallback
 
     checkpoint = CheckpointStore(tmp_path, keep=1).checkpoint_at(48)
     assert checkpoint.model_path == tmp_path / "rl_model_48_steps.zip"

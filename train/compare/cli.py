@@ -61,6 +61,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from bearing_env.extras import DISTRIBUTIONS, install_command
 from bearing_env.train.common.cli_values import (
     COUNT,
     NON_NEGATIVE,
@@ -95,8 +96,6 @@ from bearing_env.train.ray.ray_executor import (
     RayAddressError,
     check_ray_address,
 )
-
-from bearing_env.extras import DISTRIBUTIONS, install_command
 
 DEFAULT_POLICIES: tuple[str, ...] = ("random", "parallax", "greedy", "oracle", "lookahead")
 

@@ -38,6 +38,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+
 from bearing_env.agents.env_access import bearing_env_of
 from bearing_env.train.compare.config import CompareConfig, json_normalised
 

@@ -50,14 +50,13 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from bearing_env.registration import ENV_IDS
 from bearing_env.train.common.cli_values import COUNT, NON_NEGATIVE, SEED, parse_key_values
 from bearing_env.train.common.errors import available, exit_on_output_errors, fail, require
 from bearing_env.train.common.files import atomic_write_text
 from bearing_env.train.common.seeds import TRAINING_SEED_LIMIT
 from bearing_env.train.compare.config import DEFAULT_ENV_KWARGS
 from bearing_env.train.ray.ray_executor import RAY_CONNECT_TIMEOUT, check_ray_address, ray_session
-
-from bearing_env.registration import ENV_IDS
 
 RUN_NAME = "run.json"
 PROGRESS_NAME = "progress.jsonl"

@@ -38,11 +38,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bearing_env.train.common.files import atomic_path, write_json_atomically
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
+
+from bearing_env.train.common.files import atomic_path, write_json_atomically
 
 CHECKPOINT_PREFIX = "rl_model"
 _CHECKPOINT_MODEL_PATTERN = re.compile(rf"^{CHECKPOINT_PREFIX}_(\d+)_steps\.zip$")

@@ -12,13 +12,13 @@ from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
 import numpy as np
+
+import bearing_env
 from bearing_env.train.common.cli_values import json_safe
 from bearing_env.train.common.seeds import TRAINING_SEED_LIMIT, VALIDATION_SEED_START
 from bearing_env.train.sb3.callbacks import Checkpoint, CheckpointStore
 from bearing_env.train.sb3.run_folder import RunFiles, read_run_record
 from bearing_env.train.sb3.zoo import read_hyperparameters
-
-import bearing_env
 
 if TYPE_CHECKING:
     from bearing_env.train.sb3.train import TrainSettings

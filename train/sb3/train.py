@@ -93,6 +93,14 @@ from pathlib import Path
 from typing import Any
 
 import torch
+from stable_baselines3.common.base_class import BaseAlgorithm
+from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
+from stable_baselines3.common.vec_env import (
+    VecEnv,
+    VecNormalize,
+)
+
 from bearing_env.agents.sb3 import load_model, load_vecnormalize
 from bearing_env.train.common.files import write_json_atomically
 from bearing_env.train.common.seeds import (
@@ -128,13 +136,6 @@ from bearing_env.train.sb3.training_envs import (
 from bearing_env.train.sb3.zoo import (
     algorithm_class_for,
     parse_hyperparameters,
-)
-from stable_baselines3.common.base_class import BaseAlgorithm
-from stable_baselines3.common.callbacks import BaseCallback
-from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
-from stable_baselines3.common.vec_env import (
-    VecEnv,
-    VecNormalize,
 )
 
 DEFAULT_EVAL_FREQ = 25_000

@@ -12,6 +12,10 @@ from pathlib import Path
 from typing import Any, SupportsFloat
 
 import gymnasium as gym
+from stable_baselines3.common.monitor import Monitor
+from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecEnv, VecMonitor
+
+import bearing_env
 from bearing_env.train.common.seeds import validation_seeds
 from bearing_env.train.sb3.vec_env import (
     MONITOR_INFO_KEYWORDS,
@@ -19,10 +23,6 @@ from bearing_env.train.sb3.vec_env import (
     make_batched_vec_env,
     monitor_csv_path,
 )
-from stable_baselines3.common.monitor import Monitor
-from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecEnv, VecMonitor
-
-import bearing_env
 
 #: How the training envs run: ``batched`` is one Gymnasium vector env (the id's natively
 #: batched ``vector_entry_point``, else a ``SyncVectorEnv``) behind

@@ -27,12 +27,11 @@ from pathlib import Path
 from typing import Any
 
 from bearing_env.agents.sb3 import pretrained_names, pretrained_record
+from bearing_env.envs.config import EnvConfig
+from bearing_env.extras import available
 from bearing_env.train.common.cli_values import format_key_values
 from bearing_env.train.common.errors import MissingExtraError, fail
 from bearing_env.train.common.files import write_json_atomically
-
-from bearing_env.envs.config import EnvConfig
-from bearing_env.extras import available
 
 DEFAULT_BASELINES = ("random", "parallax", "greedy")
 #: The label the ratio panel divides by (GreedyOneStep's report label).
