@@ -134,6 +134,7 @@ from bearing_env.train.sb3.training_envs import (
     resolve_vec_env_kind,
 )
 from bearing_env.train.sb3.zoo import (
+    Hyperparameters,
     algorithm_class_for,
     parse_hyperparameters,
 )
@@ -272,12 +273,71 @@ def rollout_notice(
 
 
 def train(settings: TrainSettings) -> TrainResult:
-    """Train (or resume) a run; see the module docstring for the files it writes."""
+    """Train (or resume) a run; see the module docstring for the files it writes.
+
+    The phases, in order (each a function below): :func:`plan_run` reads the settings,
+    the hyperparameters and, on ``--resume``, the run folder; :func:`apply_process_settings`
+    sets torch's threads; :func:`build_envs` makes the validation and training envs and
+    :func:`normalize_envs` wraps them in VecNormalize; :func:`build_model` makes or loads
+    the model; :func:`start_run_record` writes ``run.json`` with the running segment;
+    :func:`build_callbacks` makes the checkpoint, stop and evaluation callbacks;
+    :func:`learn` trains until the budget or a stop request; :func:`save_run` saves the
+    checkpoint, the final model and the finished record. The envs are closed at the end."""
     check_device(settings.device)
+    plan = plan_run(settings)
+    apply_process_settings(settings, plan)
+    envs = build_envs(settings, plan)
+    try:
+        normalize_envs(envs, plan)
+        model = build_model(settings, plan, envs)
+        run_log = start_run_record(settings, plan, envs, model)
+        callbacks = build_callbacks(settings, plan, envs, run_log)
+        interrupted = learn(settings, plan, model, callbacks, run_log.remaining)
+        saved = save_run(plan, model, callbacks, run_log, interrupted)
+    finally:
+        envs.close()
+    return TrainResult(
+        model=model,
+        run_dir=settings.output,
+        num_timesteps=int(model.num_timesteps),
+        target_timesteps=plan.target,
+        interrupted=interrupted,
+        checkpoint=saved.checkpoint,
+        steps_per_second=saved.steps_per_second,
+        wall_seconds=saved.wall_seconds,
+    )
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """What a run will do, settled before anything is built: the algorithm, the entry of
+    the hyperparameter file, the checkpoint it resumes from (if any) and its budget."""
+
+    algorithm_class: type[BaseAlgorithm]
+    #: The raw entry of the hyperparameter file (overrides merged), as ``run.json`` keeps it.
+    raw: dict[str, Any]
+    hyperparams: Hyperparameters
+    checkpoint: Checkpoint | None
+    #: ``run.json`` of the run being resumed (empty for a new run).
+    previous_record: dict[str, Any]
+    n_envs: int
+    #: The total timesteps the run trains to.
+    target: int
+    files: RunFiles
+    #: A note that the run stops at a whole rollout past ``target`` (on-policy algorithms).
+    notice: str | None
+
+    @property
+    def start_timesteps(self) -> int:
+        return self.checkpoint.timesteps if self.checkpoint is not None else 0
+
+
+def plan_run(settings: TrainSettings) -> RunPlan:
+    """Phase 1: the algorithm, the hyperparameters and (on ``--resume``) the checkpoint and
+    record to resume from, all checked before any env or model is built."""
     algorithm_class = algorithm_class_for(settings.algo)
     raw, checkpoint = resolve_run(settings)
     hyperparams = parse_hyperparameters(raw, settings.algo)
-    env_kwargs = hyperparams.env_kwargs
     n_envs = settings.n_envs if settings.n_envs is not None else hyperparams.n_envs
     target = settings.timesteps if settings.timesteps is not None else hyperparams.n_timesteps
     if n_envs < 1 or target < 1:
@@ -299,168 +359,292 @@ def train(settings: TrainSettings) -> TrainResult:
         checkpoint.timesteps if checkpoint is not None else 0,
         target,
     )
+    return RunPlan(
+        algorithm_class=algorithm_class,
+        raw=raw,
+        hyperparams=hyperparams,
+        checkpoint=checkpoint,
+        previous_record=previous_record,
+        n_envs=n_envs,
+        target=target,
+        files=files,
+        notice=notice,
+    )
+
+
+def apply_process_settings(settings: TrainSettings, plan: RunPlan) -> None:
+    """Phase 2: torch's thread count for this process, then the plan's rollout notice."""
     if settings.torch_threads is not None:
         if settings.torch_threads < 1:
             raise ValueError(f"torch_threads must be >= 1 (or None), got {settings.torch_threads}")
         torch.set_num_threads(settings.torch_threads)
-    if notice is not None:
-        print(notice, file=sys.stderr)
+    if plan.notice is not None:
+        print(plan.notice, file=sys.stderr)
 
+
+@dataclass
+class TrainingEnvs:
+    """The training and validation envs; :func:`normalize_envs` replaces both with their
+    VecNormalize wrappers, and :meth:`close` closes whichever they are then."""
+
+    train: VecEnv
+    validation: VecEnv
+    #: The ``--vec-env`` kind the training env was built with.
+    kind: str
+    #: The area cap of the env, for the evaluation's scores.
+    area_cap: float
+    #: Training env ``i`` first resets with seed ``seed_start + i``.
+    seed_start: int
+
+    def close(self) -> None:
+        _close_quietly(self.train)
+        _close_quietly(self.validation)
+
+
+def build_envs(settings: TrainSettings, plan: RunPlan) -> TrainingEnvs:
+    """Phase 3: the validation env, then the run folder and the training envs."""
     vec_env_kind = resolve_vec_env_kind(settings.vec_env, settings.env_id)
     # The validation env is built first, in this process: bad env kwargs fail here, fast.
     eval_venv: VecEnv = make_validation_env(
         settings.env_id,
-        env_kwargs,
+        plan.hyperparams.env_kwargs,
         settings.eval_episodes,
         vec_monitor=vec_env_kind == "batched",
     )
     area_cap = float(eval_venv.get_attr("area_cap")[0])
     settings.output.mkdir(parents=True, exist_ok=True)
-    start_timesteps = checkpoint.timesteps if checkpoint is not None else 0
-    seed_start = training_seed_start(settings.seed, start_timesteps, n_envs)
+    seed_start = training_seed_start(settings.seed, plan.start_timesteps, plan.n_envs)
     venv: VecEnv = make_training_env(
-        settings.env_id, env_kwargs, n_envs, vec_env_kind, files.monitor
+        settings.env_id, plan.hyperparams.env_kwargs, plan.n_envs, vec_env_kind, plan.files.monitor
     )
-    try:
-        if hyperparams.normalize is not None:
-            if checkpoint is not None and checkpoint.vecnormalize_path.is_file():
-                resumed = load_vecnormalize(checkpoint.vecnormalize_path, venv)
-                resumed.training = True
-                venv = resumed
+    return TrainingEnvs(venv, eval_venv, vec_env_kind, area_cap, seed_start)
+
+
+def normalize_envs(envs: TrainingEnvs, plan: RunPlan) -> None:
+    """Phase 4: when the entry normalises, VecNormalize around both envs (the training
+    one resumes the checkpoint's statistics; the validation one never updates its own)."""
+    normalize = plan.hyperparams.normalize
+    if normalize is None:
+        return
+    checkpoint = plan.checkpoint
+    if checkpoint is not None and checkpoint.vecnormalize_path.is_file():
+        resumed = load_vecnormalize(checkpoint.vecnormalize_path, envs.train)
+        resumed.training = True
+        envs.train = resumed
+    else:
+        envs.train = VecNormalize(envs.train, **normalize)
+    eval_normalize = {**normalize, "training": False, "norm_reward": False}
+    envs.validation = VecNormalize(envs.validation, **eval_normalize)
+
+
+def build_model(settings: TrainSettings, plan: RunPlan, envs: TrainingEnvs) -> BaseAlgorithm:
+    """Phase 5: the model, loaded from the checkpoint (with its replay buffer) or new, and
+    seeded for this segment."""
+    tensorboard_log = str(plan.files.tensorboard) if settings.tensorboard else None
+    checkpoint = plan.checkpoint
+    model: BaseAlgorithm
+    if checkpoint is not None:
+        model = load_model(
+            checkpoint.model_path,
+            settings.algo,
+            env=envs.train,
+            device=settings.device,
+            tensorboard_log=tensorboard_log,
+            verbose=settings.verbose,
+        )
+        if isinstance(model, OffPolicyAlgorithm):
+            if checkpoint.replay_buffer_path.is_file():
+                model.load_replay_buffer(checkpoint.replay_buffer_path)
             else:
-                venv = VecNormalize(venv, **hyperparams.normalize)
-            eval_normalize = {**hyperparams.normalize, "training": False, "norm_reward": False}
-            eval_venv = VecNormalize(eval_venv, **eval_normalize)
-        tensorboard_log = str(files.tensorboard) if settings.tensorboard else None
-        if checkpoint is not None:
-            model = load_model(
-                checkpoint.model_path,
-                settings.algo,
-                env=venv,
-                device=settings.device,
-                tensorboard_log=tensorboard_log,
-                verbose=settings.verbose,
-            )
-            if isinstance(model, OffPolicyAlgorithm):
-                if checkpoint.replay_buffer_path.is_file():
-                    model.load_replay_buffer(checkpoint.replay_buffer_path)
-                else:
-                    print(f"warning: {checkpoint.replay_buffer_path} missing; empty replay buffer")
-        else:
-            model = algorithm_class(
-                env=venv,
-                seed=settings.seed,
-                device=settings.device,
-                tensorboard_log=tensorboard_log,
-                verbose=settings.verbose,
-                **hyperparams.algorithm_kwargs,
-            )
-        model.set_random_seed(seed_start)  # torch/numpy/action space, and env i: seed_start + i
-
-        raw = {**raw, "n_envs": n_envs, "n_timesteps": target}  # the entry actually used
-        record = new_run_record(
-            settings,
-            hyperparams=raw,
-            env_kwargs=env_kwargs,
-            n_envs=n_envs,
-            vec_env_kind=vec_env_kind,
-            target_timesteps=target,
-            num_timesteps=int(model.num_timesteps),
-            segments=segments_after_a_kill(previous_record, checkpoint),
+                print(f"warning: {checkpoint.replay_buffer_path} missing; empty replay buffer")
+    else:
+        model = plan.algorithm_class(
+            env=envs.train,
+            seed=settings.seed,
+            device=settings.device,
+            tensorboard_log=tensorboard_log,
+            verbose=settings.verbose,
+            **plan.hyperparams.algorithm_kwargs,
         )
-        learn_start = time.perf_counter()
-        remaining = target - int(model.num_timesteps)
-        segment: dict[str, Any] | None = None
-        if remaining > 0:
-            # Written now and at every checkpoint, so a killed process leaves its segment
-            # (marked "killed" on --resume) with the timesteps of its last checkpoint.
-            segment = running_segment(start_timesteps, n_envs, vec_env_kind)
-            record["segments"].append(segment)
-        write_json_atomically(files.record, record)
+    model.set_random_seed(envs.seed_start)  # torch/numpy/action space, env i: seed_start + i
+    return model
 
-        def record_checkpoint(saved_checkpoint: Checkpoint) -> None:
-            assert segment is not None
-            segment["end_timesteps"] = saved_checkpoint.timesteps
-            segment["wall_seconds"] = round(time.perf_counter() - learn_start, 3)
-            record["num_timesteps"] = saved_checkpoint.timesteps
-            write_json_atomically(files.record, record)
 
-        store = CheckpointStore(files.checkpoints, keep=settings.keep_checkpoints)
-        stop_request = StopRequest()
-        eval_callback = FixedSeedEvalCallback(
-            eval_venv,
-            best_folder=files.best,
-            area_cap=area_cap,
-            n_eval_episodes=settings.eval_episodes,
-            eval_freq=callback_calls(settings.eval_freq, n_envs) if settings.eval_freq > 0 else 0,
-            deterministic=True,
-            verbose=1 if settings.verbose >= 0 else 0,
-        )
-        if checkpoint is not None:
-            eval_callback.restore_history()
-        stop_callback = StopOnRequestCallback(stop_request)
-        checkpoint_callback = PeriodicCheckpointCallback(
-            store, settings.checkpoint_freq, verbose=settings.verbose, on_save=record_checkpoint
-        )
-        callbacks: list[BaseCallback] = [stop_callback, checkpoint_callback, eval_callback]
+@dataclass
+class RunLog:
+    """``run.json`` while the run trains: the record, this invocation's segment (None
+    when there is nothing left to train) and when learning started."""
 
-        interrupted = False
-        stopped_at_once = False
-        if remaining <= 0:
-            print(f"{settings.output}: already at {model.num_timesteps} >= {target} timesteps")
-        else:
-            with stop_on_signals(stop_request):
-                try:
-                    model.learn(
-                        total_timesteps=remaining,
-                        callback=callbacks,
-                        reset_num_timesteps=checkpoint is None,
-                        progress_bar=settings.progress_bar,
-                        tb_log_name=settings.algo.upper(),
-                    )
-                except KeyboardInterrupt:
-                    interrupted = stopped_at_once = True
-        interrupted = interrupted or bool(stop_request)
-        boundary = checkpoint_callback.boundary
-        if (stop_callback.stopped_mid_rollout or stopped_at_once) and boundary is not None:
-            # learn() left without training on the partial rollout: save the model of the
-            # last update boundary, which counts only the steps it was trained on.
-            dropped = rewind_to_boundary(model, boundary)
-            if dropped > 0 and settings.verbose >= 0:
-                print(
-                    f"stopped in a rollout: its {dropped} steps were not trained on and are "
-                    f"not counted; the checkpoint is at {model.num_timesteps} timesteps",
-                    file=sys.stderr,
-                )
-        wall_seconds = time.perf_counter() - learn_start
-        steps_done = int(model.num_timesteps) - start_timesteps
-        saved = store.save(model) if remaining > 0 else checkpoint
-        if not interrupted:
-            save_model_atomically(model, files.final_model)
-            normalizer = model.get_vec_normalize_env()
-            if normalizer is not None:
-                save_vecnormalize_atomically(normalizer, files.final_vecnormalize)
-        steps_per_second = steps_done / wall_seconds if wall_seconds > 0 else math.nan
-        if segment is not None:
-            segment.update(
-                end_timesteps=int(model.num_timesteps),
-                status="interrupted" if interrupted else "finished",
-                wall_seconds=round(wall_seconds, 3),
-                steps_per_second=round(steps_per_second, 1),
-            )
-        record["num_timesteps"] = int(model.num_timesteps)
-        record["status"] = "interrupted" if interrupted else "finished"
-        write_json_atomically(files.record, record)
-    finally:
-        _close_quietly(venv)
-        _close_quietly(eval_venv)
-    return TrainResult(
-        model=model,
-        run_dir=settings.output,
+    path: Path
+    record: dict[str, Any]
+    segment: dict[str, Any] | None
+    learn_start: float
+    #: Timesteps left to train in this invocation (<= 0: the run is already done).
+    remaining: int
+
+    def write(self) -> None:
+        write_json_atomically(self.path, self.record)
+
+    def checkpoint_saved(self, saved_checkpoint: Checkpoint) -> None:
+        """The record after each periodic checkpoint: a killed process leaves its segment
+        ending at the timesteps of its last checkpoint."""
+        assert self.segment is not None
+        self.segment["end_timesteps"] = saved_checkpoint.timesteps
+        self.segment["wall_seconds"] = round(time.perf_counter() - self.learn_start, 3)
+        self.record["num_timesteps"] = saved_checkpoint.timesteps
+        self.write()
+
+
+def start_run_record(
+    settings: TrainSettings, plan: RunPlan, envs: TrainingEnvs, model: BaseAlgorithm
+) -> RunLog:
+    """Phase 6: ``run.json`` with the settings, the entry actually used, the segments of
+    earlier invocations and, when there is training left, this one's running segment."""
+    raw = {**plan.raw, "n_envs": plan.n_envs, "n_timesteps": plan.target}  # the entry used
+    record = new_run_record(
+        settings,
+        hyperparams=raw,
+        env_kwargs=plan.hyperparams.env_kwargs,
+        n_envs=plan.n_envs,
+        vec_env_kind=envs.kind,
+        target_timesteps=plan.target,
         num_timesteps=int(model.num_timesteps),
-        target_timesteps=target,
-        interrupted=interrupted,
-        checkpoint=saved,
-        steps_per_second=steps_per_second,
-        wall_seconds=wall_seconds,
+        segments=segments_after_a_kill(plan.previous_record, plan.checkpoint),
     )
+    learn_start = time.perf_counter()
+    remaining = plan.target - int(model.num_timesteps)
+    segment: dict[str, Any] | None = None
+    if remaining > 0:
+        # Written now and at every checkpoint, so a killed process leaves its segment
+        # (marked "killed" on --resume) with the timesteps of its last checkpoint.
+        segment = running_segment(plan.start_timesteps, plan.n_envs, envs.kind)
+        record["segments"].append(segment)
+    run_log = RunLog(plan.files.record, record, segment, learn_start, remaining)
+    run_log.write()
+    return run_log
+
+
+@dataclass(frozen=True)
+class TrainingCallbacks:
+    """The callbacks of ``learn()`` and the objects the phases after it read."""
+
+    store: CheckpointStore
+    stop_request: StopRequest
+    stop: StopOnRequestCallback
+    checkpoint: PeriodicCheckpointCallback
+    #: In the order ``learn()`` calls them.
+    in_order: list[BaseCallback]
+
+
+def build_callbacks(
+    settings: TrainSettings, plan: RunPlan, envs: TrainingEnvs, run_log: RunLog
+) -> TrainingCallbacks:
+    """Phase 7: stop on request, periodic checkpoints (each recorded in ``run.json``) and
+    the fixed-seed evaluation that keeps the best model (its history restored on resume)."""
+    store = CheckpointStore(plan.files.checkpoints, keep=settings.keep_checkpoints)
+    stop_request = StopRequest()
+    eval_callback = FixedSeedEvalCallback(
+        envs.validation,
+        best_folder=plan.files.best,
+        area_cap=envs.area_cap,
+        n_eval_episodes=settings.eval_episodes,
+        eval_freq=callback_calls(settings.eval_freq, plan.n_envs) if settings.eval_freq > 0 else 0,
+        deterministic=True,
+        verbose=1 if settings.verbose >= 0 else 0,
+    )
+    if plan.checkpoint is not None:
+        eval_callback.restore_history()
+    stop_callback = StopOnRequestCallback(stop_request)
+    checkpoint_callback = PeriodicCheckpointCallback(
+        store, settings.checkpoint_freq, verbose=settings.verbose, on_save=run_log.checkpoint_saved
+    )
+    return TrainingCallbacks(
+        store=store,
+        stop_request=stop_request,
+        stop=stop_callback,
+        checkpoint=checkpoint_callback,
+        in_order=[stop_callback, checkpoint_callback, eval_callback],
+    )
+
+
+def learn(
+    settings: TrainSettings,
+    plan: RunPlan,
+    model: BaseAlgorithm,
+    callbacks: TrainingCallbacks,
+    remaining: int,
+) -> bool:
+    """Phase 8: ``model.learn()`` for the ``remaining`` timesteps, stopping on Ctrl-C or
+    SIGTERM; whether it was interrupted. A stop inside a rollout rewinds the model to the
+    last update boundary, so that it counts only the steps it was trained on."""
+    interrupted = False
+    stopped_at_once = False
+    if remaining <= 0:
+        print(f"{settings.output}: already at {model.num_timesteps} >= {plan.target} timesteps")
+    else:
+        with stop_on_signals(callbacks.stop_request):
+            try:
+                model.learn(
+                    total_timesteps=remaining,
+                    callback=callbacks.in_order,
+                    reset_num_timesteps=plan.checkpoint is None,
+                    progress_bar=settings.progress_bar,
+                    tb_log_name=settings.algo.upper(),
+                )
+            except KeyboardInterrupt:
+                interrupted = stopped_at_once = True
+    interrupted = interrupted or bool(callbacks.stop_request)
+    boundary = callbacks.checkpoint.boundary
+    if (callbacks.stop.stopped_mid_rollout or stopped_at_once) and boundary is not None:
+        # learn() left without training on the partial rollout: save the model of the
+        # last update boundary, which counts only the steps it was trained on.
+        dropped = rewind_to_boundary(model, boundary)
+        if dropped > 0 and settings.verbose >= 0:
+            print(
+                f"stopped in a rollout: its {dropped} steps were not trained on and are "
+                f"not counted; the checkpoint is at {model.num_timesteps} timesteps",
+                file=sys.stderr,
+            )
+    return interrupted
+
+
+@dataclass(frozen=True)
+class SavedRun:
+    """What :func:`save_run` saved, and the speed of this invocation's ``learn()``."""
+
+    #: The checkpoint written now, or the one resumed from when there was nothing to train.
+    checkpoint: Checkpoint | None
+    steps_per_second: float
+    wall_seconds: float
+
+
+def save_run(
+    plan: RunPlan,
+    model: BaseAlgorithm,
+    callbacks: TrainingCallbacks,
+    run_log: RunLog,
+    interrupted: bool,
+) -> SavedRun:
+    """Phase 9: a checkpoint (when this invocation trained), the final model and its
+    statistics (unless interrupted), and ``run.json`` with the segment's end and status."""
+    wall_seconds = time.perf_counter() - run_log.learn_start
+    steps_done = int(model.num_timesteps) - plan.start_timesteps
+    saved = callbacks.store.save(model) if run_log.remaining > 0 else plan.checkpoint
+    if not interrupted:
+        save_model_atomically(model, plan.files.final_model)
+        normalizer = model.get_vec_normalize_env()
+        if normalizer is not None:
+            save_vecnormalize_atomically(normalizer, plan.files.final_vecnormalize)
+    steps_per_second = steps_done / wall_seconds if wall_seconds > 0 else math.nan
+    status = "interrupted" if interrupted else "finished"
+    if run_log.segment is not None:
+        run_log.segment.update(
+            end_timesteps=int(model.num_timesteps),
+            status=status,
+            wall_seconds=round(wall_seconds, 3),
+            steps_per_second=round(steps_per_second, 1),
+        )
+    run_log.record["num_timesteps"] = int(model.num_timesteps)
+    run_log.record["status"] = status
+    run_log.write()
+    return SavedRun(saved, steps_per_second, wall_seconds)
