@@ -18,7 +18,7 @@ from bearing_env.train.sb3.zoo import parse_hyperparameters, read_hyperparameter
 from tests.test_train import TINY_TIMESTEPS, tiny_settings
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
-CONF_FILE = REPO_ROOT / "train" / "hyperparams" / "ppo_entities.yml"
+CONF_FILE = REPO_ROOT / "train" / "sb3" / "hyperparams" / "ppo_entities.yml"
 WIDTH = len(ENTITY_FEATURES)
 
 

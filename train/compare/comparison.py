@@ -107,8 +107,8 @@ def run_comparison(
         progress: show a progress bar.
         plots: write the PNG plots.
         command: the command line to quote in the report.
-        executor: what runs the episodes (``compare_runner.EpisodeExecutor``): the local
-            worker pool by default, given ``workers``; ``compare_runner.executor_named``
+        executor: what runs the episodes (``runner.EpisodeExecutor``): the local
+            worker pool by default, given ``workers``; ``runner.executor_named``
             gives the Ray one.
     """
     out = Path(out)
