@@ -557,6 +557,18 @@ def test_bench_slam_into_a_closed_pipe_ends_quietly(
 # --------------------------------------------------------------------------------------
 
 
+class _OsWith:
+    """``os`` with some functions replaced: patched into the project's atomic writers
+    only, so that numba's cache (which renames files too, when a test compiles a kernel
+    for the first time) keeps the real ones."""
+
+    def __init__(self, **replaced: Any) -> None:
+        self.__dict__.update(replaced)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(os, name)
+
+
 def _read_only(*args: Any, **kwargs: Any) -> None:
     raise OSError(errno.EROFS, os.strerror(errno.EROFS))
 
@@ -595,9 +607,12 @@ def test_figures_and_bench_on_a_bad_disk_name_the_file(
 ) -> None:
     """The atomic writers' rename fails on a read-only file system, their fsync on a full
     disk; either way the message names the file."""
+    from bearing_env.train.common import files
+
     out = tmp_path / "out"
     where = ["--out", str(out)] if command[0] == "figures" else ["--json", str(out / "b.json")]
-    monkeypatch.setattr(os, *patch)
+    name, replacement = patch
+    monkeypatch.setattr(files, "os", _OsWith(**{name: replacement}))
     code, err = cli_exit([*command, *where], capsys, monkeypatch)
     assert code == EXIT_ERROR, err
     lines = [line for line in err.splitlines() if line.strip()]
