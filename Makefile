@@ -22,8 +22,8 @@ test: lint typecheck
 	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m "not slow" -n 2 --dist loadfile
 
 demo: $(STAMP)
-	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.demo
-	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.compare --quick
+	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.studies.demo
+	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.compare.cli --quick
 
 bench: $(STAMP)
 	$(PY) -m bearing_env.benchmarks.bench_env

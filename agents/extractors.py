@@ -19,7 +19,7 @@ are scaled by :data:`LOG_AREA_SCALE` here instead.
 :class:`LandmarkSetPolicy` is SB3's ``MultiInputPolicy`` with this extractor: name it by
 its dotted path (``policy: bearing_env.agents.extractors.LandmarkSetPolicy``) in a
 hyperparameter file, for ``bearing-env train`` and rl-zoo3 alike
-(``train/hyperparams/ppo_entities.yml``).
+(``train/sb3/hyperparams/ppo_entities.yml``).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Where the files shipped inside the package are: found through ``importlib.resources``.
 
 The models (``bearing_env.agents``' ``pretrained/``) and the rl-zoo3 hyperparameter files
-(``bearing_env.train``'s ``hyperparams/``) are package data, so they are where the
+(``bearing_env.train.sb3``'s ``hyperparams/``) are package data, so they are where the
 package is, in a checkout (editable install) and in site-packages alike, and nothing
 looks for them relative to the working directory. pip installs a wheel as plain files,
 so a shipped folder is a real directory that other programs (rl-zoo3's ``--conf-file``)

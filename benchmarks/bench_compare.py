@@ -40,12 +40,11 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.compare_config import CompareConfig, policies_from_specs
-from bearing_env.train.compare_log import LOG_NAME, EpisodeLog
-from bearing_env.train.compare_runner import EpisodeTask, episode_tasks, executor_named
-from bearing_env.train.comparison import run_comparison
-
 from bearing_env.extras import require
+from bearing_env.train.compare.comparison import run_comparison
+from bearing_env.train.compare.config import CompareConfig, policies_from_specs
+from bearing_env.train.compare.log import LOG_NAME, EpisodeLog
+from bearing_env.train.compare.runner import EpisodeTask, episode_tasks, executor_named
 
 DEFAULT_POLICIES = ("random", "parallax", "greedy")
 

@@ -38,7 +38,7 @@ Sections:
   moves of several episodes. Seconds, not a ratio.
 - ``ppo``: SB3 ``PPO`` with the shipped ``ppo.yml``'s settings for BearingSLAM-v0
   (VecNormalize included) on ``--ppo-envs`` envs built by
-  ``bearing_env.train.training_envs.make_training_env``
+  ``bearing_env.train.sb3.training_envs.make_training_env``
   for each vec env kind (batched, subproc with spawn, dummy). The rate is env steps per
   second of wall time of ``model.learn()``, measured after a warm-up ``learn()`` of one
   rollout, so process start-up and torch initialisation are excluded. PPO always finishes
@@ -99,10 +99,15 @@ from bearing_env.benchmarks.bench_timing import (
     log,
     profile,
 )
-from bearing_env.train.cli_values import COUNT, at_least, json_safe, parse_key_values, seconds
-from bearing_env.train.errors import exit_on_output_errors
-
 from bearing_env.envs.config import MAX_N_LANDMARKS
+from bearing_env.train.common.cli_values import (
+    COUNT,
+    at_least,
+    json_safe,
+    parse_key_values,
+    seconds,
+)
+from bearing_env.train.common.errors import exit_on_output_errors
 
 # --------------------------------------------------------------------------------------
 # Command line

@@ -16,13 +16,13 @@ from typing import Any, Literal
 
 import gymnasium as gym
 import numpy as np
+
+import bearing_env
 from bearing_env.benchmarks.bench_timing import (
     ppo_label,
     vector_label,
 )
-from bearing_env.train.files import atomic_write_text
-
-import bearing_env
+from bearing_env.train.common.files import atomic_write_text
 
 #: Relative to the working directory, so an installed package never writes into itself.
 DEFAULT_JSON = Path("outputs") / "bench_env.json"

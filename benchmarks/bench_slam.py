@@ -17,11 +17,11 @@ from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
-from bearing_env.train.cli_values import seconds
-from bearing_env.train.errors import exit_on_output_errors
-from bearing_env.train.files import atomic_write_text
 
 from bearing_env.slam import PolygonSLAM
+from bearing_env.train.common.cli_values import seconds
+from bearing_env.train.common.errors import exit_on_output_errors
+from bearing_env.train.common.files import atomic_write_text
 
 
 def cartpole_steps_per_second(seconds: float) -> float:

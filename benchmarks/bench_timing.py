@@ -20,9 +20,10 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
-from bearing_env.benchmarks.bench_slam import cartpole_steps_per_second
-from bearing_env.train.cli_values import json_safe
 from gymnasium.vector import AutoresetMode
+
+from bearing_env.benchmarks.bench_slam import cartpole_steps_per_second
+from bearing_env.train.common.cli_values import json_safe
 
 ENV_ID = "BearingSLAM-v0"
 SECTIONS: tuple[str, ...] = ("single", "vector", "slam", "startup", "planning", "ppo")
@@ -387,7 +388,7 @@ def ppo_settings(
     env_kwargs: dict[str, Any], overrides: dict[str, Any]
 ) -> tuple[dict[str, Any], dict[str, Any] | None, dict[str, Any]]:
     """(PPO constructor kwargs, VecNormalize kwargs or None, env kwargs) from ppo.yml."""
-    from bearing_env.train.zoo import parse_hyperparameters, read_hyperparameters
+    from bearing_env.train.sb3.zoo import parse_hyperparameters, read_hyperparameters
 
     raw = read_hyperparameters("ppo", ENV_ID)
     raw.update(overrides)
@@ -475,9 +476,10 @@ def build_ppo_run(
     overrides: dict[str, Any],
 ) -> PPORun:
     """Build PPO on one vec env kind and warm it up (one rollout and one update)."""
-    from bearing_env.train.training_envs import make_training_env
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
+
+    from bearing_env.train.sb3.training_envs import make_training_env
 
     algorithm_kwargs, normalize, make_kwargs = ppo_settings(env_kwargs, overrides)
     build_start = time.perf_counter()

@@ -27,12 +27,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bearing_env.train.cli_values import COUNT, SEED
-from bearing_env.train.errors import exit_on_output_errors
-from bearing_env.train.files import write_json_atomically
 
 from bearing_env.slam import FUSIONS, TRANSFERS
 from bearing_env.slam.audit import SearchReport, SearchSettings, search
+from bearing_env.train.common.cli_values import COUNT, SEED
+from bearing_env.train.common.errors import exit_on_output_errors
+from bearing_env.train.common.files import write_json_atomically
 
 COLUMNS = (
     "movements", "regions", "not_simple_convex", "shapely_invalid", "area_mismatches",

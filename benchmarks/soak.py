@@ -29,11 +29,11 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
-from bearing_env.train.cli_values import COUNT, SEED
-from bearing_env.train.errors import exit_on_output_errors
-from bearing_env.train.files import write_json_atomically
 
 import bearing_env  # noqa: F401  (registers the ids)
+from bearing_env.train.common.cli_values import COUNT, SEED
+from bearing_env.train.common.errors import exit_on_output_errors
+from bearing_env.train.common.files import write_json_atomically
 
 IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
 

@@ -12,6 +12,8 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import pytest
+
+import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.agents import (
     ActionCodec,
     GreedyOneStep,
@@ -28,8 +30,6 @@ from bearing_env.agents.belief import ObservationReader, scale_sample, triangula
 from bearing_env.agents.env_access import MapReader
 from bearing_env.agents.lookahead import Lookahead, LookaheadOracle, sample_in_polygon
 from bearing_env.agents.vector import VectorPolicy
-
-import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.slam import world_to_fl
 
 ENV_IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")

@@ -11,9 +11,10 @@ from typing import Any
 
 import gymnasium as gym
 import pytest
+from gymnasium.vector import AutoresetMode
+
 from bearing_env.benchmarks import bench_env, bench_report, bench_timing
 from bearing_env.train import cli
-from gymnasium.vector import AutoresetMode
 
 MACHINE_KEYS = {"platform", "cpu_count", "numpy", "python", "gymnasium"}
 FIGURE_KEYS = {

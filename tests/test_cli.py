@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import pytest
+
 from bearing_env.train.cli import SUBCOMMANDS
 
 
@@ -53,11 +54,11 @@ def test_hyperparams_prints_the_shipped_file_from_any_folder(tmp_path) -> None:
     assert result.returncode == 0, result.stderr
     from pathlib import Path
 
-    import bearing_env.train
+    import bearing_env.train.sb3
 
     path = Path(result.stdout.strip())
     assert path.is_absolute() and path.name == "ppo.yml"
-    assert path.parent.parent == Path(bearing_env.train.__file__).parent
+    assert path.parent.parent == Path(bearing_env.train.sb3.__file__).parent
     assert "BearingSLAM-v0:" in path.read_text()
 
 
@@ -69,7 +70,7 @@ def test_hyperparams_rejects_an_algorithm_without_a_file(tmp_path) -> None:
 
 def test_compare_help_names_every_policy_kind() -> None:
     from bearing_env.agents.registry import POLICY_CLASSES
-    from bearing_env.train.compare import build_parser
+    from bearing_env.train.compare.cli import build_parser
 
     epilog = " ".join((build_parser().epilog or "").split())
     # One name per kind: the shortest of the names that build the same class.

@@ -11,16 +11,17 @@ from typing import Any
 
 import numpy as np
 import pytest
+
 from bearing_env.train import cli
-from bearing_env.train.cli_values import format_key_values, parse_key_values
-from bearing_env.train.compare import main
-from bearing_env.train.compare_config import CompareConfig, policies_from_specs
-from bearing_env.train.compare_log import LOG_NAME, EpisodeLog
-from bearing_env.train.compare_report import csv_text
-from bearing_env.train.compare_runner import EpisodeTask, episode_tasks, run_locally
-from bearing_env.train.compare_stats import bootstrap_mean_ci
-from bearing_env.train.comparison import RunMismatchError, run_comparison
-from bearing_env.train.seeds import EVAL_SEED_START
+from bearing_env.train.common.cli_values import format_key_values, parse_key_values
+from bearing_env.train.common.seeds import EVAL_SEED_START
+from bearing_env.train.compare.cli import main
+from bearing_env.train.compare.comparison import RunMismatchError, run_comparison
+from bearing_env.train.compare.config import CompareConfig, policies_from_specs
+from bearing_env.train.compare.log import LOG_NAME, EpisodeLog
+from bearing_env.train.compare.report import csv_text
+from bearing_env.train.compare.runner import EpisodeTask, episode_tasks, run_locally
+from bearing_env.train.compare.stats import bootstrap_mean_ci
 
 SMALL_ENV = {"scenario": "khepera", "max_moves": 4}
 OUTPUT_FILES = (
@@ -253,7 +254,7 @@ def test_command_line_runs_and_resumes(tmp_path: Path, capsys: pytest.CaptureFix
 
 
 def test_the_report_quotes_the_command_that_reproduces_the_results() -> None:
-    from bearing_env.train.compare import reproducing_command
+    from bearing_env.train.compare.cli import reproducing_command
 
     argv = ["--episodes", "9", "--resume", "--stop-after", "3", "--no-progress", "--out", "o"]
     assert reproducing_command(argv) == "bearing-env compare --episodes 9 --out o"
@@ -301,7 +302,7 @@ def test_bearing_env_dispatches_compare(
 
 
 def test_atomic_outputs_leave_no_partial_files(tmp_path: Path) -> None:
-    from bearing_env.train.files import atomic_write_text
+    from bearing_env.train.common.files import atomic_write_text
 
     target = tmp_path / "deep" / "file.json"
     atomic_write_text(target, "{}\n")
@@ -326,7 +327,8 @@ def test_ctrl_c_then_resume_reproduces_the_uninterrupted_run(tmp_path: Path) -> 
     root = Path(__file__).resolve().parents[1]
 
     def command(out: Path, *extra: str) -> list[str]:
-        return [sys.executable, "-m", "bearing_env.train.compare", *args, "--out", str(out), *extra]
+        module = "bearing_env.train.compare.cli"
+        return [sys.executable, "-m", module, *args, "--out", str(out), *extra]
 
     interrupted = tmp_path / "interrupted"
     process = subprocess.Popen(

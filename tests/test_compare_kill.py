@@ -13,7 +13,8 @@ import time
 from pathlib import Path
 
 import pytest
-from bearing_env.train.compare_log import LOG_NAME
+
+from bearing_env.train.compare.log import LOG_NAME
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 
@@ -40,7 +41,7 @@ def live_members(pgid: int) -> list[str]:
 def test_sigkill_of_compare_ends_its_workers_and_closes_its_stdout(tmp_path: Path) -> None:
     out = tmp_path / "killed"
     command = [
-        sys.executable, "-m", "bearing_env.train.compare", "--policies", "random", "greedy",
+        sys.executable, "-m", "bearing_env.train.compare.cli", "--policies", "random", "greedy",
         "--env-kwargs", "scenario=khepera", "max_moves=5", "--episodes", "500",
         "--workers", "2", "--no-progress", "--no-plots", "--out", str(out),
     ]  # fmt: skip

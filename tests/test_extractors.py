@@ -8,17 +8,17 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
-from bearing_env.agents import SB3Policy
-from bearing_env.agents.extractors import LandmarkSetExtractor, LandmarkSetPolicy
-from bearing_env.train.train import train
-from bearing_env.train.zoo import parse_hyperparameters, read_hyperparameters
 
 import bearing_env  # noqa: F401  (registers the ids)
+from bearing_env.agents import SB3Policy
+from bearing_env.agents.extractors import LandmarkSetExtractor, LandmarkSetPolicy
 from bearing_env.envs.core import ENTITY_FEATURES
+from bearing_env.train.sb3.train import train
+from bearing_env.train.sb3.zoo import parse_hyperparameters, read_hyperparameters
 from tests.test_train import TINY_TIMESTEPS, tiny_settings
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
-CONF_FILE = REPO_ROOT / "train" / "hyperparams" / "ppo_entities.yml"
+CONF_FILE = REPO_ROOT / "train" / "sb3" / "hyperparams" / "ppo_entities.yml"
 WIDTH = len(ENTITY_FEATURES)
 
 

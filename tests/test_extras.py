@@ -16,7 +16,6 @@ from pathlib import Path
 
 import gymnasium as gym
 import pytest
-from bearing_env.train.errors import EXIT_ERROR, exit_on_missing_extra
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.extras import (
@@ -27,6 +26,7 @@ from bearing_env.extras import (
     missing_extra,
     require,
 )
+from bearing_env.train.common.errors import EXIT_ERROR, exit_on_missing_extra
 
 ROOT = Path(__file__).resolve().parents[1]
 RENDER = 'pip install "bearing_env[render]"'
@@ -128,7 +128,7 @@ def test_compare_quick_without_sb3_runs_the_heuristics_and_skips_the_shipped_mod
 def test_compare_quick_with_every_extra_includes_the_shipped_model(tmp_path: Path) -> None:
     """The counterpart of the test above: the skip happens only without SB3."""
     pytest.importorskip("stable_baselines3")
-    from bearing_env.train.compare import shipped_policies
+    from bearing_env.train.compare.cli import shipped_policies
 
     assert shipped_policies("bearing_env:BearingSLAM-v0", {"scenario": "khepera"}) == [
         "pretrained:ppo_khepera"
@@ -151,7 +151,7 @@ def test_the_generalisation_script_without_the_train_extra_says_to_install_it(
         "import runpy, sys\n"
         f"for name in {list(PLAIN_INSTALL_LACKS)!r}:\n    sys.modules[name] = None\n"
         "sys.argv = ['generalisation.py', '--out', 'g']\n"
-        "runpy.run_module('bearing_env.train.generalisation', run_name='__main__')\n"
+        "runpy.run_module('bearing_env.train.studies.generalisation', run_name='__main__')\n"
     )
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     result = subprocess.run(

@@ -12,14 +12,17 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from bearing_env.train import compare, compare_log, compare_report
-from bearing_env.train.compare_log import LOG_NAME, CorruptLogError, EpisodeLog
-from bearing_env.train.errors import (
+
+from bearing_env.train.common.errors import (
     EXIT_ERROR,
     exit_on_output_errors,
     os_error_message,
     with_path,
 )
+from bearing_env.train.compare import cli as compare
+from bearing_env.train.compare import log as compare_log
+from bearing_env.train.compare import report as compare_report
+from bearing_env.train.compare.log import LOG_NAME, CorruptLogError, EpisodeLog
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -262,7 +265,7 @@ def test_train_on_a_full_disk_names_the_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     pytest.importorskip("stable_baselines3")
-    from bearing_env.train import train_cli
+    from bearing_env.train.sb3 import train_cli
 
     def disk_full(fd: int) -> None:  # the atomic writers fsync their temporary files
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
@@ -508,7 +511,7 @@ def test_train_on_a_missing_cuda_device_fails_in_one_line(
 
 def test_ppo_says_up_front_that_it_trains_whole_rollouts() -> None:
     pytest.importorskip("stable_baselines3")
-    from bearing_env.train.train import rollout_notice
+    from bearing_env.train.sb3.train import rollout_notice
 
     notice = rollout_notice({"n_steps": 256}, 16, 0, 100)
     assert notice is not None and "\n" not in notice
@@ -521,7 +524,7 @@ def test_ppo_says_up_front_that_it_trains_whole_rollouts() -> None:
 
 
 def test_a_ray_address_that_does_not_answer_is_refused() -> None:
-    from bearing_env.train.ray_executor import RayAddressError, check_ray_address
+    from bearing_env.train.ray.ray_executor import RayAddressError, check_ray_address
 
     port = closed_port()
     with pytest.raises(RayAddressError, match=f"'127.0.0.1:{port}' does not answer"):
@@ -537,7 +540,7 @@ def test_a_ray_address_that_does_not_answer_is_refused() -> None:
 def test_bench_slam_into_a_closed_pipe_ends_quietly(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from bearing_env.train.errors import EXIT_BROKEN_PIPE
+    from bearing_env.train.common.errors import EXIT_BROKEN_PIPE
 
     read_end, write_end = os.pipe()
     os.close(read_end)  # `| head` has gone: every write is EPIPE
@@ -552,6 +555,18 @@ def test_bench_slam_into_a_closed_pipe_ends_quietly(
 # --------------------------------------------------------------------------------------
 # bearing-env figures and bench: a read-only or full disk ends in one line
 # --------------------------------------------------------------------------------------
+
+
+class _OsWith:
+    """``os`` with some functions replaced: patched into the project's atomic writers
+    only, so that numba's cache (which renames files too, when a test compiles a kernel
+    for the first time) keeps the real ones."""
+
+    def __init__(self, **replaced: Any) -> None:
+        self.__dict__.update(replaced)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(os, name)
 
 
 def _read_only(*args: Any, **kwargs: Any) -> None:
@@ -592,9 +607,12 @@ def test_figures_and_bench_on_a_bad_disk_name_the_file(
 ) -> None:
     """The atomic writers' rename fails on a read-only file system, their fsync on a full
     disk; either way the message names the file."""
+    from bearing_env.train.common import files
+
     out = tmp_path / "out"
     where = ["--out", str(out)] if command[0] == "figures" else ["--json", str(out / "b.json")]
-    monkeypatch.setattr(os, *patch)
+    name, replacement = patch
+    monkeypatch.setattr(files, "os", _OsWith(**{name: replacement}))
     code, err = cli_exit([*command, *where], capsys, monkeypatch)
     assert code == EXIT_ERROR, err
     lines = [line for line in err.splitlines() if line.strip()]

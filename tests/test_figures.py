@@ -7,8 +7,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from bearing_env.train import cli
-from bearing_env.train.figures import (
+from bearing_env.train.studies.figures import (
     FIG7_MOVEMENTS,
     figure7,
     figure10,
@@ -89,7 +90,7 @@ def test_bearing_env_dispatches_figures(tmp_path: Path) -> None:
 
 
 def test_robustness_figure_compares_the_fusions_on_the_same_seeds(tmp_path: Path) -> None:
-    from bearing_env.train.figures import (
+    from bearing_env.train.studies.figures import (
         ROBUST_FUSIONS,
         ROBUST_NOISE_FACTORS,
         ROBUST_OUTLIER_RATES,

@@ -215,10 +215,18 @@ def test_the_wheel_record_names_only_the_bearing_env_package(built: dict[str, Pa
         paths = [line.split(",")[0] for line in archive.read(record).decode().splitlines()]
     tops = {path.split("/")[0] for path in paths if path}
     assert {top for top in tops if not top.endswith(".dist-info")} == {"bearing_env"}
+    # Every module of the folders that install as subpackages, theirs included (a
+    # subpackage that pyproject.toml's package list misses is left out of the wheel).
     for subpackage in ("agents", "train", "benchmarks"):
         assert f"bearing_env/{subpackage}/__init__.py" in paths
+        modules = [
+            f"bearing_env/{path.relative_to(ROOT).as_posix()}"
+            for path in (ROOT / subpackage).rglob("*.py")
+            if "__pycache__" not in path.parts
+        ]
+        assert sorted(set(modules) - set(paths)) == []
     # Every shipped data file: each model's files and each hyperparameter file.
-    for folder in ("agents/pretrained", "train/hyperparams"):
+    for folder in ("agents/pretrained", "train/sb3/hyperparams"):
         shipped = [f"bearing_env/{folder}/{path.name}" for path in (ROOT / folder).iterdir()]
         assert len(shipped) >= 4
         assert sorted(set(shipped) - set(paths)) == []

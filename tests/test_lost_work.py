@@ -18,13 +18,14 @@ import time
 from pathlib import Path
 from typing import Any
 
-import bearing_env.train.train as train_module
 import pytest
+
+import bearing_env.train.sb3.train as train_module
 from bearing_env.agents.sb3 import load_model
-from bearing_env.train import train_cli
-from bearing_env.train.callbacks import CheckpointStore, StopOnRequestCallback
-from bearing_env.train.run_record import segments_after_a_kill
-from bearing_env.train.train import TrainSettings, train
+from bearing_env.train.sb3 import train_cli
+from bearing_env.train.sb3.callbacks import CheckpointStore, StopOnRequestCallback
+from bearing_env.train.sb3.run_record import segments_after_a_kill
+from bearing_env.train.sb3.train import TrainSettings, train
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 PYTHON = sys.executable
@@ -163,7 +164,7 @@ def test_a_stop_mid_rollout_counts_only_trained_steps(
 
 
 def test_an_old_record_left_running_gets_its_killed_segment() -> None:
-    from bearing_env.train.callbacks import Checkpoint
+    from bearing_env.train.sb3.callbacks import Checkpoint
 
     old = {"status": "running", "n_envs": 2, "vec_env": "dummy", "segments": []}
     at = Checkpoint(48, Path("m"), Path("v"), Path("r"))

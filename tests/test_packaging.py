@@ -78,3 +78,50 @@ def test_the_sdist_carries_the_tests_with_their_helpers(tmp_path: Path) -> None:
     assert repository_tests <= names, sorted(repository_tests - names)
     assert {"LICENSE", "docs/design.md"} <= names
     assert not [n for n in names if n.endswith((".nbi", ".nbc", ".pyc"))]
+
+
+#: The repository folders that install as subpackages of bearing_env (package-dir).
+SUBPACKAGE_FOLDERS = {"agents": "bearing_env.agents", "train": "bearing_env.train",
+                      "benchmarks": "bearing_env.benchmarks"}  # fmt: skip
+
+
+def test_every_subpackage_folder_is_in_the_package_list() -> None:
+    # setuptools ships only the packages it is told of: a folder of modules that the list
+    # misses is left out of the wheel (the data folders: tests/test_install.py).
+    setuptools = _pyproject()["tool"]["setuptools"]
+    for folder, name in SUBPACKAGE_FOLDERS.items():
+        assert setuptools["package-dir"][name] == folder
+    expected = set()
+    for folder, name in SUBPACKAGE_FOLDERS.items():
+        for path in (ROOT / folder).rglob("*"):
+            if path.is_dir() and path.name != "__pycache__" and any(path.glob("*.py")):
+                parts = path.relative_to(ROOT / folder).parts
+                if "__pycache__" not in parts:
+                    expected.add(".".join((name, *parts)))
+        expected.add(name)
+    assert sorted(expected - set(setuptools["packages"])) == []
+
+
+def _imported_modules(path: Path) -> set[str]:
+    import ast
+
+    names: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module is not None:
+            names.add(node.module)
+    return names
+
+
+def test_the_tools_and_agents_never_import_the_benchmarks() -> None:
+    # benchmarks/ may use the tools; the bearing-env command line names benchmark modules
+    # only as strings, for importlib.
+    offenders = sorted(
+        f"{path.relative_to(ROOT)}: {module}"
+        for folder in ("bearing_env", "agents", "train")
+        for path in (ROOT / folder).rglob("*.py")
+        for module in _imported_modules(path)
+        if module == "bearing_env.benchmarks" or module.startswith("bearing_env.benchmarks.")
+    )
+    assert offenders == []

@@ -8,9 +8,9 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
-from bearing_env.agents import SB3Policy, pretrained_names, pretrained_record
 
 import bearing_env  # noqa: F401  (registers the ids)
+from bearing_env.agents import SB3Policy, pretrained_names, pretrained_record
 
 SHIPPED = ("ppo_khepera", "ppo_random", "ppo_generalist")
 
@@ -91,8 +91,9 @@ def test_the_generalist_runs_on_counts_outside_its_training_range(count: int) ->
 
 def test_generalisation_table_covers_every_policy_and_count(tmp_path: Path) -> None:
     out = tmp_path / "generalisation"
-    command = [sys.executable, "-m", "bearing_env.train.generalisation", "--model", "ppo_random",
-               "--counts", "3", "--episodes", "1", "--workers", "1", "--out", str(out)]  # fmt: skip
+    command = [sys.executable, "-m", "bearing_env.train.studies.generalisation",
+               "--model", "ppo_random", "--counts", "3", "--episodes", "1", "--workers", "1",
+               "--out", str(out)]  # fmt: skip
     result = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     medians = json.loads((out / "generalisation.json").read_text())
@@ -109,7 +110,7 @@ def test_generalisation_table_covers_every_policy_and_count(tmp_path: Path) -> N
 )
 def test_generalisation_rejects_counts_beyond_the_observation_slots(model: str, slots: int) -> None:
     result = subprocess.run(
-        [sys.executable, "-m", "bearing_env.train.generalisation", "--model", model,
+        [sys.executable, "-m", "bearing_env.train.studies.generalisation", "--model", model,
          "--counts", "3", str(slots + 1)],
         capture_output=True,
         text=True,

@@ -22,17 +22,17 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import ray
-from bearing_env.agents.registry import make_policy, spec_files, with_files
-from bearing_env.train.compare import main, reproducing_command
-from bearing_env.train.compare_config import CompareConfig, policies_from_specs
-from bearing_env.train.compare_log import LOG_NAME, EpisodeLog
-from bearing_env.train.compare_runner import executor_named
-from bearing_env.train.comparison import run_comparison
-from bearing_env.train.ray_executor import materialise, read_bundle, run_on_ray
-from bearing_env.train.rllib import PROGRESS_NAME, RLlibSettings, train_rllib
-from bearing_env.train.sweep import SweepSettings, parse_grid, run_sweep
 
+from bearing_env.agents.registry import make_policy, spec_files, with_files
 from bearing_env.registration import ENV_IDS
+from bearing_env.train.compare.cli import main, reproducing_command
+from bearing_env.train.compare.comparison import run_comparison
+from bearing_env.train.compare.config import CompareConfig, policies_from_specs
+from bearing_env.train.compare.log import LOG_NAME, EpisodeLog
+from bearing_env.train.compare.runner import executor_named
+from bearing_env.train.ray.ray_executor import materialise, read_bundle, run_on_ray
+from bearing_env.train.ray.rllib import PROGRESS_NAME, RLlibSettings, train_rllib
+from bearing_env.train.ray.sweep import SweepSettings, parse_grid, run_sweep
 from tests.test_extras import error_line, plain_cli
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -175,7 +175,7 @@ def test_ctrl_c_of_a_ray_comparison_keeps_its_episodes_and_resumes(
     this module's Ray instance, after some episodes are logged."""
     address = ray.get_runtime_context().gcs_address
     command = [
-        sys.executable, "-m", "bearing_env.train.compare", "--policies", *POLICIES,
+        sys.executable, "-m", "bearing_env.train.compare.cli", "--policies", *POLICIES,
         "--env", "BearingSLAM-v0", "--env-kwargs", "scenario=khepera", "max_moves=5",
         "--episodes", "12", "--bootstrap", "200", "--no-progress", "--no-plots",
         "--executor", "ray", "--ray-address", address, "--out", str(tmp_path),

@@ -59,7 +59,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
         ("--movements", "300", "--no-progress"),
     ),
     "bearing-env soak --steps 1000000 --seed 2026": ("run", ("--steps", "30", "--no-progress")),
-    "python -m bearing_env.train.demo": ("run", ("--episodes", "1", "--moves", "3")),
+    "python -m bearing_env.train.studies.demo": ("run", ("--episodes", "1", "--moves", "3")),
     "bearing-env compare --episodes 200 --workers 2 --out outputs/compare_khepera": (
         "parse",
         (),
@@ -87,7 +87,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--timesteps 400000 --seed 1 --output runs/ppo_random": ("parse", ()),
     "bearing-env train --algo ppo --output runs/ppo_random --export "
     "agents/pretrained/ppo_random --export-only": ("parse", ()),
-    "python -m bearing_env.train.generalisation --model ppo_random --counts 3 4 6 8 10 "
+    "python -m bearing_env.train.studies.generalisation --model ppo_random --counts 3 4 6 8 10 "
     "--episodes 50": ("parse", ()),
     "python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 "
     '--conf-file "$(bearing-env hyperparams ppo)"': ("parse", ()),
@@ -97,7 +97,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--seed 0 --eval-freq 100000 --output runs/ppo_generalist": ("parse", ()),
     "bearing-env train --algo ppo --output runs/ppo_generalist --export "
     "agents/pretrained/ppo_generalist --export-only": ("parse", ()),
-    "python -m bearing_env.train.generalisation --model ppo_generalist --counts 3 8 12 16 "
+    "python -m bearing_env.train.studies.generalisation --model ppo_generalist --counts 3 8 12 16 "
     "--episodes 200 --out outputs/generalisation_generalist": ("parse", ()),
     "cp outputs/generalisation_generalist/generalisation.png "
     "docs/compare/generalisation_generalist.png": ("copy", ()),
@@ -170,20 +170,20 @@ def _parse(argv: list[str]) -> None:
         # rl-zoo3 builds its parser inside train(), so the run itself is in test_train
         # (test_rl_zoo3_trains_with_the_shipped_yaml, with this substitution's path); here
         # the module imports and the substituted path exists.
-        from bearing_env.train.zoo import rl_zoo3_module
+        from bearing_env.train.sb3.zoo import rl_zoo3_module
 
         assert callable(rl_zoo3_module("rl_zoo3.train").train)
         conf = rest.index("--conf-file") + 1
         shipped = re.fullmatch(r"\$\(bearing-env hyperparams (\w+)\)", rest[conf])
         assert shipped is not None, rest[conf]
-        from bearing_env.train.conf_files import default_conf_file
+        from bearing_env.train.sb3.conf_files import default_conf_file
 
         assert default_conf_file(shipped.group(1)).is_file()
         return
     if program == "python":
-        assert rest[:2] == ["-m", "bearing_env.train.generalisation"]
+        assert rest[:2] == ["-m", "bearing_env.train.studies.generalisation"]
         result = subprocess.run(
-            [sys.executable, "-m", "bearing_env.train.generalisation", "--help"],
+            [sys.executable, "-m", "bearing_env.train.studies.generalisation", "--help"],
             capture_output=True,
             text=True,
             timeout=120,
@@ -195,15 +195,15 @@ def _parse(argv: list[str]) -> None:
     assert program == "bearing-env"
     command, arguments = rest[0], rest[1:]
     if command == "compare":
-        from bearing_env.train import compare
+        from bearing_env.train.compare import cli as compare
 
         compare.config_from_args(compare.build_parser().parse_args(arguments))
     elif command == "train":
-        from bearing_env.train import train_cli
+        from bearing_env.train.sb3 import train_cli
 
         train_cli.settings_from_args(train_cli.build_parser().parse_args(arguments))
     elif command == "figures":
-        from bearing_env.train import figures
+        from bearing_env.train.studies import figures
 
         figures.build_parser().parse_args(arguments)
     elif command == "bench":
@@ -212,11 +212,11 @@ def _parse(argv: list[str]) -> None:
         parser = bench_env.build_parser()
         bench_env.settings_from_args(parser.parse_args(arguments), parser)
     elif command == "rllib":
-        from bearing_env.train import rllib
+        from bearing_env.train.ray import rllib
 
         rllib.settings_from_args(rllib.build_parser().parse_args(arguments))
     elif command == "sweep":
-        from bearing_env.train import sweep
+        from bearing_env.train.ray import sweep
 
         sweep.build_parser().parse_args(arguments)
     else:
@@ -237,7 +237,7 @@ def test_readme_command_runs_or_parses(command: str, tmp_path: Path) -> None:
         source, destination = Path(argv[1]), Path(argv[2])
         assert (ROOT / destination.parent).is_dir()
         out_option = f"--out {source.parent}"
-        writers = ("bearing-env compare", "python -m bearing_env.train.generalisation")
+        writers = ("bearing-env compare", "python -m bearing_env.train.studies.generalisation")
         producers = [c for c in CHECKS if c.startswith(writers) and out_option in c]
         assert producers, f"no README command writes {source}"
     elif kind == "parse":

@@ -15,10 +15,10 @@ import math
 import numpy as np
 import pytest
 import shapely
-from bearing_env.benchmarks import region_search
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from bearing_env.benchmarks import region_search
 from bearing_env.slam import FUSIONS, TRANSFERS, PolygonSLAM
 from bearing_env.slam.audit import (
     SearchReport,

@@ -22,40 +22,41 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-import bearing_env.train.train as train_module
 import gymnasium as gym
 import numpy as np
 import pytest
 import torch
 import yaml
+from stable_baselines3 import PPO
+from stable_baselines3.common.utils import ConstantSchedule
+
+import bearing_env.train.sb3.train as train_module
 from bearing_env.agents import SB3Policy
 from bearing_env.agents.sb3 import ModelLoadError, load_model, load_vecnormalize
-from bearing_env.train import train_cli
-from bearing_env.train.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
-from bearing_env.train.cli_values import parse_key_values
-from bearing_env.train.export import export_run
-from bearing_env.train.seeds import (
+from bearing_env.train.common.cli_values import parse_key_values
+from bearing_env.train.common.seeds import (
     MAX_VALIDATION_EPISODES,
     TRAINING_SEED_LIMIT,
     VALIDATION_SEED_START,
     training_seed_start,
 )
-from bearing_env.train.train import (
+from bearing_env.train.sb3 import train_cli
+from bearing_env.train.sb3.callbacks import BEST_MODEL_NAME, BEST_SUMMARY_NAME, CheckpointStore
+from bearing_env.train.sb3.export import export_run
+from bearing_env.train.sb3.train import (
     TrainResult,
     TrainSettings,
     train,
 )
-from bearing_env.train.train_cli import EXIT_INTERRUPTED
-from bearing_env.train.training_envs import EnvFactory, EpisodeSeedCycle, make_validation_env
-from bearing_env.train.zoo import (
+from bearing_env.train.sb3.train_cli import EXIT_INTERRUPTED
+from bearing_env.train.sb3.training_envs import EnvFactory, EpisodeSeedCycle, make_validation_env
+from bearing_env.train.sb3.zoo import (
     DEFAULT_ENV_IDS,
     algorithm_class_for,
     parse_hyperparameters,
     read_hyperparameters,
     rl_zoo3_module,
 )
-from stable_baselines3 import PPO
-from stable_baselines3.common.utils import ConstantSchedule
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 ALGOS = ("ppo", "sac", "dqn")
@@ -436,7 +437,7 @@ def test_exported_models_load_by_name_and_join_the_comparison(
 ) -> None:
     import bearing_env.agents.sb3
     from bearing_env.agents import make_policy, pretrained_names
-    from bearing_env.train.compare import matching_pretrained
+    from bearing_env.train.compare.cli import matching_pretrained
 
     folder = tmp_path / "pretrained"
     monkeypatch.setattr(bearing_env.agents.sb3, "PRETRAINED_DIR", folder)
@@ -573,7 +574,7 @@ def test_hyperparameters_that_this_trainer_cannot_apply_are_refused_by_name() ->
 
 
 def test_seed_ranges_are_disjoint_and_validation_episodes_repeat() -> None:
-    from bearing_env.train.seeds import EVAL_SEED_START
+    from bearing_env.train.common.seeds import EVAL_SEED_START
     assert TRAINING_SEED_LIMIT <= VALIDATION_SEED_START
     assert VALIDATION_SEED_START + MAX_VALIDATION_EPISODES <= EVAL_SEED_START
     assert training_seed_start(7, 10**9, 8) + 8 <= TRAINING_SEED_LIMIT
@@ -664,12 +665,13 @@ def test_env_factory_raises_the_time_limit_with_max_moves() -> None:
 def test_train_is_a_bearing_env_subcommand() -> None:
     from bearing_env.train.cli import SUBCOMMANDS
 
-    assert SUBCOMMANDS["train"][0] == "bearing_env.train.train_cli"
+    assert SUBCOMMANDS["train"][0] == "bearing_env.train.sb3.train_cli"
 
 
 def test_checkpoints_keep_sb3_checkpoint_callback_names(tmp_path: Path) -> None:
-    from bearing_env.train.callbacks import PeriodicCheckpointCallback
     from stable_baselines3.common.callbacks import CheckpointCallback
+
+    from bearing_env.train.sb3.callbacks import PeriodicCheckpointCallback
 
     checkpoint = CheckpointStore(tmp_path, keep=1).checkpoint_at(48)
     assert checkpoint.model_path == tmp_path / "rl_model_48_steps.zip"
@@ -684,7 +686,7 @@ def test_checkpoints_keep_sb3_checkpoint_callback_names(tmp_path: Path) -> None:
 def test_rl_zoo3_envs_run_max_moves() -> None:
     """rl-zoo3 makes its envs from the registered spec with the YAML's env_kwargs: with
     no registered TimeLimit, max_moves=40 runs 40 moves there too."""
-    from bearing_env.train.zoo import _experiment_manager
+    from bearing_env.train.sb3.zoo import _experiment_manager
 
     manager = _experiment_manager("ppo", "BearingSLAM-v0")
     manager.env_kwargs = {"scenario": "khepera", "max_moves": 40, "target_area": 1e-9}

@@ -1,4 +1,4 @@
-"""``bearing_env.train.vec_env``: the SB3 adapter for Gymnasium vector envs, and
+"""``bearing_env.train.sb3.vec_env``: the SB3 adapter for Gymnasium vector envs, and
 ``--vec-env batched``.
 
 The adapter must be indistinguishable from a ``DummyVecEnv`` of the single envs that
@@ -18,14 +18,15 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import pytest
-from bearing_env.train import train_cli
-from bearing_env.train.cli_values import parse_key_values
-from bearing_env.train.train import TrainSettings, train
-from bearing_env.train.training_envs import EnvFactory, resolve_vec_env_kind
-from bearing_env.train.vec_env import GymnasiumVecEnv, make_batched_vec_env
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 from stable_baselines3 import DQN, PPO
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, VecNormalize
+
+from bearing_env.train.common.cli_values import parse_key_values
+from bearing_env.train.sb3 import train_cli
+from bearing_env.train.sb3.train import TrainSettings, train
+from bearing_env.train.sb3.training_envs import EnvFactory, resolve_vec_env_kind
+from bearing_env.train.sb3.vec_env import GymnasiumVecEnv, make_batched_vec_env
 
 ENV_IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
 ENDING_KWARGS: dict[str, Any] = {"scenario": "khepera", "target_area": 0.5, "max_moves": 10}

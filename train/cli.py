@@ -13,8 +13,8 @@
     bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
     bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (shipped rl-zoo3 files)
     bearing-env hyperparams ALGO  the path of a shipped rl-zoo3 hyperparameter file
-    bearing-env rllib [...]       PPO with RLlib, locally or on a Ray cluster (train/rllib.py)
-    bearing-env sweep [...]       a Ray Tune grid of RLlib PPO runs (train/sweep.py)
+    bearing-env rllib [...]       PPO with RLlib, locally or on a Ray cluster (train/ray/rllib.py)
+    bearing-env sweep [...]       a Ray Tune grid of RLlib PPO runs (train/ray/sweep.py)
 
 Each subcommand forwards its remaining arguments to the module that implements it, so
 ``bearing-env demo --help`` shows that module's options. A subcommand that needs an
@@ -22,7 +22,7 @@ optional extra that is not installed (``train``: stable-baselines3, torch, matpl
 ``render``: pygame; ``ray``: ray, RLlib, Ray Tune) says which one to install,
 ``pip install "bearing_env[train]"``, and exits with status 2. A bad option value ends
 as an argparse usage error (status 2) whose one error line names the option and the value
-(``bearing_env.train.cli_values``); output into a closed pipe (``... | head``) ends quietly.
+(``bearing_env.train.common.cli_values``); output into a closed pipe (``... | head``) ends quietly.
 """
 
 from __future__ import annotations
@@ -31,11 +31,11 @@ import argparse
 import importlib
 import sys
 
-from bearing_env.train.errors import exit_on_missing_extra, exit_quietly_on_broken_pipe
+from bearing_env.train.common.errors import exit_on_missing_extra, exit_quietly_on_broken_pipe
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "demo": (
-        "bearing_env.train.demo",
+        "bearing_env.train.studies.demo",
         "random polygonal exploration in the Khepera scenario",
     ),
     "bench": (
@@ -55,27 +55,27 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "a soak of the envs over random configurations, checking containment every step",
     ),
     "train": (
-        "bearing_env.train.train_cli",
+        "bearing_env.train.sb3.train_cli",
         "train PPO/SAC/DQN agents with stable-baselines3 (rl-zoo3 hyperparameter files)",
     ),
     "hyperparams": (
-        "bearing_env.train.conf_files",
+        "bearing_env.train.sb3.conf_files",
         "print the path of a shipped rl-zoo3 hyperparameter file (for --conf-file)",
     ),
     "compare": (
-        "bearing_env.train.compare",
+        "bearing_env.train.compare.cli",
         "compare exploration policies on fixed evaluation episodes",
     ),
     "rllib": (
-        "bearing_env.train.rllib",
+        "bearing_env.train.ray.rllib",
         "train PPO with RLlib on this machine or a Ray cluster (the ray extra)",
     ),
     "sweep": (
-        "bearing_env.train.sweep",
+        "bearing_env.train.ray.sweep",
         "a Ray Tune grid of RLlib PPO runs over hyperparameters or env kwargs",
     ),
     "figures": (
-        "bearing_env.train.figures",
+        "bearing_env.train.studies.figures",
         "reproduce the paper's Figs. 7, 10 and 11 in simulation",
     ),
 }

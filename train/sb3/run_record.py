@@ -1,7 +1,7 @@
 """``run.json``, the record of a training run: what a run writes into it (settings,
 seeds, versions, segments) and, on ``--resume``, what is checked against it and how the
 segment of a killed process is closed. Where the file is and how it is read back:
-:mod:`bearing_env.train.run_folder`.
+:mod:`bearing_env.train.sb3.run_folder`.
 """
 
 from __future__ import annotations
@@ -12,16 +12,16 @@ from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
 import numpy as np
-from bearing_env.train.callbacks import Checkpoint, CheckpointStore
-from bearing_env.train.cli_values import json_safe
-from bearing_env.train.run_folder import RunFiles, read_run_record
-from bearing_env.train.seeds import TRAINING_SEED_LIMIT, VALIDATION_SEED_START
-from bearing_env.train.zoo import read_hyperparameters
 
 import bearing_env
+from bearing_env.train.common.cli_values import json_safe
+from bearing_env.train.common.seeds import TRAINING_SEED_LIMIT, VALIDATION_SEED_START
+from bearing_env.train.sb3.callbacks import Checkpoint, CheckpointStore
+from bearing_env.train.sb3.run_folder import RunFiles, read_run_record
+from bearing_env.train.sb3.zoo import read_hyperparameters
 
 if TYPE_CHECKING:
-    from bearing_env.train.train import TrainSettings
+    from bearing_env.train.sb3.train import TrainSettings
 
 RUN_FORMAT_VERSION = 1
 

@@ -1,18 +1,18 @@
 """``bearing-env compare``: the command line that runs exploration policies on the same
 evaluation episodes. This module only reads the arguments, builds the
-:class:`~bearing_env.train.compare_config.CompareConfig` and reports; the work is done by
+:class:`~bearing_env.train.compare.config.CompareConfig` and reports; the work is done by
 
-- :mod:`~bearing_env.train.comparison`: one comparison from start to finish (resume, log,
+- :mod:`~bearing_env.train.compare.comparison`: one comparison from start to finish (resume, log,
   outputs);
-- :mod:`~bearing_env.train.compare_runner`: the episodes and the local worker pool;
-- :mod:`~bearing_env.train.compare_log`: ``episodes.jsonl``;
-- :mod:`~bearing_env.train.compare_stats` and :mod:`~bearing_env.train.compare_report`:
+- :mod:`~bearing_env.train.compare.runner`: the episodes and the local worker pool;
+- :mod:`~bearing_env.train.compare.log`: ``episodes.jsonl``;
+- :mod:`~bearing_env.train.compare.stats` and :mod:`~bearing_env.train.compare.report`:
   the numbers and the files that show them;
-- :mod:`~bearing_env.train.seeds`: the seed ranges.
+- :mod:`~bearing_env.train.common.seeds`: the seed ranges.
 
 Every policy plays the same episodes: episode ``i`` resets the env with seed
 ``seed_start + i`` (default ``EVAL_SEED_START = 1_000_000``). Training code keeps its
-seeds below ``TRAINING_SEED_LIMIT`` (``bearing_env.train.seeds``), so evaluation episodes
+seeds below ``TRAINING_SEED_LIMIT`` (``bearing_env.train.common.seeds``), so evaluation episodes
 are never trained on. The policy's own randomness is seeded from the same episode seed
 through a separate stream (``bearing_env.agents.base.policy_rng``).
 
@@ -28,7 +28,7 @@ Outputs (in ``--out``):
 - ``timing.json``: policy time per decision (the only output that is not reproducible).
 
 With ``--workers N`` the episodes run in a pool of spawned processes that exit with the
-command (see :mod:`~bearing_env.train.compare_runner`).
+command (see :mod:`~bearing_env.train.compare.runner`).
 
 An ``OSError`` while writing (disk full, no permission) ends the command with a one-line
 message naming the file and exit status 2. A line of ``episodes.jsonl`` that is not a
@@ -61,14 +61,24 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.cli_values import (
+from bearing_env.extras import DISTRIBUTIONS, install_command
+from bearing_env.train.common.cli_values import (
     COUNT,
     NON_NEGATIVE,
     SEED,
     parse_key_values,
     registered_env_id,
 )
-from bearing_env.train.compare_config import (
+from bearing_env.train.common.errors import (
+    available,
+    exit_on_output_errors,
+    fail,
+    missing_extra,
+    require,
+)
+from bearing_env.train.common.seeds import EVAL_SEED_START
+from bearing_env.train.compare.comparison import RunMismatchError, run_comparison
+from bearing_env.train.compare.config import (
     DEFAULT_BOOTSTRAP,
     DEFAULT_BOOTSTRAP_SEED,
     DEFAULT_ENV_ID,
@@ -78,25 +88,14 @@ from bearing_env.train.compare_config import (
     json_normalised,
     policies_from_specs,
 )
-from bearing_env.train.compare_log import LOG_NAME, CorruptLogError
-from bearing_env.train.compare_report import print_tables
-from bearing_env.train.compare_runner import EXECUTORS, executor_named, make_env
-from bearing_env.train.comparison import RunMismatchError, run_comparison
-from bearing_env.train.errors import (
-    available,
-    exit_on_output_errors,
-    fail,
-    missing_extra,
-    require,
-)
-from bearing_env.train.ray_executor import (
+from bearing_env.train.compare.log import LOG_NAME, CorruptLogError
+from bearing_env.train.compare.report import print_tables
+from bearing_env.train.compare.runner import EXECUTORS, executor_named, make_env
+from bearing_env.train.ray.ray_executor import (
     RAY_CONNECT_TIMEOUT,
     RayAddressError,
     check_ray_address,
 )
-from bearing_env.train.seeds import EVAL_SEED_START
-
-from bearing_env.extras import DISTRIBUTIONS, install_command
 
 DEFAULT_POLICIES: tuple[str, ...] = ("random", "parallax", "greedy", "oracle", "lookahead")
 

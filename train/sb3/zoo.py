@@ -32,9 +32,9 @@ from types import ModuleType
 from typing import Any
 
 import numpy as np
-from bearing_env.train.conf_files import default_conf_file
 from stable_baselines3.common.base_class import BaseAlgorithm
 
+from bearing_env.train.sb3.conf_files import default_conf_file
 from bearing_env.validation import int_at_least, is_integer
 
 #: The algorithms ``bearing-env train`` ships hyperparameters for, and the env id each

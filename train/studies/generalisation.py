@@ -7,7 +7,8 @@ median total area after 10 moves per policy and count, and writes it to
 and each policy's median over GreedyOneStep's but random polygonal's, with the model's
 training range shaded).
 
-    python -m bearing_env.train.generalisation --model ppo_random --counts 3 4 6 8 10 --episodes 50
+    python -m bearing_env.train.studies.generalisation --model ppo_random \\
+        --counts 3 4 6 8 10 --episodes 50
 
 The total area is summed over the mapped landmarks (L3, L4, ...), so it grows with the
 count; compare policies within a column. Every count runs with the env kwargs the model
@@ -26,12 +27,11 @@ from pathlib import Path
 from typing import Any
 
 from bearing_env.agents.sb3 import pretrained_names, pretrained_record
-from bearing_env.train.cli_values import format_key_values
-from bearing_env.train.errors import MissingExtraError, fail
-from bearing_env.train.files import write_json_atomically
-
 from bearing_env.envs.config import EnvConfig
 from bearing_env.extras import available
+from bearing_env.train.common.cli_values import format_key_values
+from bearing_env.train.common.errors import MissingExtraError, fail
+from bearing_env.train.common.files import write_json_atomically
 
 DEFAULT_BASELINES = ("random", "parallax", "greedy")
 #: The label the ratio panel divides by (GreedyOneStep's report label).
@@ -60,7 +60,7 @@ def run_counts(
         command = [
             sys.executable,
             "-m",
-            "bearing_env.train.compare",
+            "bearing_env.train.compare.cli",
             "--env-kwargs",
             *format_key_values(env_kwargs),
             "--policies",
@@ -89,7 +89,7 @@ def plot_medians(
     medians: dict[int, dict[str, float]], model: str, trained_counts: tuple[int, int], path: Path
 ) -> Path:
     """The medians against the landmark count (log scale) and over GreedyOneStep's."""
-    from bearing_env.train.figures import _plt, save_and_close
+    from bearing_env.train.studies.figures import _plt, save_and_close
 
     plt = _plt()
     counts = sorted(medians)

@@ -14,7 +14,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.errors import with_path
+from bearing_env.train.common.errors import with_path
 
 
 @contextmanager

@@ -16,7 +16,7 @@ exposed as options keep RLlib's defaults.
 ``s' + w + i`` and runs on from there, where ``s' = s`` for a new run and
 ``s' = segment_seed(s, k)`` for a run resumed at iteration ``k`` (so a resumed run does
 not replay the episodes it started with). Every training seed stays below
-``bearing_env.train.compare.TRAINING_SEED_LIMIT`` (the evaluation episodes of
+``bearing_env.train.common.seeds.TRAINING_SEED_LIMIT`` (the evaluation episodes of
 ``bearing-env compare`` start there); ``run.json`` lists each segment's seed.
 
 **Run folder** (``--output``, default ``runs/rllib_ppo_<env>_seed<seed>``)::
@@ -32,7 +32,7 @@ whole checkpoint. Ctrl-C stops the run (the iteration in progress is dropped), w
 outputs and exits with status 130; ``--resume`` restores the checkpoint and trains up to
 ``--iterations`` in total, dropping the lines of ``progress.jsonl`` past the checkpoint.
 
-``bearing-env sweep`` (``bearing_env.train.sweep``) runs this configuration under Ray
+``bearing-env sweep`` (``bearing_env.train.ray.sweep``) runs this configuration under Ray
 Tune over a grid of hyperparameters or env kwargs.
 """
 
@@ -50,14 +50,13 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.cli_values import COUNT, NON_NEGATIVE, SEED, parse_key_values
-from bearing_env.train.compare_config import DEFAULT_ENV_KWARGS
-from bearing_env.train.errors import available, exit_on_output_errors, fail, require
-from bearing_env.train.files import atomic_write_text
-from bearing_env.train.ray_executor import RAY_CONNECT_TIMEOUT, check_ray_address, ray_session
-from bearing_env.train.seeds import TRAINING_SEED_LIMIT
-
 from bearing_env.registration import ENV_IDS
+from bearing_env.train.common.cli_values import COUNT, NON_NEGATIVE, SEED, parse_key_values
+from bearing_env.train.common.errors import available, exit_on_output_errors, fail, require
+from bearing_env.train.common.files import atomic_write_text
+from bearing_env.train.common.seeds import TRAINING_SEED_LIMIT
+from bearing_env.train.compare.config import DEFAULT_ENV_KWARGS
+from bearing_env.train.ray.ray_executor import RAY_CONNECT_TIMEOUT, check_ray_address, ray_session
 
 RUN_NAME = "run.json"
 PROGRESS_NAME = "progress.jsonl"

@@ -14,8 +14,9 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
-from bearing_env.train.compare_config import CompareConfig
 from numpy.typing import NDArray
+
+from bearing_env.train.compare.config import CompareConfig
 
 #: Move counts at which the total area is reported.
 REPORTED_MOVES: tuple[int, ...] = (1, 3, 5, 10, 20)

@@ -38,11 +38,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bearing_env.train.files import atomic_path, write_json_atomically
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
+
+from bearing_env.train.common.files import atomic_path, write_json_atomically
 
 CHECKPOINT_PREFIX = "rl_model"
 _CHECKPOINT_MODEL_PATTERN = re.compile(rf"^{CHECKPOINT_PREFIX}_(\d+)_steps\.zip$")
@@ -291,7 +292,7 @@ class FixedSeedEvalCallback(EvalCallback):
     """``EvalCallback`` on fixed validation episodes, with area metrics and resumable history.
 
     The eval env's sub-envs must expose ``rewind_episode_seeds()`` (see
-    ``bearing_env.train.training_envs.EpisodeSeedCycle``): it is called before every
+    ``bearing_env.train.sb3.training_envs.EpisodeSeedCycle``): it is called before every
     evaluation, so every evaluation plays the same episodes and the best model is chosen
     on a fixed set.
 

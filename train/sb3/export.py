@@ -12,13 +12,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bearing_env.agents.sb3 import load_model
-from bearing_env.train.callbacks import (
+from bearing_env.train.common.files import atomic_path, write_json_atomically
+from bearing_env.train.sb3.callbacks import (
     BEST_MODEL_NAME,
     BEST_SUMMARY_NAME,
     BEST_VECNORMALIZE_NAME,
 )
-from bearing_env.train.files import atomic_path, write_json_atomically
-from bearing_env.train.run_folder import RunFiles, read_run_record
+from bearing_env.train.sb3.run_folder import RunFiles, read_run_record
 
 EXPORT_VECNORMALIZE_SUFFIX = "_vecnormalize.pkl"
 

@@ -38,8 +38,9 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+
 from bearing_env.agents.env_access import bearing_env_of
-from bearing_env.train.compare_config import CompareConfig, json_normalised
+from bearing_env.train.compare.config import CompareConfig, json_normalised
 
 
 def make_env(env_id: str, env_kwargs: Mapping[str, Any]) -> gym.Env:
@@ -177,7 +178,7 @@ EpisodeExecutor = Callable[[Sequence[EpisodeTask], int], Iterator[dict[str, Any]
 
 
 #: Where the episodes run: ``local`` (this process, or ``--workers`` processes) or ``ray``
-#: (Ray tasks, on a local Ray instance or a cluster; ``bearing_env.train.ray_executor``).
+#: (Ray tasks, on a local Ray instance or a cluster; ``bearing_env.train.ray.ray_executor``).
 EXECUTORS: tuple[str, ...] = ("local", "ray")
 
 
@@ -190,7 +191,7 @@ def executor_named(name: str, ray_address: str | None = None) -> EpisodeExecutor
         if ray_address is not None:
             raise ValueError("a Ray address needs the ray executor")
         return run_locally
-    from bearing_env.train.ray_executor import run_on_ray
+    from bearing_env.train.ray.ray_executor import run_on_ray
 
     def on_ray(tasks: Sequence[EpisodeTask], workers: int) -> Iterator[dict[str, Any]]:
         return run_on_ray(tasks, address=ray_address)  # Ray sizes itself: no workers

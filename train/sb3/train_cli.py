@@ -1,10 +1,10 @@
 """``bearing-env train``'s command line: the arguments, the run folder they name, the
-:class:`~bearing_env.train.train.TrainSettings` they give, ``--export``/``--export-only``,
+:class:`~bearing_env.train.sb3.train.TrainSettings` they give, ``--export``/``--export-only``,
 and failures as one line with exit status 2 (130 after an interruption). What training
-does, and the files it writes: :mod:`bearing_env.train.train`.
+does, and the files it writes: :mod:`bearing_env.train.sb3.train`.
 
     bearing-env train --algo ppo [--output runs/ppo_khepera] [--resume] [--export DIR/NAME]
-    python -m bearing_env.train.train_cli ...          # the same
+    python -m bearing_env.train.sb3.train_cli ...          # the same
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-from bearing_env.train.cli_values import (
+from bearing_env.train.common.cli_values import (
     COUNT,
     NON_NEGATIVE,
     SEED,
@@ -24,10 +24,10 @@ from bearing_env.train.cli_values import (
     parse_key_values,
     registered_env_id,
 )
-from bearing_env.train.errors import fail, write_error_message
-from bearing_env.train.export import ExportedModel, export_run
-from bearing_env.train.seeds import MAX_VALIDATION_EPISODES
-from bearing_env.train.train import (
+from bearing_env.train.common.errors import fail, write_error_message
+from bearing_env.train.common.seeds import MAX_VALIDATION_EPISODES
+from bearing_env.train.sb3.export import ExportedModel, export_run
+from bearing_env.train.sb3.train import (
     DEFAULT_CHECKPOINT_FREQ,
     DEFAULT_EVAL_EPISODES,
     DEFAULT_EVAL_FREQ,
@@ -36,8 +36,8 @@ from bearing_env.train.train import (
     TrainSettings,
     train,
 )
-from bearing_env.train.training_envs import VEC_ENV_CHOICES
-from bearing_env.train.zoo import DEFAULT_ENV_IDS, hyperparams_key
+from bearing_env.train.sb3.training_envs import VEC_ENV_CHOICES
+from bearing_env.train.sb3.zoo import DEFAULT_ENV_IDS, hyperparams_key
 
 #: The exit status after Ctrl-C or SIGTERM stopped training (a checkpoint was saved).
 EXIT_INTERRUPTED = 130

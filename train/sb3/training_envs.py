@@ -1,6 +1,6 @@
 """The envs of a training run: the training ``VecEnv`` of each ``--vec-env`` kind, with
 env ``i`` first reset with seed ``seed_start + i``, and the validation env that replays
-the same validation episodes (``bearing_env.train.seeds``) at every evaluation.
+the same validation episodes (``bearing_env.train.common.seeds``) at every evaluation.
 """
 
 from __future__ import annotations
@@ -12,21 +12,22 @@ from pathlib import Path
 from typing import Any, SupportsFloat
 
 import gymnasium as gym
-from bearing_env.train.seeds import validation_seeds
-from bearing_env.train.vec_env import (
+from stable_baselines3.common.monitor import Monitor
+from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecEnv, VecMonitor
+
+import bearing_env
+from bearing_env.train.common.seeds import validation_seeds
+from bearing_env.train.sb3.vec_env import (
     MONITOR_INFO_KEYWORDS,
     has_vector_entry_point,
     make_batched_vec_env,
     monitor_csv_path,
 )
-from stable_baselines3.common.monitor import Monitor
-from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecEnv, VecMonitor
-
-import bearing_env
 
 #: How the training envs run: ``batched`` is one Gymnasium vector env (the id's natively
-#: batched ``vector_entry_point``, else a ``SyncVectorEnv``) behind ``bearing_env.train.vec_env``'s
-#: adapter; ``subproc`` one process per env (spawn); ``dummy`` all envs in this process.
+#: batched ``vector_entry_point``, else a ``SyncVectorEnv``) behind
+#: ``bearing_env.train.sb3.vec_env``'s adapter; ``subproc`` one process per env (spawn);
+#: ``dummy`` all envs in this process.
 VEC_ENV_KINDS: tuple[str, ...] = ("batched", "subproc", "dummy")
 
 #: ``--vec-env`` also takes ``auto``: ``batched`` when the env id registers a batched

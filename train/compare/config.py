@@ -1,7 +1,7 @@
 """What one ``bearing-env compare`` runs: the policies, the env and the evaluation episodes
 (:class:`CompareConfig`, written to ``config.json``), and report labels for policy specs.
 
-The evaluation seeds come from :mod:`bearing_env.train.seeds` (``EVAL_SEED_START`` and up).
+The evaluation seeds come from :mod:`bearing_env.train.common.seeds` (``EVAL_SEED_START`` and up).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from bearing_env.train.seeds import EVAL_SEED_START, evaluation_seeds
+from bearing_env.train.common.seeds import EVAL_SEED_START, evaluation_seeds
 
 #: Evaluation episodes per policy.
 DEFAULT_EPISODES = 200

@@ -49,14 +49,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bearing_env.train.cli_values import COUNT, SEED
-from bearing_env.train.compare_runner import make_env
-from bearing_env.train.errors import exit_on_output_errors, fail
-from bearing_env.train.files import atomic_save_figure, atomic_write_text
-from bearing_env.train.seeds import EVAL_SEED_START
 from numpy.typing import NDArray
 
 from bearing_env.extras import MissingExtraError, available
+from bearing_env.train.common.cli_values import COUNT, SEED
+from bearing_env.train.common.errors import exit_on_output_errors, fail
+from bearing_env.train.common.files import atomic_save_figure, atomic_write_text
+from bearing_env.train.common.seeds import EVAL_SEED_START
+from bearing_env.train.compare.runner import make_env
 
 FIG7_MOVEMENTS: tuple[int, ...] = (1, 3, 6, 9)
 FIG11_EPSILONS: tuple[float, ...] = (2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
@@ -107,7 +107,6 @@ def random_polygonal_trace(
     """Run the random polygonal policy for ``moves`` movements and record the map."""
     from bearing_env.agents import RandomPolygonal
     from bearing_env.agents.env_access import bearing_env_of, world_of
-
     from bearing_env.envs.bearing_slam import BEARING_FEATURES, observation_slices
     from bearing_env.slam import world_to_fl
 

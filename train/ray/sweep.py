@@ -29,12 +29,12 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.cli_values import parse_literal
-from bearing_env.train.compare_report import csv_text
-from bearing_env.train.errors import exit_on_output_errors, fail, require
-from bearing_env.train.files import atomic_write_text
-from bearing_env.train.ray_executor import check_ray_address, ray_session
-from bearing_env.train.rllib import (
+from bearing_env.train.common.cli_values import parse_literal
+from bearing_env.train.common.errors import exit_on_output_errors, fail, require
+from bearing_env.train.common.files import atomic_write_text
+from bearing_env.train.compare.report import csv_text
+from bearing_env.train.ray.ray_executor import check_ray_address, ray_session
+from bearing_env.train.ray.rllib import (
     RLlibSettings,
     add_settings_arguments,
     ppo_config,

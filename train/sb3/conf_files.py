@@ -1,6 +1,6 @@
 """``bearing-env hyperparams ALGO``: where the shipped rl-zoo3 hyperparameter files are.
 
-The files are package data of ``bearing_env.train`` (``hyperparams/<algo>.yml``, found
+The files are package data of ``bearing_env.train.sb3`` (``hyperparams/<algo>.yml``, found
 through :mod:`bearing_env.shipped`), so they exist in site-packages as well as in a
 checkout. ``bearing-env hyperparams ppo`` prints the path of ``ppo.yml``, for rl-zoo3::
 
@@ -21,7 +21,7 @@ from pathlib import Path
 from bearing_env.shipped import shipped_dir
 
 #: The shipped rl-zoo3 hyperparameter files: ``<algo>.yml``, one entry per env id.
-HYPERPARAMS_DIR = shipped_dir("bearing_env.train", "hyperparams")
+HYPERPARAMS_DIR = shipped_dir("bearing_env.train.sb3", "hyperparams")
 
 
 def shipped_algorithms() -> list[str]:

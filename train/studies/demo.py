@@ -6,7 +6,7 @@ uncertainty area and the mean landmark error after every move, and saves an anim
 of the first episode to ``outputs/``. The animation needs pygame (the ``render`` extra);
 without it the demo runs, prints its tables, and says how to install it.
 
-    python -m bearing_env.train.demo [--episodes 3] [--moves 10] [--seed 0] [--out outputs]
+    python -m bearing_env.train.studies.demo [--episodes 3] [--moves 10] [--seed 0] [--out outputs]
 """
 
 from __future__ import annotations
@@ -20,12 +20,12 @@ from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
-from bearing_env.train.cli_values import COUNT, SEED
-from bearing_env.train.errors import fail, write_error_message
 from numpy.typing import NDArray
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.extras import MissingExtraError, available
+from bearing_env.train.common.cli_values import COUNT, SEED
+from bearing_env.train.common.errors import fail, write_error_message
 
 #: The paper's Khepera run is 10 movements; docs/design.md's reference runs move 25 cm.
 DEFAULT_MOVES = 10

@@ -45,9 +45,8 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.compare_runner import EpisodeTask, run_task
-
 from bearing_env.extras import require
+from bearing_env.train.compare.runner import EpisodeTask, run_task
 
 #: A policy's files as they travel: option -> (file name, bytes).
 FileBundle = dict[str, tuple[str, bytes]]

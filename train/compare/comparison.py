@@ -11,15 +11,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.compare_config import CompareConfig
-from bearing_env.train.compare_log import LOG_NAME, EpisodeLog
-from bearing_env.train.compare_report import write_outputs
-from bearing_env.train.compare_runner import EpisodeExecutor, episode_tasks, run_locally
-from bearing_env.train.compare_stats import policy_ms_per_move, summarise
-from bearing_env.train.errors import (
+from bearing_env.train.common.errors import (
     available,
 )
-from bearing_env.train.files import atomic_write_text
+from bearing_env.train.common.files import atomic_write_text
+from bearing_env.train.compare.config import CompareConfig
+from bearing_env.train.compare.log import LOG_NAME, EpisodeLog
+from bearing_env.train.compare.report import write_outputs
+from bearing_env.train.compare.runner import EpisodeExecutor, episode_tasks, run_locally
+from bearing_env.train.compare.stats import policy_ms_per_move, summarise
 
 CONFIG_NAME = "config.json"
 
@@ -107,8 +107,8 @@ def run_comparison(
         progress: show a progress bar.
         plots: write the PNG plots.
         command: the command line to quote in the report.
-        executor: what runs the episodes (``compare_runner.EpisodeExecutor``): the local
-            worker pool by default, given ``workers``; ``compare_runner.executor_named``
+        executor: what runs the episodes (``runner.EpisodeExecutor``): the local
+            worker pool by default, given ``workers``; ``runner.executor_named``
             gives the Ray one.
     """
     out = Path(out)

@@ -207,7 +207,7 @@ class GymnasiumVecEnv(VecEnv):
         vector_env: A Gymnasium vector env with ``metadata["autoreset_mode"] ==
             AutoresetMode.SAME_STEP``; the adapter closes it on :meth:`close`.
         success_on_termination: Report ``info["is_success"] = terminated`` at the end of
-            every episode, as ``bearing_env.train.training_envs.SuccessInfo`` does for single
+            every episode, as ``bearing_env.train.sb3.training_envs.SuccessInfo`` does for single
             envs (here termination is success), unless the final info already has
             ``is_success``.
 

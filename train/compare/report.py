@@ -14,13 +14,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bearing_env.train.compare_config import CompareConfig
-from bearing_env.train.errors import (
+from numpy.typing import NDArray
+
+from bearing_env.train.common.errors import (
     MissingExtraError,
     available,
 )
-from bearing_env.train.files import atomic_save_figure, atomic_write_text
-from numpy.typing import NDArray
+from bearing_env.train.common.files import atomic_save_figure, atomic_write_text
+from bearing_env.train.compare.config import CompareConfig
 
 
 def _fmt(value: float | None, digits: int = 3) -> str:

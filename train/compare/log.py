@@ -13,10 +13,10 @@ import os
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.errors import (
+from bearing_env.train.common.errors import (
     with_path,
 )
-from bearing_env.train.files import atomic_write_text
+from bearing_env.train.common.files import atomic_write_text
 
 LOG_NAME = "episodes.jsonl"
 

@@ -1,0 +1,1 @@
+"""The paper studies: its figures, the generalisation study and the demo."""
