@@ -104,8 +104,8 @@ def test_the_action_spec_is_the_one_home_of_spaces_decoding_and_encoding(env_id:
     """The env, its vector env and the agents' codec share one action spec: encode gives
     an action of the env's space that decodes to the nearest movement on its grid."""
     import gymnasium as gym
-    from bearing_env.agents import ActionCodec
 
+    from bearing_env.agents import ActionCodec
     from bearing_env.envs.bearing_slam_vector import (
         BearingSLAMDiscreteVectorEnv,
         BearingSLAMVectorEnv,
