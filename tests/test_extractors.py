@@ -14,7 +14,7 @@ from bearing_env.train.train import train
 from bearing_env.train.zoo import parse_hyperparameters, read_hyperparameters
 
 import bearing_env  # noqa: F401  (registers the ids)
-from bearing_env.envs.core import ENTITY_FEATURES
+from bearing_env.envs.observations import ENTITY_FEATURES
 from tests.test_train import TINY_TIMESTEPS, tiny_settings
 
 REPO_ROOT = Path(__file__).resolve().parents[1]

@@ -23,6 +23,7 @@ from bearing_env.envs.bearing_slam import BearingSLAMEnv, Setting, check_reset_o
 from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
 from bearing_env.envs.config import MAX_N_LANDMARKS, EnvConfig
 from bearing_env.envs.core import BatchState, MapBank, WorldView
+from bearing_env.envs.observations import observation_size
 from bearing_env.validation import int_at_least, is_integer
 
 AUTORESET_MODES = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP, AutoresetMode.DISABLED)
@@ -172,8 +173,8 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         #: Landmark slots of the per-landmark info arrays when counts vary per episode.
         self._info_slots = first.max_landmarks - 2 if first.has_count_range else None
         #: The sub-envs' observations, flat (the observation kind cannot change per env).
-        self._flat_shape = (self.num_envs, core.observation_size(first.max_landmarks))
-        self._entities = first.observation == "entities"
+        self._flat_shape = (self.num_envs, observation_size(first.max_landmarks))
+        self._observation_spec = prototype.observation_spec
         self._max_landmarks = first.max_landmarks
         self._autoreset_envs = np.zeros(self.num_envs, dtype=bool)
         self._elapsed_steps = np.zeros(self.num_envs, dtype=np.int64)
@@ -286,9 +287,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
     def _observation(self, flat: NDArray[np.float32]) -> Any:
         """Observations of the sub-envs' kind from flat ones (as the single env's)."""
-        if self._entities:
-            return core.entity_observations(flat, self._max_landmarks)
-        return flat
+        return self._observation_spec.convert(flat, self._max_landmarks)
 
     def render(self) -> tuple[Any, ...] | None:
         if self.render_mode is None:

@@ -75,7 +75,7 @@ MAX_ACTION_TABLE = 4096
 
 REWARDS: tuple[str, ...] = ("log_area", "area")
 #: Observation kinds: the flat Box (default) or a Dict of a robot block and a landmark
-#: table (``bearing_env.envs.core.entity_observations``).
+#: table (``bearing_env.envs.observations.EntityObservation``).
 OBSERVATIONS: tuple[str, ...] = ("flat", "entities")
 
 

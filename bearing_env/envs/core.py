@@ -21,7 +21,6 @@ The functions below take a group's row indices; rows with other settings are unt
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, fields
 from typing import Any
@@ -31,7 +30,7 @@ from numpy.typing import NDArray
 
 from bearing_env.envs import kernels, robot_map
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig, MapSettings
-from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
+from bearing_env.envs.observations import FL_COORD_LIMIT, observation_size
 from bearing_env.numerics import wrap_angle
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import (
@@ -53,82 +52,8 @@ IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 ComplexArray = NDArray[np.complex128]
 
-#: FL coordinates in the observation are clipped to +-this (the frame is |L1 - L2| = 1, so
-#: this is 50 baselines away: far beyond any landmark of a sensible layout).
-FL_COORD_LIMIT = 50.0
-
 #: Trajectory slots allocated per row at first; the array doubles when a row fills it.
 INITIAL_TRAJECTORY_SLOTS = 32
-
-
-def observation_size(max_landmarks: int) -> int:
-    """Length of the observation vector for ``max_landmarks`` landmark slots."""
-    return (
-        len(ROBOT_FEATURES)
-        + len(LANDMARK_FEATURES) * (max_landmarks - 2)
-        + len(BEARING_FEATURES) * max_landmarks
-    )
-
-
-def observation_slices(max_landmarks: int) -> dict[str, slice]:
-    """Where each block lives in the observation vector.
-
-    ``"robot"`` is the robot block; ``"landmarks"`` reshapes to ``(max_landmarks - 2,
-    len(LANDMARK_FEATURES))``; ``"bearings"`` to ``(max_landmarks, len(BEARING_FEATURES))``.
-    """
-    robot_end = len(ROBOT_FEATURES)
-    landmarks_end = robot_end + len(LANDMARK_FEATURES) * (max_landmarks - 2)
-    return {
-        "robot": slice(0, robot_end),
-        "landmarks": slice(robot_end, landmarks_end),
-        "bearings": slice(landmarks_end, observation_size(max_landmarks)),
-    }
-
-
-#: The columns of the entity observation's landmark table, one row per landmark slot
-#: (L1, L2, L3, ...): present, is-frame (L1 and L2, fixed at (0, 0) and (1, 0) in FL),
-#: not initialised yet, the estimate in FL, the log-area, and the latest bearing.
-ENTITY_FEATURES: tuple[str, ...] = (
-    "present",
-    "is_frame",
-    "uninitialised",
-    "x",
-    "y",
-    "log_area",
-    "bearing_cos",
-    "bearing_sin",
-)
-
-
-def entity_observations(flat: NDArray[np.float32], max_landmarks: int) -> dict[str, Any]:
-    """The entity view of flat observations (..., observation_size): the same numbers,
-    rearranged. ``"robot"`` (..., len(ROBOT_FEATURES)) is the robot block;
-    ``"landmarks"`` (..., max_landmarks * len(ENTITY_FEATURES)) is the landmark table, a
-    row per slot, flattened row by row (a 1-D Box per observation, as SB3's checker
-    wants: reshape to (max_landmarks, len(ENTITY_FEATURES))). L1 and L2 are the frame:
-    estimate (0, 0) and (1, 0), exact (log-area ``log(AREA_FLOOR)``). Rows of absent
-    landmarks are all zeros.
-    """
-    flat = np.asarray(flat, dtype=np.float32)
-    blocks = observation_slices(max_landmarks)
-    lead = flat.shape[:-1]
-    mapped = flat[..., blocks["landmarks"]].reshape(*lead, max_landmarks - 2, -1)
-    bearings = flat[..., blocks["bearings"]].reshape(*lead, max_landmarks, -1)
-    table = np.zeros((*lead, max_landmarks, len(ENTITY_FEATURES)), dtype=np.float32)
-    column = {name: index for index, name in enumerate(ENTITY_FEATURES)}
-    landmark = {name: index for index, name in enumerate(LANDMARK_FEATURES)}
-    bearing = {name: index for index, name in enumerate(BEARING_FEATURES)}
-    table[..., column["present"]] = bearings[..., bearing["present"]]
-    frame = table[..., :2, :]
-    frame[..., column["is_frame"]] = frame[..., column["present"]]
-    frame[..., 1, column["x"]] = frame[..., 1, column["present"]]
-    exact = np.float32(math.log(AREA_FLOOR))
-    frame[..., column["log_area"]] = exact * frame[..., column["present"]]
-    for name in ("uninitialised", "x", "y", "log_area"):
-        table[..., 2:, column[name]] = mapped[..., landmark[name]]
-    table[..., column["bearing_cos"]] = bearings[..., bearing["cos"]]
-    table[..., column["bearing_sin"]] = bearings[..., bearing["sin"]]
-    return {"robot": flat[..., blocks["robot"]].copy(), "landmarks": table.reshape(*lead, -1)}
 
 
 # ----------------------------------------------------------------------------------------

@@ -14,29 +14,15 @@ import math
 import numpy as np
 from numba import njit
 
+from bearing_env.envs.observations import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
 from bearing_env.numerics import JIT_OPTIONS as _JIT
 from bearing_env.numerics import wrap
 from bearing_env.slam.kernels import contains_point
 from bearing_env.world import bearing, straight_move
 
-#: Observation layout: the robot block first, then one block per mapped landmark slot
-#: (landmarks L3, L4, ...), then one block per bearing slot (L1, L2, L3, ...).
-#: :func:`write_observations` writes them in this order; the block sizes below are
-#: numba compile-time constants.
-ROBOT_FEATURES: tuple[str, ...] = (
-    "robot_x",
-    "robot_y",
-    "robot_log_area",
-    "robot_unknown",
-    "heading_cos",
-    "heading_sin",
-    "progress",
-    "last_frame_changed",
-    "last_move_blocked",
-)
-LANDMARK_FEATURES: tuple[str, ...] = ("present", "uninitialised", "x", "y", "log_area")
-BEARING_FEATURES: tuple[str, ...] = ("present", "cos", "sin")
-
+#: The flat observation's block sizes (numba compile-time constants), from the feature
+#: tuples of :mod:`bearing_env.envs.observations`; :func:`write_observations` writes the
+#: blocks in that module's order.
 _ROBOT_FEATURES = len(ROBOT_FEATURES)
 _LANDMARK_FEATURES = len(LANDMARK_FEATURES)
 _BEARING_FEATURES = len(BEARING_FEATURES)
