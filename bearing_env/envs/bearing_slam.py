@@ -30,7 +30,7 @@ from bearing_env.envs.config import (
     REWARDS,
     EnvConfig,
 )
-from bearing_env.envs.core import BatchState, MapBank, WorldView
+from bearing_env.envs.core import MapBank, WorldView
 from bearing_env.envs.observations import (
     BEARING_FEATURES,
     FL_COORD_LIMIT,
@@ -41,6 +41,7 @@ from bearing_env.envs.observations import (
     observation_slices,
     spec_for,
 )
+from bearing_env.envs.state import BatchState
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import DEFAULT_MAX_OUTLIERS
 from bearing_env.world import Arena, NoiseModel
@@ -486,8 +487,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         core.reset_rows(self._state, rows, config, [self.np_random], self._maps)
         if self._world is None:
             self._world = WorldView(self, 0)
-        observation = core.observations(self._state, rows, config, self._maps)[0]
-        infos = core.infos(self._state, rows, config, self._maps, core.reset_outcome(1))
+        group = self._maps.group(self._state, rows, config)
+        observation = core.observations(self._state, group)[0]
+        infos = core.infos(self._state, group, core.reset_outcome(1))
         if self.render_mode == "human":
             self.render()
         return self._observation(observation), core.row_info(infos, 0)
@@ -504,11 +506,10 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             )
         turns, lengths = self._decode_batch(self._checked_action(action)[None])
         rows, config = self._rows, self.config
-        outcome = core.step(
-            self._state, rows, config, turns, lengths, [self.np_random], self._maps
-        )
-        observation = core.observations(self._state, rows, config, self._maps)[0]
-        info = core.row_info(core.infos(self._state, rows, config, self._maps, outcome), 0)
+        group = self._maps.group(self._state, rows, config)
+        outcome = core.step(self._state, group, turns, lengths, [self.np_random])
+        observation = core.observations(self._state, group)[0]
+        info = core.row_info(core.infos(self._state, group, outcome), 0)
         if self.render_mode == "human":
             self.render()
         return (

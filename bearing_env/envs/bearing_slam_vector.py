@@ -22,8 +22,9 @@ from bearing_env.envs.actions import CONTINUOUS, DISCRETE, ActionSpec
 from bearing_env.envs.bearing_slam import BearingSLAMEnv, Setting, check_reset_options
 from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
 from bearing_env.envs.config import MAX_N_LANDMARKS, EnvConfig
-from bearing_env.envs.core import BatchState, MapBank, WorldView
+from bearing_env.envs.core import MapBank, WorldView
 from bearing_env.envs.observations import observation_size
+from bearing_env.envs.state import BatchState
 from bearing_env.validation import int_at_least, is_integer
 
 AUTORESET_MODES = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP, AutoresetMode.DISABLED)
@@ -257,8 +258,9 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         finished: list[IntArray] = []
         for config, rows, turns, lengths in groups:
             rngs = [self._rng(row) for row in rows.tolist()]
-            outcome = core.step(self._state, rows, config, turns, lengths, rngs, self._maps)
-            observations[rows] = core.observations(self._state, rows, config, self._maps)
+            group = self._maps.group(self._state, rows, config)
+            outcome = core.step(self._state, group, turns, lengths, rngs)
+            observations[rows] = core.observations(self._state, group)
             rewards[rows] = outcome.rewards
             terminations[rows] = outcome.terminated
             truncations[rows] = outcome.truncated
@@ -266,7 +268,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             if self.max_episode_steps is not None:
                 truncations[rows] |= self._elapsed_steps[rows] >= self.max_episode_steps
             group_infos = self._padded(
-                core.infos(self._state, rows, config, self._maps, outcome)
+                core.infos(self._state, group, outcome)
             )
             infos = self._merge_rows(infos, group_infos, rows)
             if self.autoreset_mode == AutoresetMode.SAME_STEP:
@@ -477,10 +479,9 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             rngs = [self._rng(row) for row in group.tolist()]
             core.reset_rows(self._state, group, config, rngs, self._maps)
         for config, group in self._groups(rows):
-            observations[group] = core.observations(self._state, group, config, self._maps)
-            reset_infos = core.infos(
-                self._state, group, config, self._maps, core.reset_outcome(group.size)
-            )
+            rows_group = self._maps.group(self._state, group, config)
+            observations[group] = core.observations(self._state, rows_group)
+            reset_infos = core.infos(self._state, rows_group, core.reset_outcome(group.size))
             infos = self._merge_rows(infos, self._padded(reset_infos), group)
         self._elapsed_steps[rows] = 0
         return infos
