@@ -110,9 +110,7 @@ def settings_from(
         return EnvConfig.create(**settings)
     if not isinstance(config, EnvConfig):
         raise TypeError(f"config must be an EnvConfig or None, got {config!r}")
-    given = sorted(
-        name for name, value in settings.items() if _differs(value, defaults.get(name))
-    )
+    given = sorted(name for name, value in settings.items() if _differs(value, defaults.get(name)))
     if given:
         raise TypeError(f"pass the settings either as config or as keywords, not both: {given}")
     return config
@@ -501,8 +499,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             raise RuntimeError("call reset() before step()")
         if self._state.done[0]:
             raise RuntimeError(
-                "the episode has ended (terminated or truncated): call reset() before "
-                "step() again"
+                "the episode has ended (terminated or truncated): call reset() before step() again"
             )
         turns, lengths = self._decode_batch(self._checked_action(action)[None])
         rows, config = self._rows, self.config
@@ -536,9 +533,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         if self._renderer is None:
             from bearing_env.rendering import Renderer
 
-            self._renderer = Renderer(
-                self.render_mode, self.arena, fps=self.metadata["render_fps"]
-            )
+            self._renderer = Renderer(self.render_mode, self.arena, fps=self.metadata["render_fps"])
         return self._renderer.render(core.scene(self._state, 0, self.config, self.slam))
 
     def close(self) -> None:

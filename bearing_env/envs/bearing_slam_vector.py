@@ -203,8 +203,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         seeds = self._seeds(seed)
         if not self._has_reset and not mask.all():
             raise ValueError(
-                "the first reset() must reset every sub-env, got options['reset_mask'] = "
-                f"{mask!r}"
+                f"the first reset() must reset every sub-env, got options['reset_mask'] = {mask!r}"
             )
         rows = np.flatnonzero(mask)
         for row in rows.tolist():
@@ -267,9 +266,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             self._elapsed_steps[rows] += 1
             if self.max_episode_steps is not None:
                 truncations[rows] |= self._elapsed_steps[rows] >= self.max_episode_steps
-            group_infos = self._padded(
-                core.infos(self._state, group, outcome)
-            )
+            group_infos = self._padded(core.infos(self._state, group, outcome))
             infos = self._merge_rows(infos, group_infos, rows)
             if self.autoreset_mode == AutoresetMode.SAME_STEP:
                 ended = np.flatnonzero(terminations[rows] | truncations[rows])
@@ -454,8 +451,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         if not isinstance(mask, np.ndarray) or mask.dtype != np.bool_:
             kind = f"dtype {mask.dtype}" if isinstance(mask, np.ndarray) else type(mask).__name__
             raise TypeError(
-                f"options['reset_mask'] must be a numpy array of dtype bool, got {mask!r} "
-                f"({kind})"
+                f"options['reset_mask'] must be a numpy array of dtype bool, got {mask!r} ({kind})"
             )
         if mask.shape != (self.num_envs,):
             raise ValueError(
@@ -463,9 +459,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
                 f"sub-env, got shape {mask.shape}: {mask!r}"
             )
         if not mask.any():
-            raise ValueError(
-                f"options['reset_mask'] must reset at least one sub-env, got {mask!r}"
-            )
+            raise ValueError(f"options['reset_mask'] must reset at least one sub-env, got {mask!r}")
         return mask.copy()
 
     def _reset_rows(
@@ -486,9 +480,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         self._elapsed_steps[rows] = 0
         return infos
 
-    def _groups(
-        self, rows: IntArray, by_count: bool = True
-    ) -> list[tuple[EnvConfig, IntArray]]:
+    def _groups(self, rows: IntArray, by_count: bool = True) -> list[tuple[EnvConfig, IntArray]]:
         """``rows`` split into groups that step as one batch: same config and (unless
         ``by_count`` is False) same landmark count, so one map batch. Sub-envs share their
         config unless ``set_attr`` changed some; each distinct config gets its own group."""
@@ -569,9 +561,7 @@ class BearingSLAMDiscreteVectorEnv(BearingSLAMVectorEnv):
 
 
 #: Sub-env attributes the vector env serves itself (see ``_row_attribute``).
-_ROW_ATTRIBUTES = frozenset(
-    {"n_landmarks", "slam", "world", "observation_space", "action_space"}
-)
+_ROW_ATTRIBUTES = frozenset({"n_landmarks", "slam", "world", "observation_space", "action_space"})
 
 
 def _select_rows(batched: dict[str, Any], rows: IntArray) -> dict[str, Any]:

@@ -65,34 +65,41 @@ class MapBank:
 
     Envs whose landmark count varies switch batches at reset; their rows in the other
     batches are simply left idle. The bank also keeps each (config, landmark count)'s
-    kernel settings (:meth:`group`).
+    kernel inputs (:meth:`group`).
     """
 
     def __init__(self, num_rows: int) -> None:
         self.num_rows = num_rows
         self.batches: dict[tuple[int, MapSettings], BatchedPolygonSLAM] = {}
         self._views: dict[tuple[int, MapSettings, int], PolygonSLAM] = {}
-        self._settings: dict[tuple[int, EnvConfig], Settings] = {}
-
-    def batch(self, n_landmarks: int, config: EnvConfig) -> BatchedPolygonSLAM:
-        return self._lookup(n_landmarks, config)[0]
+        #: Each (landmark count, config)'s kernel inputs (an ``InputsRef``), with the
+        #: state and map references they were made of.
+        self._inputs: dict[tuple[int, EnvConfig], tuple[Any, Any, kernels.Inputs]] = {}
 
     def group(self, state: BatchState, rows: IntArray, config: EnvConfig) -> Group:
-        """The group of ``rows`` (all with ``config`` and one landmark count)."""
+        """The group of ``rows`` (all with ``config`` and one landmark count), with its
+        kernel inputs: made once per (config, count) and state, then reused."""
         n = int(state.n_landmarks[rows[0]])
-        batch, settings = self._lookup(n, config)
-        return Group(rows, config, n, batch, batch._kernel_state(), settings)
-
-    def _lookup(self, n_landmarks: int, config: EnvConfig) -> tuple[BatchedPolygonSLAM, Settings]:
+        state_ref = state.kernel_ref()
         last = self.__dict__.get("_last")
-        if last is not None and last[0] is config and last[1] == n_landmarks:
-            return last[2]  # the common case: asked again for the same group's batch
-        n = int(n_landmarks)
+        if last is None or last[0] is not config or last[1] != n or last[2] is not state_ref:
+            last = self._last = (config, n, state_ref, *self._inputs_for(n, config, state_ref))
+        return Group(rows, config, n, last[3], last[4])
+
+    def batch(self, n_landmarks: int, config: EnvConfig) -> BatchedPolygonSLAM:
+        return self._batch_for((int(n_landmarks), config.map_settings))
+
+    def _inputs_for(
+        self, n: int, config: EnvConfig, state_ref: BatchState
+    ) -> tuple[BatchedPolygonSLAM, kernels.Inputs]:
         batch = self._batch_for((n, config.map_settings))
-        if (n, config) not in self._settings:
-            self._settings[n, config] = kernel_settings(n, config)
-        self._last = (config, n_landmarks, (batch, self._settings[n, config]))
-        return self._last[2]
+        maps_ref = batch._kernel_state()
+        kept = self._inputs.get((n, config))
+        if kept is None or kept[0] is not state_ref or kept[1] is not maps_ref:
+            settings = kernel_settings(n, config)
+            inputs = kernels.inputs_ref(kernels.Inputs(settings, maps_ref, state_ref))
+            kept = self._inputs[n, config] = (state_ref, maps_ref, inputs)
+        return batch, kept[2]
 
     def _batch_for(self, key: tuple[int, MapSettings]) -> BatchedPolygonSLAM:
         if key not in self.batches:
@@ -108,9 +115,9 @@ class MapBank:
         return self._views[key]
 
     def __getstate__(self) -> dict[str, Any]:
-        # The kernel settings (structrefs) cannot be pickled; they are made again.
+        # The kernel inputs (structrefs) cannot be pickled; they are made again.
         state = {key: value for key, value in self.__dict__.items() if key != "_last"}
-        state["_settings"] = {}
+        state["_inputs"] = {}
         return state
 
 
@@ -122,31 +129,28 @@ class Group(NamedTuple):
     config: EnvConfig
     n: int  #: the rows' landmark count
     batch: BatchedPolygonSLAM  #: their maps
-    maps: Any  #: the maps' state as the kernels take it (a slam kernels ``StateRef``)
-    settings: Settings  #: the kernels' settings (a ``SettingsRef``)
+    inputs: kernels.Inputs  #: what the kernels take (an ``InputsRef``)
 
 
 def kernel_settings(n_landmarks: int, config: EnvConfig) -> Settings:
     """The kernels' settings of a group of ``config`` with ``n_landmarks`` landmarks."""
     arena = config.arena
-    return kernels.settings_ref(
-        Settings(
-            n=int(n_landmarks),
-            n_slots=int(config.max_landmarks),
-            width=float(arena.width),
-            height=float(arena.height),
-            margin=float(arena.wall_margin),
-            min_baseline=float(arena.min_baseline),
-            log_area=config.reward == "log_area",
-            floor=AREA_FLOOR,
-            cap=float(config.area_cap),
-            target_area=float(config.target_area),
-            max_moves=int(config.max_moves),
-            path_cost=float(config.path_cost),
-            move_cost=float(config.move_cost),
-            coordinate_limit=FL_COORD_LIMIT,
-            tolerance=CONTAINMENT_TOLERANCE,
-        )
+    return Settings(
+        n=int(n_landmarks),
+        n_slots=int(config.max_landmarks),
+        width=float(arena.width),
+        height=float(arena.height),
+        margin=float(arena.wall_margin),
+        min_baseline=float(arena.min_baseline),
+        log_area=config.reward == "log_area",
+        floor=AREA_FLOOR,
+        cap=float(config.area_cap),
+        target_area=float(config.target_area),
+        max_moves=int(config.max_moves),
+        path_cost=float(config.path_cost),
+        move_cost=float(config.move_cost),
+        coordinate_limit=FL_COORD_LIMIT,
+        tolerance=CONTAINMENT_TOLERANCE,
     )
 
 
@@ -372,34 +376,35 @@ def step(
     size = rows.size
     # Each row draws its first reading's noise, then its second's, from its generator.
     first, second = config.noise.draw_movement_rows(rngs, n, config.epsilon)
-    read = kernels.Readings(np.empty(size), np.empty((size, n)), np.empty((size, n)))
+    travelled, start, end = np.empty(size), np.empty((size, n)), np.empty((size, n))
     kernels.move_and_read(
         rows,
         np.ascontiguousarray(turns, dtype=np.float64),
         np.ascontiguousarray(lengths, dtype=np.float64),
-        group.settings,
+        group.inputs,
         _draws_for_kernel(first),
         _draws_for_kernel(second),
-        state.kernel_ref(),
-        read,
+        travelled,
+        start,
+        end,
     )
     state.append_positions(rows)
 
     # A move that could not start took both readings from the same place: there is no
     # robot frame (R1 = R2), so the SLAM must not see it. The robot knows it did not move
     # (it is stuck against the wall).
-    changes_map = read.travelled >= config.arena.min_baseline
+    changes_map = travelled >= config.arena.min_baseline
     frame_changed = np.zeros(size, dtype=bool)
     inconsistent = np.zeros(size, dtype=np.int64)
     batch = group.batch
     # The readings are the kernel's own float arrays and the rows distinct: the map's
     # unchecked update is enough.
     if changes_map.all():
-        result = batch._update_checked(read.start, read.end, rows)
+        result = batch._update_checked(start, end, rows)
         frame_changed, inconsistent = result.frame_changed, result.n_inconsistent
     elif changes_map.any():
         moving = np.flatnonzero(changes_map)
-        result = batch._update_checked(read.start[moving], read.end[moving], rows[moving])
+        result = batch._update_checked(start[moving], end[moving], rows[moving])
         frame_changed[moving] = result.frame_changed
         inconsistent[moving] = result.n_inconsistent
     state.frame_changed[rows] = frame_changed
@@ -410,21 +415,30 @@ def step(
         truncated=np.empty(size, dtype=bool),
         frame_changed=frame_changed,
         inconsistent=inconsistent,
-        travelled=read.travelled,
+        travelled=travelled,
         uncertainty=np.empty(size),
         path_cost=np.empty(size),
         move_cost=np.empty(size),
     )
-    kernels.finish_steps(rows, group.settings, group.maps, state.kernel_ref(), outcome)
+    kernels.finish_steps(
+        rows,
+        group.inputs,
+        travelled,
+        outcome.rewards,
+        outcome.uncertainty,
+        outcome.path_cost,
+        outcome.move_cost,
+        outcome.terminated,
+        outcome.truncated,
+    )
     return outcome
 
 
 def _draws_for_kernel(draws: NoiseDraws) -> kernels.Draws:
     """The draws as the kernel takes them; no outliers: an all-False mask."""
     if draws.is_outlier is None or draws.replacement is None:
-        no = np.zeros(draws.offsets.shape, dtype=bool)
-        return kernels.Draws(draws.offsets, no, draws.offsets)
-    return kernels.Draws(draws.offsets, draws.is_outlier, draws.replacement)
+        return draws.offsets, np.zeros(draws.offsets.shape, dtype=bool), draws.offsets
+    return draws.offsets, draws.is_outlier, draws.replacement
 
 
 def reset_outcome(size: int) -> StepOutcome:
@@ -442,7 +456,7 @@ def reset_outcome(size: int) -> StepOutcome:
 def potentials(state: BatchState, group: Group) -> FloatArray:
     """The uncertainty potential Phi of the group's maps (see the env's Rewards section)."""
     out = np.empty(group.rows.size)
-    kernels.potentials(group.rows, group.settings, group.maps, out)
+    kernels.potentials(group.rows, group.inputs, out)
     return out
 
 
@@ -451,7 +465,7 @@ def observations(state: BatchState, group: Group) -> NDArray[np.float32]:
     Space section)."""
     size = observation_size(group.config.max_landmarks)
     out = np.zeros((group.rows.size, size), dtype=np.float32)
-    kernels.write_observations(group.rows, group.settings, group.maps, state.kernel_ref(), out)
+    kernels.write_observations(group.rows, group.inputs, out)
     return out
 
 
@@ -459,16 +473,18 @@ def infos(state: BatchState, group: Group, outcome: StepOutcome) -> dict[str, An
     """The group's infos, batched along a first axis (see the env's Info section)."""
     rows, batch = group.rows, group.batch
     size, n_mapped = rows.size, group.n - 2
-    truth = kernels.Truth(
-        landmark_area=np.empty((size, n_mapped)),
-        landmark_error=np.empty((size, n_mapped)),
-        landmark_contains_truth=np.empty((size, n_mapped), dtype=bool),
-        total_area=np.empty(size),
-        robot_error=np.empty(size),
-    )
-    kernels.write_infos(rows, group.settings, group.maps, state.kernel_ref(), truth)
+    areas = np.empty((size, n_mapped))
+    errors = np.empty((size, n_mapped))
+    contains = np.empty((size, n_mapped), dtype=bool)
+    total_area = np.empty(size)
+    robot_error = np.empty(size)
+    kernels.write_infos(rows, group.inputs, areas, errors, contains, total_area, robot_error)
     return {
-        **truth._asdict(),
+        "landmark_area": areas,
+        "landmark_error": errors,
+        "landmark_contains_truth": contains,
+        "total_area": total_area,
+        "robot_error": robot_error,
         "frame_changed": outcome.frame_changed,
         "inconsistent": outcome.inconsistent,
         "outliers": batch.outliers[rows],

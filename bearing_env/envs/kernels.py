@@ -25,8 +25,7 @@ from bearing_env.slam.kernels import State as MapState
 from bearing_env.slam.kernels import contains_point
 from bearing_env.world import bearing, straight_move
 
-if TYPE_CHECKING:  # only for annotations: both modules import this one
-    from bearing_env.envs.core import StepOutcome
+if TYPE_CHECKING:  # only for annotations: that module imports this one
     from bearing_env.envs.state import BatchState
 
 FloatArray = NDArray[np.float64]
@@ -60,56 +59,45 @@ class Settings(NamedTuple):
     tolerance: float  #: relative tolerance of the info's containment test
 
 
+class Inputs(NamedTuple):
+    """What a group's kernels read and write besides their per-call arrays."""
+
+    settings: Settings
+    maps: MapState  #: the group's map batch (its slam kernels ``StateRef``)
+    state: BatchState  #: the envs' state (its ``BatchStateRef``)
+
+
 @structref.register
-class SettingsType(types.StructRef):
-    """numba's type of a :class:`SettingsRef`: one field per :class:`Settings` field."""
+class InputsType(types.StructRef):
+    """numba's type of an :class:`InputsRef`: one field per :class:`Inputs` field."""
 
     def preprocess_fields(self, fields: Any) -> tuple[tuple[str, Any], ...]:
         # why (each ignore below): these numba functions carry no annotations
         return tuple((name, types.unliteral(typ)) for name, typ in fields)  # type: ignore[no-untyped-call]
 
 
-class SettingsRef(structref.StructRefProxy):
-    """:class:`Settings` as the kernels take them: a structref, typed once rather than
-    field by field on every call as a namedtuple is (see :mod:`bearing_env.envs.state`)."""
+class InputsRef(structref.StructRefProxy):
+    """:class:`Inputs` as the kernels take them: one structref, made once per group and
+    state (see ``core.MapBank.group``). numba types a structref argument once per call
+    (about 1 us here) but a namedtuple field by field, and positional arrays cheaply:
+    so the long-lived inputs travel as this one reference and each call's fresh output
+    arrays positionally."""
 
 
-structref.define_constructor(SettingsRef, SettingsType, Settings._fields)  # type: ignore[no-untyped-call]
-structref.define_boxing(SettingsType, SettingsRef)  # type: ignore[no-untyped-call]
+structref.define_constructor(InputsRef, InputsType, Inputs._fields)  # type: ignore[no-untyped-call]
+structref.define_boxing(InputsType, InputsRef)  # type: ignore[no-untyped-call]
 
 
 @njit(**_JIT)
-def settings_ref(settings: Settings) -> Settings:
-    """The :class:`SettingsRef` of ``settings`` (annotated as Settings: same fields)."""
-    return SettingsRef(*settings)  # type: ignore[no-untyped-call, return-value]
+def inputs_ref(inputs: Inputs) -> Inputs:
+    """The :class:`InputsRef` of ``inputs`` (annotated as Inputs: the same fields)."""
+    return InputsRef(*inputs)  # type: ignore[no-untyped-call, return-value]
 
 
-class Draws(NamedTuple):
-    """One reading's pre-drawn noise per row (len(rows), n): the offsets, which bearings
-    are outliers (all False without outliers), and their random replacements."""
-
-    offsets: FloatArray
-    is_outlier: BoolArray
-    replacement: FloatArray
-
-
-class Readings(NamedTuple):
-    """What :func:`move_and_read` reports per row: the distance moved and both readings
-    (len(rows), n)."""
-
-    travelled: FloatArray
-    start: FloatArray
-    end: FloatArray
-
-
-class Truth(NamedTuple):
-    """The ground-truth parts of a group's infos (each named as its info key)."""
-
-    landmark_area: FloatArray  #: (len(rows), n - 2)
-    landmark_error: FloatArray  #: (len(rows), n - 2)
-    landmark_contains_truth: BoolArray  #: (len(rows), n - 2)
-    total_area: FloatArray  #: (len(rows),)
-    robot_error: FloatArray  #: (len(rows),)
+#: One reading's pre-drawn noise per row, as :func:`move_and_read` takes it: a plain
+#: tuple (offsets, is-outlier mask (all False without outliers), replacements), each
+#: (len(rows), n); numba types a plain tuple of arrays faster than a namedtuple.
+Draws = tuple[FloatArray, BoolArray, FloatArray]
 
 
 @njit(**_JIT)
@@ -122,20 +110,25 @@ def move_and_read(
     rows: np.ndarray,
     turns: np.ndarray,
     lengths: np.ndarray,
-    settings: Settings,
+    inputs: Inputs,
     first: Draws,
     second: Draws,
-    state: BatchState,
-    out: Readings,
+    travelled: np.ndarray,
+    reading_start: np.ndarray,
+    reading_end: np.ndarray,
 ) -> None:
     """Turn, read, move straight until the wall margin, read again; for each row.
 
     The readings are the true bearings plus the rows' pre-drawn noise (``first``,
     ``second``; see :meth:`~bearing_env.world.NoiseModel.draw_rows`), wrapped; out in
-    ``out``. In place: the rows' pose, start position, readings, move count and blocked
-    flag. A robot that could not move at least ``min_baseline`` does not move (see
+    ``reading_start`` and ``reading_end`` (len(rows), n) and ``travelled``. In place:
+    the rows' pose, start position, readings, move count and blocked flag. A robot that
+    could not move at least ``min_baseline`` does not move (see
     :func:`~bearing_env.world.straight_move`).
     """
+    settings, state = inputs.settings, inputs.state
+    offsets_start, outlier_start, replacement_start = first
+    offsets_end, outlier_end, replacement_end = second
     for i in range(rows.shape[0]):
         row = rows[i]
         heading = wrap(state.headings[row] + turns[i])
@@ -154,24 +147,24 @@ def move_and_read(
             lx, ly = state.landmarks[row, j, 0], state.landmarks[row, j, 1]
             reading = _noisy(
                 bearing(lx, ly, x, y, heading),
-                first.offsets[i, j],
-                first.is_outlier[i, j],
-                first.replacement[i, j],
+                offsets_start[i, j],
+                outlier_start[i, j],
+                replacement_start[i, j],
             )
-            out.start[i, j] = state.start_bearings[row, j] = reading
+            reading_start[i, j] = state.start_bearings[row, j] = reading
             reading = _noisy(
                 bearing(lx, ly, new_x, new_y, heading),
-                second.offsets[i, j],
-                second.is_outlier[i, j],
-                second.replacement[i, j],
+                offsets_end[i, j],
+                outlier_end[i, j],
+                replacement_end[i, j],
             )
-            out.end[i, j] = state.latest_bearings[row, j] = reading
+            reading_end[i, j] = state.latest_bearings[row, j] = reading
         state.start_positions[row, 0], state.start_positions[row, 1] = x, y
         state.positions[row, 0], state.positions[row, 1] = new_x, new_y
         state.headings[row] = heading
         state.blocked[row] = stopped
         state.moves[row] += 1
-        out.travelled[i] = distance
+        travelled[i] = distance
 
 
 @njit(**_JIT)
@@ -214,35 +207,43 @@ def _potential(settings: Settings, areas: np.ndarray) -> float:
 
 
 @njit(**_JIT)
-def potentials(rows: np.ndarray, settings: Settings, maps: MapState, out: np.ndarray) -> None:
+def potentials(rows: np.ndarray, inputs: Inputs, out: np.ndarray) -> None:
     for i in range(rows.shape[0]):
-        out[i] = _potential(settings, maps.areas[rows[i]])
+        out[i] = _potential(inputs.settings, inputs.maps.areas[rows[i]])
 
 
 @njit(**_JIT)
 def finish_steps(
-    rows: np.ndarray, settings: Settings, maps: MapState, state: BatchState, out: StepOutcome
+    rows: np.ndarray,
+    inputs: Inputs,
+    travelled: np.ndarray,
+    reward: np.ndarray,
+    uncertainty: np.ndarray,
+    path: np.ndarray,
+    move: np.ndarray,
+    terminated: np.ndarray,
+    truncated: np.ndarray,
 ) -> None:
     """Rewards (with their named parts), terminations and truncations after the map
-    update, into ``out`` (whose ``travelled`` is the move's); the rows' potentials and
-    done flags are updated in place."""
+    update; the rows' potentials and done flags are updated in place."""
+    settings, maps, state = inputs.settings, inputs.maps, inputs.state
     for i in range(rows.shape[0]):
         row = rows[i]
         potential = _potential(settings, maps.areas[row])
-        out.uncertainty[i] = state.potentials[row] - potential
-        out.path_cost[i] = -settings.path_cost * out.travelled[i]
-        out.move_cost[i] = -settings.move_cost
+        uncertainty[i] = state.potentials[row] - potential
+        path[i] = -settings.path_cost * travelled[i]
+        move[i] = -settings.move_cost
         # 0.0 + turns an uncertainty of -0.0 into 0.0; the order of the sum is fixed.
-        out.rewards[i] = ((0.0 + out.uncertainty[i]) + out.path_cost[i]) + out.move_cost[i]
+        reward[i] = ((0.0 + uncertainty[i]) + path[i]) + move[i]
         state.potentials[row] = potential
         success = True
         for j in range(settings.n - 2):
             if maps.counts[row, j] == 0 or not maps.areas[row, j] <= settings.target_area:
                 success = False
                 break
-        out.terminated[i] = success
-        out.truncated[i] = not success and state.moves[row] >= settings.max_moves
-        state.done[row] = out.terminated[i] or out.truncated[i]
+        terminated[i] = success
+        truncated[i] = not success and state.moves[row] >= settings.max_moves
+        state.done[row] = terminated[i] or truncated[i]
 
 
 @njit(**_JIT)
@@ -251,11 +252,10 @@ def _coordinate(value: float, limit: float) -> float:
 
 
 @njit(**_JIT)
-def write_observations(
-    rows: np.ndarray, settings: Settings, maps: MapState, state: BatchState, out: np.ndarray
-) -> None:
+def write_observations(rows: np.ndarray, inputs: Inputs, out: np.ndarray) -> None:
     """The observations (len(rows), size) of a group, float32 (the env's Observation
     Space section documents every element); ``out`` must be zeros."""
+    settings, maps, state = inputs.settings, inputs.maps, inputs.state
     floor, cap, limit = settings.floor, settings.cap, settings.coordinate_limit
     bearings_at = _ROBOT_FEATURES + _LANDMARK_FEATURES * (settings.n_slots - 2)
     log_cap = math.log(cap)
@@ -299,34 +299,41 @@ def write_observations(
 
 @njit(**_JIT)
 def write_infos(
-    rows: np.ndarray, settings: Settings, maps: MapState, state: BatchState, out: Truth
+    rows: np.ndarray,
+    inputs: Inputs,
+    landmark_area: np.ndarray,
+    landmark_error: np.ndarray,
+    contains_truth: np.ndarray,
+    total_area: np.ndarray,
+    robot_error: np.ndarray,
 ) -> None:
     """The ground-truth parts of a group's infos (see the env's Info section)."""
+    settings, maps, state = inputs.settings, inputs.maps, inputs.state
     for i in range(rows.shape[0]):
         row = rows[i]
         total = 0.0
         for j in range(settings.n - 2):
             area = maps.areas[row, j]
-            out.landmark_area[i, j] = area
+            landmark_area[i, j] = area
             total += area
             count = maps.counts[row, j]
             if count > 0:
                 truth = state.landmarks_fl[row, j]
-                out.landmark_error[i, j] = abs(maps.centroids[row, j] - truth)
-                out.landmark_contains_truth[i, j] = contains_point(
+                landmark_error[i, j] = abs(maps.centroids[row, j] - truth)
+                contains_truth[i, j] = contains_point(
                     maps.vertices[row, j], count, truth, settings.tolerance
                 )
             else:
-                out.landmark_error[i, j] = np.inf
-                out.landmark_contains_truth[i, j] = False
-        out.total_area[i] = total
+                landmark_error[i, j] = np.inf
+                contains_truth[i, j] = False
+        total_area[i] = total
         centroid = maps.robot_centroid[row]
         if np.isfinite(centroid.real) and np.isfinite(centroid.imag):
             position = complex(state.positions[row, 0], state.positions[row, 1])
             truth = (position - state.frame_origin[row]) / state.frame_unit[row]
-            out.robot_error[i] = abs(centroid - truth)
+            robot_error[i] = abs(centroid - truth)
         else:
-            out.robot_error[i] = np.inf
+            robot_error[i] = np.inf
 
 
 #: Outcomes of :func:`decode_continuous`.

@@ -117,18 +117,17 @@ class BatchState:
             grown = np.zeros((self.num_rows, 2 * capacity, 2))
             grown[:, :capacity] = self.trajectory
             self.trajectory = grown
-            self.__dict__.pop("_ref", None)  # the kernels' reference holds the old array
             kernels.append_positions(rows, self.positions, self.trajectory, self.trajectory_length)
 
     def kernel_ref(self) -> BatchState:
-        """This state as the kernels take it: a :class:`BatchStateRef` to the same arrays,
-        made on first use and kept until an array is replaced (a trajectory that grows).
+        """This state as the kernels take it: a :class:`BatchStateRef` to the same arrays
+        (all but the trajectory), made on first use and kept.
 
-        Annotated as :class:`BatchState`: the reference has exactly its fields.
+        Annotated as :class:`BatchState`: the kernels read only fields it has.
         """
         ref: BatchState | None = self.__dict__.get("_ref")
         if ref is None:
-            ref = _batch_state_ref(tuple(getattr(self, name) for name in STATE_ARRAYS))
+            ref = _batch_state_ref(tuple(getattr(self, name) for name in KERNEL_ARRAYS))
             self.__dict__["_ref"] = ref
         return ref
 
@@ -137,13 +136,16 @@ class BatchState:
         return {key: value for key, value in self.__dict__.items() if key != "_ref"}
 
 
-#: The state's arrays, in field order (the fields of a :class:`BatchStateRef`).
+#: The state's arrays, in field order.
 STATE_ARRAYS: tuple[str, ...] = tuple(f.name for f in fields(BatchState))
+#: The fields of a :class:`BatchStateRef`: all but the trajectory, the one array that is
+#: replaced (when it grows), so that a reference, once made, stays valid.
+KERNEL_ARRAYS: tuple[str, ...] = tuple(name for name in STATE_ARRAYS if name != "trajectory")
 
 
 @structref.register
 class BatchStateType(types.StructRef):
-    """numba's type of a :class:`BatchStateRef`: one field per :class:`BatchState` field."""
+    """numba's type of a :class:`BatchStateRef`: one field per name in :data:`KERNEL_ARRAYS`."""
 
     def preprocess_fields(self, fields: Any) -> tuple[tuple[str, Any], ...]:
         # why (each ignore below): these numba functions carry no annotations
@@ -154,7 +156,7 @@ class BatchStateRef(structref.StructRefProxy):
     """A :class:`BatchState`'s arrays as the kernels take them."""
 
 
-structref.define_constructor(BatchStateRef, BatchStateType, STATE_ARRAYS)  # type: ignore[no-untyped-call]
+structref.define_constructor(BatchStateRef, BatchStateType, KERNEL_ARRAYS)  # type: ignore[no-untyped-call]
 structref.define_boxing(BatchStateType, BatchStateRef)  # type: ignore[no-untyped-call]
 
 
