@@ -48,7 +48,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
     `num_envs` copies of :class:`~bearing_env.envs.bearing_slam.BearingSLAMEnv` stepped
     together. The sub-envs are rows of one structure of arrays
-    (:class:`~bearing_env.envs.core.BatchState`), and each step is a few compiled kernel
+    (:class:`~bearing_env.envs.state.BatchState`), and each step is a few compiled kernel
     calls per group of rows with the same settings (`EnvConfig`) and landmark count: all
     robots move at once, all maps fuse their movement in one
     :class:`BatchedPolygonSLAM` update (most of the work), and observations, rewards and

@@ -1,6 +1,7 @@
 """The envs' pure functional core: world state and bookkeeping of a batch, as arrays.
 
-In the spirit of Gymnasium's ``phys2d/cartpole.py``: one :class:`BatchState` holds the
+In the spirit of Gymnasium's ``phys2d/cartpole.py``: one
+:class:`~bearing_env.envs.state.BatchState` holds the
 state of ``N`` envs as a structure of arrays (one row per env), and plain functions
 compute on a group of rows at once:
 
@@ -16,7 +17,9 @@ random draw comes from the row's own generator, in the same order as in a batch 
 
 A *group* is a set of rows that share one :class:`~bearing_env.envs.config.EnvConfig`
 and one landmark count ``n`` (so one map batch, and arrays ``[:, :n]`` without padding).
-The functions below take a group's row indices; rows with other settings are untouched.
+The functions below take a :class:`Group` (its rows, config, landmark count, map batch
+and kernel inputs), which :meth:`MapBank.group` builds once per step; rows outside it are
+untouched.
 """
 
 from __future__ import annotations

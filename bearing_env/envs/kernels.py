@@ -5,6 +5,12 @@ These do in one call what would otherwise be dozens of small numpy operations pe
 :mod:`bearing_env.envs.core` calls them for the single env (a group of one row) and the
 vector env alike, so both compute every number with the same code. Random draws stay
 in Python, where each row's own generator makes them (see ``core.step``).
+
+Each kernel takes the group's rows, one :class:`InputsRef` (the group's
+:class:`Settings`, its map batch's state and the envs' ``BatchState``: long-lived, so
+made once and typed by numba in about 1 us per call) and its per-call arrays
+positionally (fresh each step; positional arrays are typed fastest: 5 arrays cost 0.6 us
+positionally, 2.2 us as a namedtuple).
 """
 
 from __future__ import annotations

@@ -2,12 +2,13 @@
 
 :class:`BatchState` holds the world state and bookkeeping of ``N`` envs, one row each
 (a structure of arrays); its field list is the only place these arrays are listed
-(:data:`STATE_ARRAYS`). The kernels of :mod:`bearing_env.envs.kernels` take it as a
-:class:`BatchStateRef`, a numba ``structref`` of the same arrays that the state makes
-once (:meth:`BatchState.kernel_ref`): numba types a namedtuple argument field by field
-on every call, about 0.15 us per array (3.5 us for 14 arrays against 1.3 us for a
-structref, measured on this machine), which the single env would pay in each of its four
-kernel calls per step.
+(:data:`STATE_ARRAYS`). The kernels of :mod:`bearing_env.envs.kernels` reach it through
+a :class:`BatchStateRef`, a numba ``structref`` of the same arrays (all but the
+trajectory, :data:`KERNEL_ARRAYS`) that the state makes once
+(:meth:`BatchState.kernel_ref`) and that goes into the group's ``kernels.InputsRef``.
+A namedtuple would be typed field by field on every call (3.5 us for 14 arrays against
+1.3 us for a structref, measured here), in each of the single env's four kernel calls
+per step.
 """
 
 from __future__ import annotations
