@@ -42,8 +42,12 @@ import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
-from bearing_env.envs.bearing_slam import BEARING_FEATURES, ROBOT_FEATURES, observation_slices
-from bearing_env.envs.core import ENTITY_FEATURES
+from bearing_env.envs.observations import (
+    BEARING_FEATURES,
+    ENTITY_FEATURES,
+    ROBOT_FEATURES,
+    observation_slices,
+)
 from bearing_env.numerics import wrap
 from bearing_env.slam import PolygonSLAM
 

@@ -32,7 +32,7 @@ from stable_baselines3.common.policies import MultiInputActorCriticPolicy
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
-from bearing_env.envs.core import ENTITY_FEATURES
+from bearing_env.envs.observations import ENTITY_FEATURES
 
 #: The log-area column is divided by this (log-areas span about [-23, 14]).
 LOG_AREA_SCALE = 10.0

@@ -774,7 +774,7 @@ def test_an_env_from_a_read_only_unpickle_still_steps(env_id: str) -> None:
 def test_entity_observation_is_the_flat_one_rearranged(env_id: str) -> None:
     from gymnasium.wrappers import FlattenObservation
 
-    from bearing_env.envs.core import ENTITY_FEATURES
+    from bearing_env.envs.observations import ENTITY_FEATURES
 
     flat_env = gym.make(env_id, n_landmarks=(3, 6), max_landmarks=7)
     entity_env = gym.make(env_id, n_landmarks=(3, 6), max_landmarks=7, observation="entities")

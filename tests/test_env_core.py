@@ -8,7 +8,8 @@ import pytest
 from bearing_env.envs import core
 from bearing_env.envs.actions import CONTINUOUS
 from bearing_env.envs.config import EnvConfig
-from bearing_env.envs.core import BatchState, MapBank
+from bearing_env.envs.core import MapBank
+from bearing_env.envs.state import INITIAL_TRAJECTORY_SLOTS, STATE_ARRAYS, BatchState
 
 
 def started_batch(
@@ -30,15 +31,15 @@ def test_a_batch_steps_as_its_rows_one_at_a_time() -> None:
     all_rows, one = np.arange(n), np.array([0])
     for step_actions in actions:
         turns, lengths = CONTINUOUS.decode(config, step_actions)
-        outcome = core.step(batch, all_rows, config, turns, lengths, batch_rngs, batch_maps)
-        observations = core.observations(batch, all_rows, config, batch_maps)
+        group = batch_maps.group(batch, all_rows, config)
+        outcome = core.step(batch, group, turns, lengths, batch_rngs)
+        observations = core.observations(batch, group)
         for row, (state, maps, rngs) in enumerate(singles):
-            single = core.step(
-                state, one, config, turns[row : row + 1], lengths[row : row + 1], rngs, maps
-            )
+            alone = maps.group(state, one, config)
+            single = core.step(state, alone, turns[row : row + 1], lengths[row : row + 1], rngs)
             assert single.rewards[0] == outcome.rewards[row]
             assert single.frame_changed[0] == outcome.frame_changed[row]
-            assert np.array_equal(core.observations(state, one, config, maps)[0], observations[row])
+            assert np.array_equal(core.observations(state, alone)[0], observations[row])
             assert np.array_equal(state.positions[0], batch.positions[row])
     assert np.any(batch.frame_changed)  # the maps really fused movements
 
@@ -46,13 +47,14 @@ def test_a_batch_steps_as_its_rows_one_at_a_time() -> None:
 def test_a_group_step_leaves_the_other_rows_untouched() -> None:
     config = EnvConfig.create(scenario="khepera")
     state, maps, rngs = started_batch(config, 4, seed=3)
-    before = {name: np.copy(value) for name, value in vars(state).items()}
+    before = {name: np.copy(getattr(state, name)) for name in STATE_ARRAYS}
     areas_before = maps.batch(4, config).areas.copy()
     group = np.array([1, 3])
     turns, lengths = CONTINUOUS.decode(config, np.array([[0.3, 1.0], [-0.2, 1.0]]))
-    core.step(state, group, config, turns, lengths, [rngs[1], rngs[3]], maps)
+    core.step(state, maps.group(state, group, config), turns, lengths, [rngs[1], rngs[3]])
     others = np.array([0, 2])
-    for name, value in vars(state).items():
+    for name in STATE_ARRAYS:
+        value = getattr(state, name)
         if name == "trajectory":
             continue  # may have grown; the used entries are compared below
         assert np.array_equal(value[others], before[name][others], equal_nan=True), name
@@ -66,10 +68,10 @@ def test_the_trajectory_grows_past_its_first_capacity() -> None:
     state, maps, rngs = started_batch(config, 2, seed=0)
     rows = np.arange(2)
     visited = [state.positions.copy()]
-    steps = 2 * core.INITIAL_TRAJECTORY_SLOTS + 3
+    steps = 2 * INITIAL_TRAJECTORY_SLOTS + 3
     for action in np.random.default_rng(1).uniform(-1, 1, (steps, 2, 2)):
         turns, lengths = CONTINUOUS.decode(config, action)
-        core.step(state, rows, config, turns, lengths, rngs, maps)
+        core.step(state, maps.group(state, rows, config), turns, lengths, rngs)
         visited.append(state.positions.copy())
     assert np.all(state.trajectory_length == steps + 1)
     assert np.array_equal(state.trajectory[:, : steps + 1], np.stack(visited, axis=1))

@@ -12,7 +12,7 @@ import torch
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.agents import SB3Policy
 from bearing_env.agents.extractors import LandmarkSetExtractor, LandmarkSetPolicy
-from bearing_env.envs.core import ENTITY_FEATURES
+from bearing_env.envs.observations import ENTITY_FEATURES
 from bearing_env.train.sb3.train import train
 from bearing_env.train.sb3.zoo import parse_hyperparameters, read_hyperparameters
 from tests.test_train import TINY_TIMESTEPS, tiny_settings

@@ -309,7 +309,7 @@ def test_env_fusion_change_gives_a_new_map() -> None:
 
 def test_missed_detections_are_nan_readings_that_the_map_skips() -> None:
     from bearing_env.envs import BearingSLAMEnv
-    from bearing_env.envs.core import observation_slices
+    from bearing_env.envs.observations import observation_slices
 
     noise = {"kind": "uniform", "detection_rate": 0.7}
     env = BearingSLAMEnv(scenario="khepera", noise=noise, fusion="relaxed")

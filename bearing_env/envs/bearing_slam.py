@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
-import math
 from collections.abc import Collection, Mapping
 from typing import Any, ClassVar, Generic, SupportsFloat, TypeVar, cast
 
@@ -34,15 +33,18 @@ from bearing_env.envs.config import (
     EnvConfig,
     settings_signature,
 )
-from bearing_env.envs.core import (
+from bearing_env.envs.core import MapBank, WorldView
+from bearing_env.envs.observations import (
+    BEARING_FEATURES,
     FL_COORD_LIMIT,
-    BatchState,
-    MapBank,
-    WorldView,
+    LANDMARK_FEATURES,
+    ROBOT_FEATURES,
+    ObservationSpec,
     observation_size,
     observation_slices,
+    spec_for,
 )
-from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
+from bearing_env.envs.state import BatchState
 from bearing_env.slam import PolygonSLAM
 from bearing_env.world import Arena, NoiseModel
 
@@ -198,7 +200,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     With `observation="entities"` the observation is a `Dict` of the same numbers:
     `"robot"` (the 9 elements above) and `"landmarks"`, a table of one row per landmark
     slot L1 .. LM, flattened row by row (a Box of `M * 8`; reshape to `(M, 8)`), with the
-    columns `core.ENTITY_FEATURES`: present, is-frame (L1 and L2, at (0, 0) and (1, 0)),
+    columns `observations.ENTITY_FEATURES`: present, is-frame (L1 and L2, at (0, 0) and (1, 0)),
     not initialised, estimate x, y, log-area (`log(1e-10)` for the exact L1 and L2) and
     the latest bearing's cos and sin. Absent rows are zeros.
 
@@ -370,13 +372,10 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         self._config = config
         self.render_mode = render_mode
         self.action_space = self._make_action_space()
+        #: The observation kind's spec (the kind cannot change on a live env).
+        self.observation_spec: ObservationSpec = spec_for(config)
         # Any: the entity kind's Dict space is not the Box the class's type parameter names.
-        self.observation_space = cast(
-            Any,
-            entity_observation_space(config)
-            if config.observation == "entities"
-            else observation_space(config),
-        )
+        self.observation_space = cast(Any, self.observation_spec.space(config))
         #: The batch of one this env is; its row index array, for the core's functions.
         self._rows = np.array([0])
         self._state = BatchState.empty(1, config.max_landmarks)
@@ -449,8 +448,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         core.reset_rows(self._state, rows, config, [self.np_random], self._maps)
         if self._world is None:
             self._world = WorldView(self, 0)
-        observation = core.observations(self._state, rows, config, self._maps)[0]
-        infos = core.infos(self._state, rows, config, self._maps, core.reset_outcome(1))
+        group = self._maps.group(self._state, rows, config)
+        observation = core.observations(self._state, group)[0]
+        infos = core.infos(self._state, group, core.reset_outcome(1))
         if self.render_mode == "human":
             self.render()
         return self._observation(observation), core.row_info(infos, 0)
@@ -462,16 +462,14 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             raise RuntimeError("call reset() before step()")
         if self._state.done[0]:
             raise RuntimeError(
-                "the episode has ended (terminated or truncated): call reset() before "
-                "step() again"
+                "the episode has ended (terminated or truncated): call reset() before step() again"
             )
         turns, lengths = self._decode_batch(self._checked_action(action)[None])
         rows, config = self._rows, self.config
-        outcome = core.step(
-            self._state, rows, config, turns, lengths, [self.np_random], self._maps
-        )
-        observation = core.observations(self._state, rows, config, self._maps)[0]
-        info = core.row_info(core.infos(self._state, rows, config, self._maps, outcome), 0)
+        group = self._maps.group(self._state, rows, config)
+        outcome = core.step(self._state, group, turns, lengths, [self.np_random])
+        observation = core.observations(self._state, group)[0]
+        info = core.row_info(core.infos(self._state, group, outcome), 0)
         if self.render_mode == "human":
             self.render()
         return (
@@ -484,9 +482,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     def _observation(self, flat: NDArray[np.float32]) -> Any:
         """The observation of the env's kind from the flat vector."""
-        if self.config.observation == "entities":
-            return core.entity_observations(flat, self.config.max_landmarks)
-        return flat
+        return self.observation_spec.convert(flat, self.config.max_landmarks)
 
     def render(self) -> NDArray[np.uint8] | None:
         if self.render_mode is None:
@@ -500,9 +496,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         if self._renderer is None:
             from bearing_env.rendering import Renderer
 
-            self._renderer = Renderer(
-                self.render_mode, self.arena, fps=self.metadata["render_fps"]
-            )
+            self._renderer = Renderer(self.render_mode, self.arena, fps=self.metadata["render_fps"])
         return self._renderer.render(core.scene(self._state, 0, self.config, self.slam))
 
     def close(self) -> None:
@@ -569,51 +563,6 @@ def check_reset_options(options: object, known: Collection[str] = ()) -> Mapping
         expected = f"expected keys among {sorted(known)!r}" if known else "it takes none"
         raise TypeError(f"unknown reset options {unknown!r}; {expected}")
     return options
-
-
-def observation_space(config: EnvConfig) -> spaces.Box[np.float32]:
-    """The observation space of envs with ``config`` (see the Observation Space section)."""
-    log_min, log_max = math.log(AREA_FLOOR), math.log(config.area_cap)
-    robot_low = [-FL_COORD_LIMIT, -FL_COORD_LIMIT, log_min, 0, -1, -1, 0, 0, 0]
-    robot_high = [FL_COORD_LIMIT, FL_COORD_LIMIT, log_max, 1, 1, 1, 1, 1, 1]
-    landmark_low = [0, 0, -FL_COORD_LIMIT, -FL_COORD_LIMIT, min(log_min, 0.0)]
-    landmark_high = [1, 1, FL_COORD_LIMIT, FL_COORD_LIMIT, max(log_max, 0.0)]
-    bearing_low, bearing_high = [0, -1, -1], [1, 1, 1]
-    n_slots = config.max_landmarks
-    low = np.concatenate(
-        [robot_low, np.tile(landmark_low, n_slots - 2), np.tile(bearing_low, n_slots)]
-    )
-    high = np.concatenate(
-        [robot_high, np.tile(landmark_high, n_slots - 2), np.tile(bearing_high, n_slots)]
-    )
-    # Rounding to float32 must not leave a computed value outside its own bound.
-    return spaces.Box(
-        np.nextafter(low.astype(np.float32), np.float32(-np.inf)),
-        np.nextafter(high.astype(np.float32), np.float32(np.inf)),
-        dtype=np.float32,
-    )
-
-
-def entity_observation_space(config: EnvConfig) -> spaces.Dict:
-    """The observation space of ``observation="entities"``: the flat space's bounds,
-    rearranged as :func:`~bearing_env.envs.core.entity_observations` rearranges the values
-    (each table column's bounds are its extremes over the slots)."""
-    flat = observation_space(config)
-    low = core.entity_observations(flat.low, config.max_landmarks)
-    high = core.entity_observations(flat.high, config.max_landmarks)
-    rows = (config.max_landmarks, len(core.ENTITY_FEATURES))
-    table_low = np.minimum(low["landmarks"], high["landmarks"]).reshape(rows).min(axis=0)
-    table_high = np.maximum(low["landmarks"], high["landmarks"]).reshape(rows).max(axis=0)
-    return spaces.Dict(
-        {
-            "robot": spaces.Box(low["robot"], high["robot"], dtype=np.float32),
-            "landmarks": spaces.Box(
-                np.tile(table_low, config.max_landmarks),
-                np.tile(table_high, config.max_landmarks),
-                dtype=np.float32,
-            ),
-        }
-    )
 
 
 def constructor_signature(env_class: type[BearingSLAMEnv]) -> inspect.Signature:

@@ -22,7 +22,9 @@ from bearing_env.envs.actions import CONTINUOUS, DISCRETE, ActionSpec
 from bearing_env.envs.bearing_slam import BearingSLAMEnv, Setting, check_reset_options
 from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
 from bearing_env.envs.config import MAX_N_LANDMARKS, EnvConfig
-from bearing_env.envs.core import BatchState, MapBank, WorldView
+from bearing_env.envs.core import MapBank, WorldView
+from bearing_env.envs.observations import observation_size
+from bearing_env.envs.state import BatchState
 from bearing_env.validation import int_at_least, is_integer
 
 AUTORESET_MODES = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP, AutoresetMode.DISABLED)
@@ -46,7 +48,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
     `num_envs` copies of :class:`~bearing_env.envs.bearing_slam.BearingSLAMEnv` stepped
     together. The sub-envs are rows of one structure of arrays
-    (:class:`~bearing_env.envs.core.BatchState`), and each step is a few compiled kernel
+    (:class:`~bearing_env.envs.state.BatchState`), and each step is a few compiled kernel
     calls per group of rows with the same settings (`EnvConfig`) and landmark count: all
     robots move at once, all maps fuse their movement in one
     :class:`BatchedPolygonSLAM` update (most of the work), and observations, rewards and
@@ -172,8 +174,8 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         #: Landmark slots of the per-landmark info arrays when counts vary per episode.
         self._info_slots = first.max_landmarks - 2 if first.has_count_range else None
         #: The sub-envs' observations, flat (the observation kind cannot change per env).
-        self._flat_shape = (self.num_envs, core.observation_size(first.max_landmarks))
-        self._entities = first.observation == "entities"
+        self._flat_shape = (self.num_envs, observation_size(first.max_landmarks))
+        self._observation_spec = prototype.observation_spec
         self._max_landmarks = first.max_landmarks
         self._autoreset_envs = np.zeros(self.num_envs, dtype=bool)
         self._elapsed_steps = np.zeros(self.num_envs, dtype=np.int64)
@@ -201,8 +203,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         seeds = self._seeds(seed)
         if not self._has_reset and not mask.all():
             raise ValueError(
-                "the first reset() must reset every sub-env, got options['reset_mask'] = "
-                f"{mask!r}"
+                f"the first reset() must reset every sub-env, got options['reset_mask'] = {mask!r}"
             )
         rows = np.flatnonzero(mask)
         for row in rows.tolist():
@@ -256,17 +257,16 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         finished: list[IntArray] = []
         for config, rows, turns, lengths in groups:
             rngs = [self._rng(row) for row in rows.tolist()]
-            outcome = core.step(self._state, rows, config, turns, lengths, rngs, self._maps)
-            observations[rows] = core.observations(self._state, rows, config, self._maps)
+            group = self._maps.group(self._state, rows, config)
+            outcome = core.step(self._state, group, turns, lengths, rngs)
+            observations[rows] = core.observations(self._state, group)
             rewards[rows] = outcome.rewards
             terminations[rows] = outcome.terminated
             truncations[rows] = outcome.truncated
             self._elapsed_steps[rows] += 1
             if self.max_episode_steps is not None:
                 truncations[rows] |= self._elapsed_steps[rows] >= self.max_episode_steps
-            group_infos = self._padded(
-                core.infos(self._state, rows, config, self._maps, outcome)
-            )
+            group_infos = self._padded(core.infos(self._state, group, outcome))
             infos = self._merge_rows(infos, group_infos, rows)
             if self.autoreset_mode == AutoresetMode.SAME_STEP:
                 ended = np.flatnonzero(terminations[rows] | truncations[rows])
@@ -286,9 +286,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
     def _observation(self, flat: NDArray[np.float32]) -> Any:
         """Observations of the sub-envs' kind from flat ones (as the single env's)."""
-        if self._entities:
-            return core.entity_observations(flat, self._max_landmarks)
-        return flat
+        return self._observation_spec.convert(flat, self._max_landmarks)
 
     def render(self) -> tuple[Any, ...] | None:
         if self.render_mode is None:
@@ -453,8 +451,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         if not isinstance(mask, np.ndarray) or mask.dtype != np.bool_:
             kind = f"dtype {mask.dtype}" if isinstance(mask, np.ndarray) else type(mask).__name__
             raise TypeError(
-                f"options['reset_mask'] must be a numpy array of dtype bool, got {mask!r} "
-                f"({kind})"
+                f"options['reset_mask'] must be a numpy array of dtype bool, got {mask!r} ({kind})"
             )
         if mask.shape != (self.num_envs,):
             raise ValueError(
@@ -462,9 +459,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
                 f"sub-env, got shape {mask.shape}: {mask!r}"
             )
         if not mask.any():
-            raise ValueError(
-                f"options['reset_mask'] must reset at least one sub-env, got {mask!r}"
-            )
+            raise ValueError(f"options['reset_mask'] must reset at least one sub-env, got {mask!r}")
         return mask.copy()
 
     def _reset_rows(
@@ -478,17 +473,14 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             rngs = [self._rng(row) for row in group.tolist()]
             core.reset_rows(self._state, group, config, rngs, self._maps)
         for config, group in self._groups(rows):
-            observations[group] = core.observations(self._state, group, config, self._maps)
-            reset_infos = core.infos(
-                self._state, group, config, self._maps, core.reset_outcome(group.size)
-            )
+            rows_group = self._maps.group(self._state, group, config)
+            observations[group] = core.observations(self._state, rows_group)
+            reset_infos = core.infos(self._state, rows_group, core.reset_outcome(group.size))
             infos = self._merge_rows(infos, self._padded(reset_infos), group)
         self._elapsed_steps[rows] = 0
         return infos
 
-    def _groups(
-        self, rows: IntArray, by_count: bool = True
-    ) -> list[tuple[EnvConfig, IntArray]]:
+    def _groups(self, rows: IntArray, by_count: bool = True) -> list[tuple[EnvConfig, IntArray]]:
         """``rows`` split into groups that step as one batch: same config and (unless
         ``by_count`` is False) same landmark count, so one map batch. Sub-envs share their
         config unless ``set_attr`` changed some; each distinct config gets its own group."""
@@ -569,9 +561,7 @@ class BearingSLAMDiscreteVectorEnv(BearingSLAMVectorEnv):
 
 
 #: Sub-env attributes the vector env serves itself (see ``_row_attribute``).
-_ROW_ATTRIBUTES = frozenset(
-    {"n_landmarks", "slam", "world", "observation_space", "action_space"}
-)
+_ROW_ATTRIBUTES = frozenset({"n_landmarks", "slam", "world", "observation_space", "action_space"})
 
 
 def _select_rows(batched: dict[str, Any], rows: IntArray) -> dict[str, Any]:

@@ -76,7 +76,7 @@ MAX_ACTION_TABLE = 4096
 
 REWARDS: tuple[str, ...] = ("log_area", "area")
 #: Observation kinds: the flat Box (default) or a Dict of a robot block and a landmark
-#: table (``bearing_env.envs.core.entity_observations``).
+#: table (``bearing_env.envs.observations.EntityObservation``).
 OBSERVATIONS: tuple[str, ...] = ("flat", "entities")
 
 
@@ -241,8 +241,7 @@ class EnvConfig:
         lo_eps, hi_eps = EPSILON_DEG_RANGE
         if not lo_eps < float(self.epsilon_deg) < hi_eps:
             raise ValueError(
-                f"epsilon_deg must be in ({lo_eps:g}, {hi_eps:g}) degrees, "
-                f"got {self.epsilon_deg!r}"
+                f"epsilon_deg must be in ({lo_eps:g}, {hi_eps:g}) degrees, got {self.epsilon_deg!r}"
             )
         normalise("epsilon_deg", float(self.epsilon_deg))
         normalise("noise", NoiseModel.parse(self.noise))

@@ -1,6 +1,7 @@
 """The envs' pure functional core: world state and bookkeeping of a batch, as arrays.
 
-In the spirit of Gymnasium's ``phys2d/cartpole.py``: one :class:`BatchState` holds the
+In the spirit of Gymnasium's ``phys2d/cartpole.py``: one
+:class:`~bearing_env.envs.state.BatchState` holds the
 state of ``N`` envs as a structure of arrays (one row per env), and plain functions
 compute on a group of rows at once:
 
@@ -16,22 +17,24 @@ random draw comes from the row's own generator, in the same order as in a batch 
 
 A *group* is a set of rows that share one :class:`~bearing_env.envs.config.EnvConfig`
 and one landmark count ``n`` (so one map batch, and arrays ``[:, :n]`` without padding).
-The functions below take a group's row indices; rows with other settings are untouched.
+The functions below take a :class:`Group` (its rows, config, landmark count, map batch
+and kernel inputs), which :meth:`MapBank.group` builds once per step; rows outside it are
+untouched.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
-from dataclasses import dataclass, fields
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env.envs import kernels, robot_map
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig, MapSettings
-from bearing_env.envs.kernels import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
+from bearing_env.envs.kernels import Settings
+from bearing_env.envs.observations import FL_COORD_LIMIT, observation_size
+from bearing_env.envs.state import BatchState
 from bearing_env.numerics import wrap_angle
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import (
@@ -53,174 +56,10 @@ IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 ComplexArray = NDArray[np.complex128]
 
-#: FL coordinates in the observation are clipped to +-this (the frame is |L1 - L2| = 1, so
-#: this is 50 baselines away: far beyond any landmark of a sensible layout).
-FL_COORD_LIMIT = 50.0
-
-#: Trajectory slots allocated per row at first; the array doubles when a row fills it.
-INITIAL_TRAJECTORY_SLOTS = 32
-
-
-def observation_size(max_landmarks: int) -> int:
-    """Length of the observation vector for ``max_landmarks`` landmark slots."""
-    return (
-        len(ROBOT_FEATURES)
-        + len(LANDMARK_FEATURES) * (max_landmarks - 2)
-        + len(BEARING_FEATURES) * max_landmarks
-    )
-
-
-def observation_slices(max_landmarks: int) -> dict[str, slice]:
-    """Where each block lives in the observation vector.
-
-    ``"robot"`` is the robot block; ``"landmarks"`` reshapes to ``(max_landmarks - 2,
-    len(LANDMARK_FEATURES))``; ``"bearings"`` to ``(max_landmarks, len(BEARING_FEATURES))``.
-    """
-    robot_end = len(ROBOT_FEATURES)
-    landmarks_end = robot_end + len(LANDMARK_FEATURES) * (max_landmarks - 2)
-    return {
-        "robot": slice(0, robot_end),
-        "landmarks": slice(robot_end, landmarks_end),
-        "bearings": slice(landmarks_end, observation_size(max_landmarks)),
-    }
-
-
-#: The columns of the entity observation's landmark table, one row per landmark slot
-#: (L1, L2, L3, ...): present, is-frame (L1 and L2, fixed at (0, 0) and (1, 0) in FL),
-#: not initialised yet, the estimate in FL, the log-area, and the latest bearing.
-ENTITY_FEATURES: tuple[str, ...] = (
-    "present",
-    "is_frame",
-    "uninitialised",
-    "x",
-    "y",
-    "log_area",
-    "bearing_cos",
-    "bearing_sin",
-)
-
-
-def entity_observations(flat: NDArray[np.float32], max_landmarks: int) -> dict[str, Any]:
-    """The entity view of flat observations (..., observation_size): the same numbers,
-    rearranged. ``"robot"`` (..., len(ROBOT_FEATURES)) is the robot block;
-    ``"landmarks"`` (..., max_landmarks * len(ENTITY_FEATURES)) is the landmark table, a
-    row per slot, flattened row by row (a 1-D Box per observation, as SB3's checker
-    wants: reshape to (max_landmarks, len(ENTITY_FEATURES))). L1 and L2 are the frame:
-    estimate (0, 0) and (1, 0), exact (log-area ``log(AREA_FLOOR)``). Rows of absent
-    landmarks are all zeros.
-    """
-    flat = np.asarray(flat, dtype=np.float32)
-    blocks = observation_slices(max_landmarks)
-    lead = flat.shape[:-1]
-    mapped = flat[..., blocks["landmarks"]].reshape(*lead, max_landmarks - 2, -1)
-    bearings = flat[..., blocks["bearings"]].reshape(*lead, max_landmarks, -1)
-    table = np.zeros((*lead, max_landmarks, len(ENTITY_FEATURES)), dtype=np.float32)
-    column = {name: index for index, name in enumerate(ENTITY_FEATURES)}
-    landmark = {name: index for index, name in enumerate(LANDMARK_FEATURES)}
-    bearing = {name: index for index, name in enumerate(BEARING_FEATURES)}
-    table[..., column["present"]] = bearings[..., bearing["present"]]
-    frame = table[..., :2, :]
-    frame[..., column["is_frame"]] = frame[..., column["present"]]
-    frame[..., 1, column["x"]] = frame[..., 1, column["present"]]
-    exact = np.float32(math.log(AREA_FLOOR))
-    frame[..., column["log_area"]] = exact * frame[..., column["present"]]
-    for name in ("uninitialised", "x", "y", "log_area"):
-        table[..., 2:, column[name]] = mapped[..., landmark[name]]
-    table[..., column["bearing_cos"]] = bearings[..., bearing["cos"]]
-    table[..., column["bearing_sin"]] = bearings[..., bearing["sin"]]
-    return {"robot": flat[..., blocks["robot"]].copy(), "landmarks": table.reshape(*lead, -1)}
-
 
 # ----------------------------------------------------------------------------------------
 # State
 # ----------------------------------------------------------------------------------------
-
-
-@dataclass
-class BatchState:
-    """World state and env bookkeeping of ``num_rows`` envs, one row each.
-
-    Per-landmark arrays have ``slots`` columns (the largest landmark count a row can
-    have); row ``i`` uses the first ``n_landmarks[i]`` (the rest are zeros).
-    """
-
-    #: Landmarks in each row's current episode.
-    n_landmarks: IntArray
-    #: True landmark positions (N, slots, 2), metres; L1 first.
-    landmarks: FloatArray
-    #: True robot positions (N, 2), metres, and headings (N,), radians CCW from +x.
-    positions: FloatArray
-    headings: FloatArray
-    #: FL frame per row: FL = (world - origin) / unit, as complex numbers (fixed per episode).
-    frame_origin: ComplexArray
-    frame_unit: ComplexArray
-    #: True FL positions (N, slots - 2) of landmarks L3.., for the info.
-    landmarks_fl: ComplexArray
-    #: Moves made this episode, and the potential Phi after the latest one.
-    moves: IntArray
-    potentials: FloatArray
-    #: The latest reading (N, slots), relative to the current heading.
-    latest_bearings: FloatArray
-    #: The last movement's first reading and start position (NaN before the first move).
-    start_bearings: FloatArray
-    start_positions: FloatArray
-    #: Flags of the last movement: it changed frames (updated the map); the wall stopped it.
-    frame_changed: BoolArray
-    blocked: BoolArray
-    #: Whether the episode has ended (terminated or truncated) and needs a reset.
-    done: BoolArray
-    #: Robot positions since the reset (N, capacity, 2), for rendering; the first
-    #: ``trajectory_length[i]`` entries of row ``i`` are used.
-    trajectory: FloatArray
-    trajectory_length: IntArray
-
-    @classmethod
-    def empty(cls, num_rows: int, slots: int) -> BatchState:
-        """A batch of rows that have not been reset yet."""
-        n = num_rows
-        return cls(
-            n_landmarks=np.zeros(n, dtype=np.int64),
-            landmarks=np.zeros((n, slots, 2)),
-            positions=np.zeros((n, 2)),
-            headings=np.zeros(n),
-            frame_origin=np.zeros(n, dtype=complex),
-            frame_unit=np.ones(n, dtype=complex),
-            landmarks_fl=np.zeros((n, slots - 2), dtype=complex),
-            moves=np.zeros(n, dtype=np.int64),
-            potentials=np.zeros(n),
-            latest_bearings=np.zeros((n, slots)),
-            start_bearings=np.full((n, slots), np.nan),
-            start_positions=np.full((n, 2), np.nan),
-            frame_changed=np.zeros(n, dtype=bool),
-            blocked=np.zeros(n, dtype=bool),
-            done=np.zeros(n, dtype=bool),
-            trajectory=np.zeros((n, INITIAL_TRAJECTORY_SLOTS, 2)),
-            trajectory_length=np.zeros(n, dtype=np.int64),
-        )
-
-    @property
-    def num_rows(self) -> int:
-        return int(self.n_landmarks.shape[0])
-
-    def writable(self) -> BatchState:
-        """This state with every array writable: read-only arrays (e.g. from an
-        out-of-band pickle with read-only buffers) are copied, the others kept."""
-        arrays = {
-            f.name: np.require(getattr(self, f.name), requirements=["W"]) for f in fields(self)
-        }
-        return BatchState(**arrays)
-
-    def append_positions(self, rows: IntArray) -> None:
-        """Record the rows' current positions in their trajectories."""
-        if not kernels.append_positions(
-            rows, self.positions, self.trajectory, self.trajectory_length
-        ):
-            # Some row is full: double the capacity (for every row) and record again.
-            capacity = self.trajectory.shape[1]
-            grown = np.zeros((self.num_rows, 2 * capacity, 2))
-            grown[:, :capacity] = self.trajectory
-            self.trajectory = grown
-            kernels.append_positions(rows, self.positions, self.trajectory, self.trajectory_length)
 
 
 class MapBank:
@@ -228,21 +67,42 @@ class MapBank:
     transfer), each with a row per env (row ``i`` of every batch belongs to env ``i``).
 
     Envs whose landmark count varies switch batches at reset; their rows in the other
-    batches are simply left idle.
+    batches are simply left idle. The bank also keeps each (config, landmark count)'s
+    kernel inputs (:meth:`group`).
     """
 
     def __init__(self, num_rows: int) -> None:
         self.num_rows = num_rows
         self.batches: dict[tuple[int, MapSettings], BatchedPolygonSLAM] = {}
         self._views: dict[tuple[int, MapSettings, int], PolygonSLAM] = {}
+        #: Each (landmark count, config)'s kernel inputs (an ``InputsRef``), with the
+        #: state and map references they were made of.
+        self._inputs: dict[tuple[int, EnvConfig], tuple[Any, Any, kernels.Inputs]] = {}
+
+    def group(self, state: BatchState, rows: IntArray, config: EnvConfig) -> Group:
+        """The group of ``rows`` (all with ``config`` and one landmark count), with its
+        kernel inputs: made once per (config, count) and state, then reused."""
+        n = int(state.n_landmarks[rows[0]])
+        state_ref = state.kernel_ref()
+        last = self.__dict__.get("_last")
+        if last is None or last[0] is not config or last[1] != n or last[2] is not state_ref:
+            last = self._last = (config, n, state_ref, *self._inputs_for(n, config, state_ref))
+        return Group(rows, config, n, last[3], last[4])
 
     def batch(self, n_landmarks: int, config: EnvConfig) -> BatchedPolygonSLAM:
-        last = self.__dict__.get("_last")
-        if last is not None and last[0] is config and last[1] == n_landmarks:
-            return last[2]  # the common case: asked again for the same group's batch
-        key = (int(n_landmarks), config.map_settings)
-        self._last = (config, n_landmarks, self._batch_for(key))
-        return self._last[2]
+        return self._batch_for((int(n_landmarks), config.map_settings))
+
+    def _inputs_for(
+        self, n: int, config: EnvConfig, state_ref: BatchState
+    ) -> tuple[BatchedPolygonSLAM, kernels.Inputs]:
+        batch = self._batch_for((n, config.map_settings))
+        maps_ref = batch._kernel_state()
+        kept = self._inputs.get((n, config))
+        if kept is None or kept[0] is not state_ref or kept[1] is not maps_ref:
+            settings = kernel_settings(n, config)
+            inputs = kernels.inputs_ref(kernels.Inputs(settings, maps_ref, state_ref))
+            kept = self._inputs[n, config] = (state_ref, maps_ref, inputs)
+        return batch, kept[2]
 
     def _batch_for(self, key: tuple[int, MapSettings]) -> BatchedPolygonSLAM:
         if key not in self.batches:
@@ -256,6 +116,45 @@ class MapBank:
         if key not in self._views:
             self._views[key] = PolygonSLAM.view(self.batch(n_landmarks, config), row)
         return self._views[key]
+
+    def __getstate__(self) -> dict[str, Any]:
+        # The kernel inputs (structrefs) cannot be pickled; they are made again.
+        state = {key: value for key, value in self.__dict__.items() if key != "_last"}
+        state["_inputs"] = {}
+        return state
+
+
+class Group(NamedTuple):
+    """A group's rows and everything its kernels take, found once per step
+    (:meth:`MapBank.group`)."""
+
+    rows: IntArray
+    config: EnvConfig
+    n: int  #: the rows' landmark count
+    batch: BatchedPolygonSLAM  #: their maps
+    inputs: kernels.Inputs  #: what the kernels take (an ``InputsRef``)
+
+
+def kernel_settings(n_landmarks: int, config: EnvConfig) -> Settings:
+    """The kernels' settings of a group of ``config`` with ``n_landmarks`` landmarks."""
+    arena = config.arena
+    return Settings(
+        n=int(n_landmarks),
+        n_slots=int(config.max_landmarks),
+        width=float(arena.width),
+        height=float(arena.height),
+        margin=float(arena.wall_margin),
+        min_baseline=float(arena.min_baseline),
+        log_area=config.reward == "log_area",
+        floor=AREA_FLOOR,
+        cap=float(config.area_cap),
+        target_area=float(config.target_area),
+        max_moves=int(config.max_moves),
+        path_cost=float(config.path_cost),
+        move_cost=float(config.move_cost),
+        coordinate_limit=FL_COORD_LIMIT,
+        tolerance=CONTAINMENT_TOLERANCE,
+    )
 
 
 def check_config_switch(old: EnvConfig, new: EnvConfig, action_grid_fixed: bool) -> None:
@@ -284,9 +183,7 @@ def check_config_switch(old: EnvConfig, new: EnvConfig, action_grid_fixed: bool)
         )
 
 
-def switch_maps(
-    state: BatchState, maps: MapBank, row: int, old: EnvConfig, new: EnvConfig
-) -> None:
+def switch_maps(state: BatchState, maps: MapBank, row: int, old: EnvConfig, new: EnvConfig) -> None:
     """After a config change of row ``row``: an empty map if the map's settings (epsilon,
     transfer, fusion, ...) changed, since the row may have stale state in that other map
     batch."""
@@ -357,9 +254,7 @@ class WorldView:
 
     def true_bearings(self) -> FloatArray:
         """Noise-free bearings (n,) of all landmarks, relative to the heading, [-pi, pi)."""
-        return true_bearings(
-            self.landmarks[None], self.position[None], np.array([self.heading])
-        )[0]
+        return true_bearings(self.landmarks[None], self.position[None], np.array([self.heading]))[0]
 
     def copy(self) -> World:
         """An independent, mutable snapshot of this ground truth."""
@@ -433,9 +328,9 @@ def reset_rows(
         readings = config.noise.corrupt_rows(group_rngs, truth, config.epsilon)
         state.latest_bearings[group] = 0.0
         state.latest_bearings[group, :n] = readings
-        batch = maps.batch(n, config)
-        batch.reset(group)
-        state.potentials[group] = potentials(group, batch, config)
+        rows_group = maps.group(state, group, config)
+        rows_group.batch.reset(group)
+        state.potentials[group] = potentials(state, rows_group)
 
 
 def group_rows(state: BatchState, rows: IntArray) -> list[tuple[int, IntArray]]:
@@ -452,8 +347,7 @@ def group_rows(state: BatchState, rows: IntArray) -> list[tuple[int, IntArray]]:
 # ----------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class StepOutcome:
+class StepOutcome(NamedTuple):
     """What one step of a group did, per row (arrays of the group's length)."""
 
     rewards: FloatArray
@@ -470,12 +364,10 @@ class StepOutcome:
 
 def step(
     state: BatchState,
-    rows: IntArray,
-    config: EnvConfig,
+    group: Group,
     turns: FloatArray,
     lengths: FloatArray,
     rngs: Sequence[np.random.Generator],
-    maps: MapBank,
 ) -> StepOutcome:
     """One movement of every row of a group (same config, same landmark count ``n``):
     turn, read, move straight (stopped at the wall), read, update the map.
@@ -483,99 +375,70 @@ def step(
     ``turns`` and ``lengths`` are decoded actions (radians, metres); ``rngs[j]`` is row
     ``rows[j]``'s generator.
     """
-    n = int(state.n_landmarks[rows[0]])
-    arena, noise, epsilon = config.arena, config.noise, config.epsilon
-    min_baseline = arena.min_baseline
+    rows, config, n = group.rows, group.config, group.n
     size = rows.size
     # Each row draws its first reading's noise, then its second's, from its generator.
-    first_draws, second_draws = noise.draw_movement_rows(rngs, n, epsilon)
-    first, second = _draws_as_arrays(first_draws), _draws_as_arrays(second_draws)
-    travelled = np.empty(size)
-    start_bearings = np.empty((size, n))
-    end_bearings = np.empty((size, n))
+    first, second = config.noise.draw_movement_rows(rngs, n, config.epsilon)
+    travelled, start, end = np.empty(size), np.empty((size, n)), np.empty((size, n))
     kernels.move_and_read(
         rows,
         np.ascontiguousarray(turns, dtype=np.float64),
         np.ascontiguousarray(lengths, dtype=np.float64),
-        n,
-        arena.width,
-        arena.height,
-        arena.wall_margin,
-        min_baseline,
-        *first,
-        *second,
-        state.positions,
-        state.headings,
-        state.landmarks,
-        state.start_positions,
-        state.start_bearings,
-        state.latest_bearings,
-        state.moves,
-        state.blocked,
+        group.inputs,
+        _draws_for_kernel(first),
+        _draws_for_kernel(second),
         travelled,
-        start_bearings,
-        end_bearings,
+        start,
+        end,
     )
     state.append_positions(rows)
 
     # A move that could not start took both readings from the same place: there is no
     # robot frame (R1 = R2), so the SLAM must not see it. The robot knows it did not move
     # (it is stuck against the wall).
-    changes_map = travelled >= min_baseline
+    changes_map = travelled >= config.arena.min_baseline
     frame_changed = np.zeros(size, dtype=bool)
     inconsistent = np.zeros(size, dtype=np.int64)
-    batch = maps.batch(n, config)
+    batch = group.batch
+    # The readings are the kernel's own float arrays and the rows distinct: the map's
+    # unchecked update is enough.
     if changes_map.all():
-        result = batch.update(start_bearings, end_bearings, maps=rows)
+        result = batch._update_checked(start, end, rows)
         frame_changed, inconsistent = result.frame_changed, result.n_inconsistent
     elif changes_map.any():
         moving = np.flatnonzero(changes_map)
-        result = batch.update(start_bearings[moving], end_bearings[moving], maps=rows[moving])
+        result = batch._update_checked(start[moving], end[moving], rows[moving])
         frame_changed[moving] = result.frame_changed
         inconsistent[moving] = result.n_inconsistent
     state.frame_changed[rows] = frame_changed
 
-    reward, uncertainty, path_cost, move_cost = (np.empty(size) for _ in range(4))
-    terminated = np.empty(size, dtype=bool)
-    truncated = np.empty(size, dtype=bool)
-    kernels.finish_steps(
-        rows,
-        n - 2,
-        config.reward == "log_area",
-        AREA_FLOOR,
-        config.area_cap,
-        config.target_area,
-        config.max_moves,
-        config.path_cost,
-        config.move_cost,
-        travelled,
-        batch.areas,
-        batch.counts,
-        state.potentials,
-        state.moves,
-        state.done,
-        reward,
-        uncertainty,
-        path_cost,
-        move_cost,
-        terminated,
-        truncated,
-    )
-    return StepOutcome(
-        rewards=reward,
-        terminated=terminated,
-        truncated=truncated,
+    outcome = StepOutcome(
+        rewards=np.empty(size),
+        terminated=np.empty(size, dtype=bool),
+        truncated=np.empty(size, dtype=bool),
         frame_changed=frame_changed,
         inconsistent=inconsistent,
         travelled=travelled,
-        uncertainty=uncertainty,
-        path_cost=path_cost,
-        move_cost=move_cost,
+        uncertainty=np.empty(size),
+        path_cost=np.empty(size),
+        move_cost=np.empty(size),
     )
+    kernels.finish_steps(
+        rows,
+        group.inputs,
+        travelled,
+        outcome.rewards,
+        outcome.uncertainty,
+        outcome.path_cost,
+        outcome.move_cost,
+        outcome.terminated,
+        outcome.truncated,
+    )
+    return outcome
 
 
-def _draws_as_arrays(draws: NoiseDraws) -> tuple[FloatArray, BoolArray, FloatArray]:
-    """(offsets, outlier mask, replacements) for the kernel; no outliers: all False."""
+def _draws_for_kernel(draws: NoiseDraws) -> kernels.Draws:
+    """The draws as the kernel takes them; no outliers: an all-False mask."""
     if draws.is_outlier is None or draws.replacement is None:
         return draws.offsets, np.zeros(draws.offsets.shape, dtype=bool), draws.offsets
     return draws.offsets, draws.is_outlier, draws.replacement
@@ -593,88 +456,32 @@ def reset_outcome(size: int) -> StepOutcome:
 # ----------------------------------------------------------------------------------------
 
 
-def potentials(state_rows: IntArray, batch: BatchedPolygonSLAM, config: EnvConfig) -> FloatArray:
-    """The uncertainty potential Phi of the rows' maps (see the env's Rewards section)."""
-    out = np.empty(state_rows.size)
-    kernels.potentials(
-        state_rows,
-        batch.areas,
-        batch.n_landmarks - 2,
-        config.reward == "log_area",
-        AREA_FLOOR,
-        config.area_cap,
-        out,
-    )
+def potentials(state: BatchState, group: Group) -> FloatArray:
+    """The uncertainty potential Phi of the group's maps (see the env's Rewards section)."""
+    out = np.empty(group.rows.size)
+    kernels.potentials(group.rows, group.inputs, out)
     return out
 
 
-def observations(
-    state: BatchState, rows: IntArray, config: EnvConfig, maps: MapBank
-) -> NDArray[np.float32]:
+def observations(state: BatchState, group: Group) -> NDArray[np.float32]:
     """Observations (len(rows), observation_size) of a group (see the env's Observation
     Space section)."""
-    n = int(state.n_landmarks[rows[0]])
-    batch = maps.batch(n, config)
-    out = np.zeros((rows.size, observation_size(config.max_landmarks)), dtype=np.float32)
-    kernels.write_observations(
-        rows,
-        n,
-        config.max_landmarks,
-        AREA_FLOOR,
-        config.area_cap,
-        config.max_moves,
-        FL_COORD_LIMIT,
-        batch.robot_centroid,
-        batch.robot_counts,
-        batch.robot_area,
-        batch.robot_heading,
-        batch.counts,
-        batch.centroids,
-        batch.areas,
-        state.moves,
-        state.frame_changed,
-        state.blocked,
-        state.latest_bearings,
-        out,
-    )
+    size = observation_size(group.config.max_landmarks)
+    out = np.zeros((group.rows.size, size), dtype=np.float32)
+    kernels.write_observations(group.rows, group.inputs, out)
     return out
 
 
-def infos(
-    state: BatchState,
-    rows: IntArray,
-    config: EnvConfig,
-    maps: MapBank,
-    outcome: StepOutcome,
-) -> dict[str, Any]:
+def infos(state: BatchState, group: Group, outcome: StepOutcome) -> dict[str, Any]:
     """The group's infos, batched along a first axis (see the env's Info section)."""
-    n = int(state.n_landmarks[rows[0]])
-    batch = maps.batch(n, config)
-    size, n_mapped = rows.size, n - 2
+    rows, batch = group.rows, group.batch
+    size, n_mapped = rows.size, group.n - 2
     areas = np.empty((size, n_mapped))
     errors = np.empty((size, n_mapped))
     contains = np.empty((size, n_mapped), dtype=bool)
     total_area = np.empty(size)
     robot_error = np.empty(size)
-    kernels.write_infos(
-        rows,
-        n_mapped,
-        CONTAINMENT_TOLERANCE,
-        batch.areas,
-        batch.counts,
-        batch.centroids,
-        batch.vertices,
-        state.landmarks_fl,
-        state.positions,
-        state.frame_origin,
-        state.frame_unit,
-        batch.robot_centroid,
-        areas,
-        errors,
-        contains,
-        total_area,
-        robot_error,
-    )
+    kernels.write_infos(rows, group.inputs, areas, errors, contains, total_area, robot_error)
     return {
         "landmark_area": areas,
         "landmark_error": errors,
@@ -685,7 +492,7 @@ def infos(
         "inconsistent": outcome.inconsistent,
         "outliers": batch.outliers[rows],
         "path_length": outcome.travelled,
-        robot_map.KEY: robot_map.encode(batch, rows, config.max_landmarks - 2),
+        robot_map.KEY: robot_map.encode(batch, rows, group.config.max_landmarks - 2),
         "rewards": {
             "uncertainty": outcome.uncertainty,
             "path_cost": outcome.path_cost,

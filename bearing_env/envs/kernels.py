@@ -5,41 +5,105 @@ These do in one call what would otherwise be dozens of small numpy operations pe
 :mod:`bearing_env.envs.core` calls them for the single env (a group of one row) and the
 vector env alike, so both compute every number with the same code. Random draws stay
 in Python, where each row's own generator makes them (see ``core.step``).
+
+Each kernel takes the group's rows, one :class:`InputsRef` (the group's
+:class:`Settings`, its map batch's state and the envs' ``BatchState``: long-lived, so
+made once and typed by numba in about 1 us per call) and its per-call arrays
+positionally (fresh each step; positional arrays are typed fastest: 5 arrays cost 0.6 us
+positionally, 2.2 us as a namedtuple).
 """
 
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 from numba import njit
+from numba.core import types
+from numba.experimental import structref
+from numpy.typing import NDArray
 
+from bearing_env.envs.observations import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
 from bearing_env.numerics import JIT_OPTIONS as _JIT
 from bearing_env.numerics import wrap
+from bearing_env.slam.kernels import State as MapState
 from bearing_env.slam.kernels import contains_point
 from bearing_env.world import bearing, straight_move
 
-#: Observation layout: the robot block first, then one block per mapped landmark slot
-#: (landmarks L3, L4, ...), then one block per bearing slot (L1, L2, L3, ...).
-#: :func:`write_observations` writes them in this order; the block sizes below are
-#: numba compile-time constants.
-ROBOT_FEATURES: tuple[str, ...] = (
-    "robot_x",
-    "robot_y",
-    "robot_log_area",
-    "robot_unknown",
-    "heading_cos",
-    "heading_sin",
-    "progress",
-    "last_frame_changed",
-    "last_move_blocked",
-)
-LANDMARK_FEATURES: tuple[str, ...] = ("present", "uninitialised", "x", "y", "log_area")
-BEARING_FEATURES: tuple[str, ...] = ("present", "cos", "sin")
+if TYPE_CHECKING:  # only for annotations: that module imports this one
+    from bearing_env.envs.state import BatchState
 
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+#: The flat observation's block sizes (numba compile-time constants), from the feature
+#: tuples of :mod:`bearing_env.envs.observations`; :func:`write_observations` writes the
+#: blocks in that module's order.
 _ROBOT_FEATURES = len(ROBOT_FEATURES)
 _LANDMARK_FEATURES = len(LANDMARK_FEATURES)
 _BEARING_FEATURES = len(BEARING_FEATURES)
+
+
+class Settings(NamedTuple):
+    """A group's settings (one config, one landmark count), as the kernels take them."""
+
+    n: int  #: landmarks of the group's rows
+    n_slots: int  #: the observation's landmark slots (max_landmarks)
+    width: float  #: the arena, metres
+    height: float
+    margin: float  #: the wall margin
+    min_baseline: float  #: shortest move that changes frames
+    log_area: bool  #: the reward's potential sums log-areas (else areas)
+    floor: float  #: areas are floored here before taking logs
+    cap: float  #: and capped here (area_cap)
+    target_area: float  #: success: every landmark's area at most this
+    max_moves: int
+    path_cost: float  #: per metre
+    move_cost: float  #: per move
+    coordinate_limit: float  #: FL coordinates are clipped to +-this in the observation
+    tolerance: float  #: relative tolerance of the info's containment test
+
+
+class Inputs(NamedTuple):
+    """What a group's kernels read and write besides their per-call arrays."""
+
+    settings: Settings
+    maps: MapState  #: the group's map batch (its slam kernels ``StateRef``)
+    state: BatchState  #: the envs' state (its ``BatchStateRef``)
+
+
+@structref.register
+class InputsType(types.StructRef):
+    """numba's type of an :class:`InputsRef`: one field per :class:`Inputs` field."""
+
+    def preprocess_fields(self, fields: Any) -> tuple[tuple[str, Any], ...]:
+        # why (each ignore below): these numba functions carry no annotations
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)  # type: ignore[no-untyped-call]
+
+
+class InputsRef(structref.StructRefProxy):
+    """:class:`Inputs` as the kernels take them: one structref, made once per group and
+    state (see ``core.MapBank.group``). numba types a structref argument once per call
+    (about 1 us here) but a namedtuple field by field, and positional arrays cheaply:
+    so the long-lived inputs travel as this one reference and each call's fresh output
+    arrays positionally."""
+
+
+structref.define_constructor(InputsRef, InputsType, Inputs._fields)  # type: ignore[no-untyped-call]
+structref.define_boxing(InputsType, InputsRef)  # type: ignore[no-untyped-call]
+
+
+@njit(**_JIT)
+def inputs_ref(inputs: Inputs) -> Inputs:
+    """The :class:`InputsRef` of ``inputs`` (annotated as Inputs: the same fields)."""
+    return InputsRef(*inputs)  # type: ignore[no-untyped-call, return-value]
+
+
+#: One reading's pre-drawn noise per row, as :func:`move_and_read` takes it: a plain
+#: tuple (offsets, is-outlier mask (all False without outliers), replacements), each
+#: (len(rows), n); numba types a plain tuple of arrays faster than a namedtuple.
+Draws = tuple[FloatArray, BoolArray, FloatArray]
 
 
 @njit(**_JIT)
@@ -52,61 +116,60 @@ def move_and_read(
     rows: np.ndarray,
     turns: np.ndarray,
     lengths: np.ndarray,
-    n: int,
-    width: float,
-    height: float,
-    margin: float,
-    min_baseline: float,
-    offsets_start: np.ndarray,
-    outlier_start: np.ndarray,
-    replacement_start: np.ndarray,
-    offsets_end: np.ndarray,
-    outlier_end: np.ndarray,
-    replacement_end: np.ndarray,
-    positions: np.ndarray,
-    headings: np.ndarray,
-    landmarks: np.ndarray,
-    start_positions: np.ndarray,
-    start_bearings: np.ndarray,
-    latest_bearings: np.ndarray,
-    moves: np.ndarray,
-    blocked: np.ndarray,
+    inputs: Inputs,
+    first: Draws,
+    second: Draws,
     travelled: np.ndarray,
     reading_start: np.ndarray,
     reading_end: np.ndarray,
 ) -> None:
     """Turn, read, move straight until the wall margin, read again; for each row.
 
-    The readings are the true bearings plus the rows' pre-drawn noise (see
-    :meth:`~bearing_env.world.NoiseModel.draw_rows`), wrapped; out in ``reading_start``
-    and ``reading_end`` (len(rows), n) and ``travelled``. In place: the rows' pose,
-    start position, readings, move count and blocked flag. A robot that could not move
-    at least ``min_baseline`` does not move (see :func:`~bearing_env.world.straight_move`).
+    The readings are the true bearings plus the rows' pre-drawn noise (``first``,
+    ``second``; see :meth:`~bearing_env.world.NoiseModel.draw_rows`), wrapped; out in
+    ``reading_start`` and ``reading_end`` (len(rows), n) and ``travelled``. In place:
+    the rows' pose, start position, readings, move count and blocked flag. A robot that
+    could not move at least ``min_baseline`` does not move (see
+    :func:`~bearing_env.world.straight_move`).
     """
+    settings, state = inputs.settings, inputs.state
+    offsets_start, outlier_start, replacement_start = first
+    offsets_end, outlier_end, replacement_end = second
     for i in range(rows.shape[0]):
         row = rows[i]
-        heading = wrap(headings[row] + turns[i])
-        x, y = positions[row, 0], positions[row, 1]
+        heading = wrap(state.headings[row] + turns[i])
+        x, y = state.positions[row, 0], state.positions[row, 1]
         new_x, new_y, distance, stopped = straight_move(
-            x, y, heading, lengths[i], width, height, margin, min_baseline
+            x,
+            y,
+            heading,
+            lengths[i],
+            settings.width,
+            settings.height,
+            settings.margin,
+            settings.min_baseline,
         )
-        for j in range(n):
-            lx, ly = landmarks[row, j, 0], landmarks[row, j, 1]
-            first = _noisy(
+        for j in range(settings.n):
+            lx, ly = state.landmarks[row, j, 0], state.landmarks[row, j, 1]
+            reading = _noisy(
                 bearing(lx, ly, x, y, heading),
-                offsets_start[i, j], outlier_start[i, j], replacement_start[i, j],
+                offsets_start[i, j],
+                outlier_start[i, j],
+                replacement_start[i, j],
             )
-            second = _noisy(
+            reading_start[i, j] = state.start_bearings[row, j] = reading
+            reading = _noisy(
                 bearing(lx, ly, new_x, new_y, heading),
-                offsets_end[i, j], outlier_end[i, j], replacement_end[i, j],
+                offsets_end[i, j],
+                outlier_end[i, j],
+                replacement_end[i, j],
             )
-            reading_start[i, j] = start_bearings[row, j] = first
-            reading_end[i, j] = latest_bearings[row, j] = second
-        start_positions[row, 0], start_positions[row, 1] = x, y
-        positions[row, 0], positions[row, 1] = new_x, new_y
-        headings[row] = heading
-        blocked[row] = stopped
-        moves[row] += 1
+            reading_end[i, j] = state.latest_bearings[row, j] = reading
+        state.start_positions[row, 0], state.start_positions[row, 1] = x, y
+        state.positions[row, 0], state.positions[row, 1] = new_x, new_y
+        state.headings[row] = heading
+        state.blocked[row] = stopped
+        state.moves[row] += 1
         travelled[i] = distance
 
 
@@ -145,31 +208,21 @@ def potential_of(
 
 
 @njit(**_JIT)
-def potentials(
-    rows: np.ndarray, areas: np.ndarray, n_mapped: int, log_area: bool, floor: float,
-    cap: float, out: np.ndarray,
-) -> None:
+def _potential(settings: Settings, areas: np.ndarray) -> float:
+    return potential_of(areas, settings.n - 2, settings.log_area, settings.floor, settings.cap)
+
+
+@njit(**_JIT)
+def potentials(rows: np.ndarray, inputs: Inputs, out: np.ndarray) -> None:
     for i in range(rows.shape[0]):
-        out[i] = potential_of(areas[rows[i]], n_mapped, log_area, floor, cap)
+        out[i] = _potential(inputs.settings, inputs.maps.areas[rows[i]])
 
 
 @njit(**_JIT)
 def finish_steps(
     rows: np.ndarray,
-    n_mapped: int,
-    log_area: bool,
-    floor: float,
-    cap: float,
-    target_area: float,
-    max_moves: int,
-    path_cost: float,
-    move_cost: float,
+    inputs: Inputs,
     travelled: np.ndarray,
-    areas: np.ndarray,
-    counts: np.ndarray,
-    state_potentials: np.ndarray,
-    moves: np.ndarray,
-    done: np.ndarray,
     reward: np.ndarray,
     uncertainty: np.ndarray,
     path: np.ndarray,
@@ -179,23 +232,24 @@ def finish_steps(
 ) -> None:
     """Rewards (with their named parts), terminations and truncations after the map
     update; the rows' potentials and done flags are updated in place."""
+    settings, maps, state = inputs.settings, inputs.maps, inputs.state
     for i in range(rows.shape[0]):
         row = rows[i]
-        potential = potential_of(areas[row], n_mapped, log_area, floor, cap)
-        uncertainty[i] = state_potentials[row] - potential
-        path[i] = -path_cost * travelled[i]
-        move[i] = -move_cost
+        potential = _potential(settings, maps.areas[row])
+        uncertainty[i] = state.potentials[row] - potential
+        path[i] = -settings.path_cost * travelled[i]
+        move[i] = -settings.move_cost
         # 0.0 + turns an uncertainty of -0.0 into 0.0; the order of the sum is fixed.
         reward[i] = ((0.0 + uncertainty[i]) + path[i]) + move[i]
-        state_potentials[row] = potential
+        state.potentials[row] = potential
         success = True
-        for j in range(n_mapped):
-            if counts[row, j] == 0 or not areas[row, j] <= target_area:
+        for j in range(settings.n - 2):
+            if maps.counts[row, j] == 0 or not maps.areas[row, j] <= settings.target_area:
                 success = False
                 break
         terminated[i] = success
-        truncated[i] = not success and moves[row] >= max_moves
-        done[row] = terminated[i] or truncated[i]
+        truncated[i] = not success and state.moves[row] >= settings.max_moves
+        state.done[row] = terminated[i] or truncated[i]
 
 
 @njit(**_JIT)
@@ -204,80 +258,55 @@ def _coordinate(value: float, limit: float) -> float:
 
 
 @njit(**_JIT)
-def write_observations(
-    rows: np.ndarray,
-    n: int,
-    n_slots: int,
-    floor: float,
-    cap: float,
-    max_moves: int,
-    coordinate_limit: float,
-    robot_centroid: np.ndarray,
-    robot_counts: np.ndarray,
-    robot_area: np.ndarray,
-    robot_heading: np.ndarray,
-    counts: np.ndarray,
-    centroids: np.ndarray,
-    areas: np.ndarray,
-    moves: np.ndarray,
-    frame_changed: np.ndarray,
-    blocked: np.ndarray,
-    latest_bearings: np.ndarray,
-    out: np.ndarray,
-) -> None:
+def write_observations(rows: np.ndarray, inputs: Inputs, out: np.ndarray) -> None:
     """The observations (len(rows), size) of a group, float32 (the env's Observation
     Space section documents every element); ``out`` must be zeros."""
-    bearings_at = _ROBOT_FEATURES + _LANDMARK_FEATURES * (n_slots - 2)
+    settings, maps, state = inputs.settings, inputs.maps, inputs.state
+    floor, cap, limit = settings.floor, settings.cap, settings.coordinate_limit
+    bearings_at = _ROBOT_FEATURES + _LANDMARK_FEATURES * (settings.n_slots - 2)
     log_cap = math.log(cap)
     for i in range(rows.shape[0]):
         row = rows[i]
-        centroid = robot_centroid[row]
-        known = robot_counts[row] > 0 and np.isfinite(centroid.real) and np.isfinite(centroid.imag)
+        centroid = maps.robot_centroid[row]
+        known = (
+            maps.robot_counts[row] > 0 and np.isfinite(centroid.real) and np.isfinite(centroid.imag)
+        )
         if known:
-            out[i, 0] = _coordinate(centroid.real, coordinate_limit)
-            out[i, 1] = _coordinate(centroid.imag, coordinate_limit)
-            out[i, 2] = math.log(capped(robot_area[row], floor, cap))
+            out[i, 0] = _coordinate(centroid.real, limit)
+            out[i, 1] = _coordinate(centroid.imag, limit)
+            out[i, 2] = math.log(capped(maps.robot_area[row], floor, cap))
         else:
             out[i, 2] = log_cap
             out[i, 3] = 1.0
-        heading = robot_heading[row]
+        heading = maps.robot_heading[row]
         if np.isfinite(heading):
             out[i, 4] = math.cos(heading)
             out[i, 5] = math.sin(heading)
-        out[i, 6] = min(moves[row] / max_moves, 1.0)
-        out[i, 7] = 1.0 if frame_changed[row] else 0.0
-        out[i, 8] = 1.0 if blocked[row] else 0.0
-        for j in range(n - 2):
+        out[i, 6] = min(state.moves[row] / settings.max_moves, 1.0)
+        out[i, 7] = 1.0 if state.frame_changed[row] else 0.0
+        out[i, 8] = 1.0 if state.blocked[row] else 0.0
+        for j in range(settings.n - 2):
             at = _ROBOT_FEATURES + _LANDMARK_FEATURES * j
             out[i, at] = 1.0
-            if counts[row, j] > 0:
-                out[i, at + 2] = _coordinate(centroids[row, j].real, coordinate_limit)
-                out[i, at + 3] = _coordinate(centroids[row, j].imag, coordinate_limit)
+            if maps.counts[row, j] > 0:
+                out[i, at + 2] = _coordinate(maps.centroids[row, j].real, limit)
+                out[i, at + 3] = _coordinate(maps.centroids[row, j].imag, limit)
             else:
                 out[i, at + 1] = 1.0
-            out[i, at + 4] = math.log(capped(areas[row, j], floor, cap))
-        for k in range(n):
+            out[i, at + 4] = math.log(capped(maps.areas[row, j], floor, cap))
+        latest = state.latest_bearings
+        for k in range(settings.n):
             at = bearings_at + _BEARING_FEATURES * k
             out[i, at] = 1.0
-            if not math.isnan(latest_bearings[row, k]):  # a missed reading reads (0, 0)
-                out[i, at + 1] = math.cos(latest_bearings[row, k])
-                out[i, at + 2] = math.sin(latest_bearings[row, k])
+            if not math.isnan(latest[row, k]):  # a missed reading reads (0, 0)
+                out[i, at + 1] = math.cos(latest[row, k])
+                out[i, at + 2] = math.sin(latest[row, k])
 
 
 @njit(**_JIT)
 def write_infos(
     rows: np.ndarray,
-    n_mapped: int,
-    relative_tolerance: float,
-    areas: np.ndarray,
-    counts: np.ndarray,
-    centroids: np.ndarray,
-    vertices: np.ndarray,
-    landmarks_fl: np.ndarray,
-    positions: np.ndarray,
-    frame_origin: np.ndarray,
-    frame_unit: np.ndarray,
-    robot_centroid: np.ndarray,
+    inputs: Inputs,
     landmark_area: np.ndarray,
     landmark_error: np.ndarray,
     contains_truth: np.ndarray,
@@ -285,29 +314,29 @@ def write_infos(
     robot_error: np.ndarray,
 ) -> None:
     """The ground-truth parts of a group's infos (see the env's Info section)."""
+    settings, maps, state = inputs.settings, inputs.maps, inputs.state
     for i in range(rows.shape[0]):
         row = rows[i]
         total = 0.0
-        for j in range(n_mapped):
-            area = areas[row, j]
+        for j in range(settings.n - 2):
+            area = maps.areas[row, j]
             landmark_area[i, j] = area
             total += area
-            count = counts[row, j]
+            count = maps.counts[row, j]
             if count > 0:
-                truth = landmarks_fl[row, j]
-                landmark_error[i, j] = abs(centroids[row, j] - truth)
+                truth = state.landmarks_fl[row, j]
+                landmark_error[i, j] = abs(maps.centroids[row, j] - truth)
                 contains_truth[i, j] = contains_point(
-                    vertices[row, j], count, truth, relative_tolerance
+                    maps.vertices[row, j], count, truth, settings.tolerance
                 )
             else:
                 landmark_error[i, j] = np.inf
                 contains_truth[i, j] = False
         total_area[i] = total
-        centroid = robot_centroid[row]
+        centroid = maps.robot_centroid[row]
         if np.isfinite(centroid.real) and np.isfinite(centroid.imag):
-            truth = (complex(positions[row, 0], positions[row, 1]) - frame_origin[row]) / (
-                frame_unit[row]
-            )
+            position = complex(state.positions[row, 0], state.positions[row, 1])
+            truth = (position - state.frame_origin[row]) / state.frame_unit[row]
             robot_error[i] = abs(centroid - truth)
         else:
             robot_error[i] = np.inf

@@ -1,0 +1,195 @@
+"""The observation specs: one per observation kind, the one home of its features, its
+space and its conversion from the flat vector the kernels write.
+
+Every observation starts as the flat vector (float32) that
+:func:`bearing_env.envs.kernels.write_observations` writes: the robot block
+(:data:`ROBOT_FEATURES`), one block per mapped landmark slot L3, L4, ...
+(:data:`LANDMARK_FEATURES`), then one block per bearing slot L1, L2, ...
+(:data:`BEARING_FEATURES`). The kernels' block sizes are the lengths of these tuples.
+
+* :data:`FLAT` (``observation="flat"``, the default): that vector, a ``Box``.
+* :data:`ENTITIES` (``observation="entities"``): a ``Dict`` of the robot block and a
+  landmark table, a row per slot with the columns :data:`ENTITY_FEATURES` (the same
+  numbers, rearranged).
+
+An env picks its spec once (:func:`spec_for`); the rest asks the spec.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, ClassVar
+
+import numpy as np
+from gymnasium import spaces
+from numpy.typing import NDArray
+
+from bearing_env.envs.config import AREA_FLOOR, EnvConfig
+
+#: The robot block, first in the flat vector.
+ROBOT_FEATURES: tuple[str, ...] = (
+    "robot_x",
+    "robot_y",
+    "robot_log_area",
+    "robot_unknown",
+    "heading_cos",
+    "heading_sin",
+    "progress",
+    "last_frame_changed",
+    "last_move_blocked",
+)
+#: One block per mapped landmark slot (L3, L4, ...), after the robot block.
+LANDMARK_FEATURES: tuple[str, ...] = ("present", "uninitialised", "x", "y", "log_area")
+#: One block per bearing slot (L1, L2, L3, ...), last.
+BEARING_FEATURES: tuple[str, ...] = ("present", "cos", "sin")
+
+#: The columns of the entity observation's landmark table, one row per landmark slot
+#: (L1, L2, L3, ...): present, is-frame (L1 and L2, fixed at (0, 0) and (1, 0) in FL),
+#: not initialised yet, the estimate in FL, the log-area, and the latest bearing.
+ENTITY_FEATURES: tuple[str, ...] = (
+    "present",
+    "is_frame",
+    "uninitialised",
+    "x",
+    "y",
+    "log_area",
+    "bearing_cos",
+    "bearing_sin",
+)
+
+#: FL coordinates in the observation are clipped to +-this (the frame is |L1 - L2| = 1, so
+#: this is 50 baselines away: far beyond any landmark of a sensible layout).
+FL_COORD_LIMIT = 50.0
+
+
+def observation_size(max_landmarks: int) -> int:
+    """Length of the flat observation vector for ``max_landmarks`` landmark slots."""
+    return (
+        len(ROBOT_FEATURES)
+        + len(LANDMARK_FEATURES) * (max_landmarks - 2)
+        + len(BEARING_FEATURES) * max_landmarks
+    )
+
+
+def observation_slices(max_landmarks: int) -> dict[str, slice]:
+    """Where each block lives in the flat observation vector.
+
+    ``"robot"`` is the robot block; ``"landmarks"`` reshapes to ``(max_landmarks - 2,
+    len(LANDMARK_FEATURES))``; ``"bearings"`` to ``(max_landmarks, len(BEARING_FEATURES))``.
+    """
+    robot_end = len(ROBOT_FEATURES)
+    landmarks_end = robot_end + len(LANDMARK_FEATURES) * (max_landmarks - 2)
+    return {
+        "robot": slice(0, robot_end),
+        "landmarks": slice(robot_end, landmarks_end),
+        "bearings": slice(landmarks_end, observation_size(max_landmarks)),
+    }
+
+
+class FlatObservation:
+    """``observation="flat"``: the flat vector itself (see the module doc)."""
+
+    kind: ClassVar[str] = "flat"
+
+    def space(self, config: EnvConfig) -> spaces.Space[Any]:
+        """The Box of envs with ``config`` (the env's Observation Space section)."""
+        log_min, log_max = math.log(AREA_FLOOR), math.log(config.area_cap)
+        limit = FL_COORD_LIMIT
+        # (low, high) per feature, in the order of ROBOT_, LANDMARK_ and BEARING_FEATURES.
+        robot_low = [-limit, -limit, log_min, 0, -1, -1, 0, 0, 0]
+        robot_high = [limit, limit, log_max, 1, 1, 1, 1, 1, 1]
+        landmark_low = [0, 0, -limit, -limit, min(log_min, 0.0)]
+        landmark_high = [1, 1, limit, limit, max(log_max, 0.0)]
+        bearing_low, bearing_high = [0, -1, -1], [1, 1, 1]
+        n_slots = config.max_landmarks
+        low = np.concatenate(
+            [robot_low, np.tile(landmark_low, n_slots - 2), np.tile(bearing_low, n_slots)]
+        )
+        high = np.concatenate(
+            [robot_high, np.tile(landmark_high, n_slots - 2), np.tile(bearing_high, n_slots)]
+        )
+        # Rounding to float32 must not leave a computed value outside its own bound.
+        return spaces.Box(
+            np.nextafter(low.astype(np.float32), np.float32(-np.inf)),
+            np.nextafter(high.astype(np.float32), np.float32(np.inf)),
+            dtype=np.float32,
+        )
+
+    def convert(self, flat: NDArray[np.float32], max_landmarks: int) -> Any:
+        """The observation from flat vectors: they are it."""
+        return flat
+
+
+class EntityObservation:
+    """``observation="entities"``: a robot block and a landmark table (see the module doc)."""
+
+    kind: ClassVar[str] = "entities"
+    #: The landmark table's columns.
+    features: ClassVar[tuple[str, ...]] = ENTITY_FEATURES
+
+    def space(self, config: EnvConfig) -> spaces.Space[Any]:
+        """The flat space's bounds, rearranged as :meth:`convert` rearranges the values
+        (each table column's bounds are its extremes over the slots)."""
+        flat = FLAT.space(config)
+        assert isinstance(flat, spaces.Box)
+        slots = config.max_landmarks
+        low, high = self.convert(flat.low, slots), self.convert(flat.high, slots)
+        rows = (slots, len(ENTITY_FEATURES))
+        table_low = np.minimum(low["landmarks"], high["landmarks"]).reshape(rows).min(axis=0)
+        table_high = np.maximum(low["landmarks"], high["landmarks"]).reshape(rows).max(axis=0)
+        return spaces.Dict(
+            {
+                "robot": spaces.Box(low["robot"], high["robot"], dtype=np.float32),
+                "landmarks": spaces.Box(
+                    np.tile(table_low, slots), np.tile(table_high, slots), dtype=np.float32
+                ),
+            }
+        )
+
+    def convert(self, flat: NDArray[np.float32], max_landmarks: int) -> dict[str, Any]:
+        """The entity view of flat observations (..., observation_size): the same numbers,
+        rearranged. ``"robot"`` (..., len(ROBOT_FEATURES)) is the robot block;
+        ``"landmarks"`` (..., max_landmarks * len(ENTITY_FEATURES)) is the landmark table,
+        a row per slot, flattened row by row (a 1-D Box per observation, as SB3's checker
+        wants: reshape to (max_landmarks, len(ENTITY_FEATURES))). L1 and L2 are the frame:
+        estimate (0, 0) and (1, 0), exact (log-area ``log(AREA_FLOOR)``). Rows of absent
+        landmarks are all zeros.
+        """
+        flat = np.asarray(flat, dtype=np.float32)
+        blocks = observation_slices(max_landmarks)
+        lead = flat.shape[:-1]
+        mapped = flat[..., blocks["landmarks"]].reshape(*lead, max_landmarks - 2, -1)
+        bearings = flat[..., blocks["bearings"]].reshape(*lead, max_landmarks, -1)
+        table = np.zeros((*lead, max_landmarks, len(ENTITY_FEATURES)), dtype=np.float32)
+        column = {name: index for index, name in enumerate(ENTITY_FEATURES)}
+        landmark = {name: index for index, name in enumerate(LANDMARK_FEATURES)}
+        bearing = {name: index for index, name in enumerate(BEARING_FEATURES)}
+        table[..., column["present"]] = bearings[..., bearing["present"]]
+        frame = table[..., :2, :]
+        frame[..., column["is_frame"]] = frame[..., column["present"]]
+        frame[..., 1, column["x"]] = frame[..., 1, column["present"]]
+        exact = np.float32(math.log(AREA_FLOOR))
+        frame[..., column["log_area"]] = exact * frame[..., column["present"]]
+        for name in ("uninitialised", "x", "y", "log_area"):
+            table[..., 2:, column[name]] = mapped[..., landmark[name]]
+        table[..., column["bearing_cos"]] = bearings[..., bearing["cos"]]
+        table[..., column["bearing_sin"]] = bearings[..., bearing["sin"]]
+        robot = flat[..., blocks["robot"]].copy()
+        return {"robot": robot, "landmarks": table.reshape(*lead, -1)}
+
+
+FLAT = FlatObservation()
+ENTITIES = EntityObservation()
+ObservationSpec = FlatObservation | EntityObservation
+#: The spec of each ``config.observation`` kind.
+SPECS: dict[str, ObservationSpec] = {spec.kind: spec for spec in (FLAT, ENTITIES)}
+
+
+def spec_for(config: EnvConfig) -> ObservationSpec:
+    """The observation spec of envs with ``config``."""
+    return SPECS[config.observation]
+
+
+def entity_observations(flat: NDArray[np.float32], max_landmarks: int) -> dict[str, Any]:
+    """:meth:`EntityObservation.convert` (the entity view of flat observations)."""
+    return ENTITIES.convert(flat, max_landmarks)
