@@ -20,11 +20,8 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import asdict, replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -33,6 +30,7 @@ from bearing_env.slam.audit import SearchReport, SearchSettings, search
 from bearing_env.train.common.cli_values import COUNT, SEED
 from bearing_env.train.common.errors import exit_on_output_errors
 from bearing_env.train.common.files import write_json_atomically
+from bearing_env.train.common.progress import progress_bar
 
 COLUMNS = (
     "movements", "regions", "not_simple_convex", "shapely_invalid", "area_mismatches",
@@ -46,26 +44,15 @@ def run(
     """Check at least ``movements`` movements, ``batch`` maps at a time, from ``seed``."""
     rng = np.random.default_rng(seed)
     report = SearchReport()
-    with _bar(movements, settings.transfer, progress) as advance:
+    with progress_bar(movements, desc=settings.transfer, unit="mv", enabled=progress) as bar:
         try:
             while report.movements < movements:
                 maps = min(batch, -(-(movements - report.movements) // settings.moves))
                 report.add(search(settings, maps, rng))
-                advance(maps * settings.moves)
+                bar.update(maps * settings.moves)
         except KeyboardInterrupt:
             print("interrupted: the figures cover what was checked so far", file=sys.stderr)
     return report
-
-
-@contextmanager
-def _bar(total: int, label: str, enabled: bool) -> Iterator[Any]:
-    try:
-        from tqdm.auto import tqdm
-    except ImportError:  # the core install has no tqdm: no bar
-        yield lambda _n: None
-        return
-    with tqdm(total=total, desc=label, unit="mv", disable=not enabled) as bar:
-        yield bar.update
 
 
 def format_rows(reports: dict[str, SearchReport]) -> list[str]:

@@ -34,6 +34,7 @@ import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.train.common.cli_values import COUNT, SEED
 from bearing_env.train.common.errors import exit_on_output_errors
 from bearing_env.train.common.files import write_json_atomically
+from bearing_env.train.common.progress import progress_bar
 
 IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
 
@@ -133,23 +134,15 @@ def run(steps: int, seed: int, episodes: int, progress: bool = False) -> SoakRep
     configurations that all fail before their first step end the soak too."""
     rng = np.random.default_rng(seed)
     report = SoakReport()
-    try:
-        from tqdm.auto import tqdm
-    except ImportError:  # the core install has no tqdm: no bar
-        progress = False
-    bar = tqdm(total=steps, unit="step", desc="soak") if progress else None
-    try:
-        while report.steps < steps and report.configurations < steps:
-            before = report.steps
-            env_id, kwargs = random_configuration(rng)
-            soak_configuration(env_id, kwargs, int(rng.integers(2**31)), episodes, report)
-            if bar is not None:
+    with progress_bar(steps, desc="soak", unit="step", enabled=progress) as bar:
+        try:
+            while report.steps < steps and report.configurations < steps:
+                before = report.steps
+                env_id, kwargs = random_configuration(rng)
+                soak_configuration(env_id, kwargs, int(rng.integers(2**31)), episodes, report)
                 bar.update(report.steps - before)
-    except KeyboardInterrupt:
-        print("interrupted: the counts cover what ran so far", file=sys.stderr)
-    finally:
-        if bar is not None:
-            bar.close()
+        except KeyboardInterrupt:
+            print("interrupted: the counts cover what ran so far", file=sys.stderr)
     return report
 
 

@@ -11,10 +11,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from bearing_env.train.common.errors import (
-    available,
-)
 from bearing_env.train.common.files import atomic_write_text
+from bearing_env.train.common.progress import progress_bar
 from bearing_env.train.compare.config import CompareConfig
 from bearing_env.train.compare.log import LOG_NAME, EpisodeLog
 from bearing_env.train.compare.report import write_outputs
@@ -43,34 +41,6 @@ def _check_resumable(existing: Mapping[str, Any], config: CompareConfig) -> None
                 f"cannot resume: policy {label!r} was {old!r} and is now {spec!r}; "
                 "give it another label (spec option label=...) or use another --out"
             )
-
-
-class _NoProgress:
-    """Stands in for a tqdm bar when tqdm is not installed."""
-
-    def __enter__(self) -> _NoProgress:
-        return self
-
-    def __exit__(self, *exc_info: object) -> None:
-        return None
-
-    def update(self, n: int = 1) -> None:
-        pass
-
-
-def _progress(total: int, initial: int, enabled: bool) -> Any:
-    if not available("tqdm"):
-        return _NoProgress()
-    from tqdm.auto import tqdm
-
-    return tqdm(
-        total=total,
-        initial=initial,
-        disable=not enabled,
-        unit="episode",
-        dynamic_ncols=True,
-        desc="compare",
-    )
 
 
 @dataclass
@@ -144,7 +114,10 @@ def run_comparison(
     pending = episode_tasks(config, done)
     tasks = pending if stop_after is None else pending[: max(0, stop_after)]
     n_total = len(config.seeds) * len(config.policies)
-    with _progress(n_total, n_total - len(pending), progress) as bar:
+    done_before = n_total - len(pending)
+    with progress_bar(
+        n_total, initial=done_before, desc="compare", unit="episode", enabled=progress
+    ) as bar:
         for record in executor(tasks, workers):
             log.append(record)  # fsynced before the next one: a kill loses no logged episode
             records.append(record)

@@ -52,8 +52,9 @@ from typing import Any
 
 from bearing_env.registration import ENV_IDS
 from bearing_env.train.common.cli_values import COUNT, NON_NEGATIVE, SEED, parse_key_values
-from bearing_env.train.common.errors import available, exit_on_output_errors, fail, require
+from bearing_env.train.common.errors import exit_on_output_errors, fail, require
 from bearing_env.train.common.files import atomic_write_text
+from bearing_env.train.common.progress import progress_bar
 from bearing_env.train.common.seeds import TRAINING_SEED_LIMIT
 from bearing_env.train.compare.config import DEFAULT_ENV_KWARGS
 from bearing_env.train.ray.ray_executor import RAY_CONNECT_TIMEOUT, check_ray_address, ray_session
@@ -213,14 +214,6 @@ def _checkpoint_of(output: Path) -> Path | None:
     return None
 
 
-def _progress_bar(total: int, initial: int, enabled: bool) -> Any:
-    if not available("tqdm"):
-        return contextlib.nullcontext(None)
-    from tqdm.auto import tqdm
-
-    return tqdm(total=total, initial=initial, disable=not enabled, unit="iter", desc="rllib ppo")
-
-
 def train_rllib(
     settings: RLlibSettings,
     output: Path,
@@ -284,7 +277,9 @@ def train_rllib(
             if resume and checkpoint is not None:
                 algo.restore_from_path(str(checkpoint.resolve()))
             iteration = done
-            with _progress_bar(settings.iterations, done, progress) as bar:
+            with progress_bar(
+                settings.iterations, initial=done, desc="rllib ppo", unit="iter", enabled=progress
+            ) as bar:
                 while iteration < target:
                     row = iteration_metrics(algo.train())
                     iteration = row["iteration"]
@@ -297,9 +292,8 @@ def train_rllib(
                         checkpoint = _save_checkpoint(algo, output)
                         record.update(checkpoint_iteration=iteration, env_steps=row["env_steps"])
                         write_record("running")
-                    if bar is not None:
-                        bar.update()
-                        bar.set_postfix(ret=row["episode_return_mean"])
+                    bar.update()
+                    bar.set_postfix(ret=row["episode_return_mean"])
         except KeyboardInterrupt:
             write_record("interrupted")
             raise
