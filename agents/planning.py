@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from bearing_env.envs.bearing_slam import AREA_FLOOR
+from bearing_env.envs.config import AREA_FLOOR
 from bearing_env.envs.kernels import potential_of
 from bearing_env.numerics import wrap_angle
 from bearing_env.slam import PolygonSLAM

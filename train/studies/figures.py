@@ -107,7 +107,7 @@ def random_polygonal_trace(
     """Run the random polygonal policy for ``moves`` movements and record the map."""
     from bearing_env.agents import RandomPolygonal
     from bearing_env.agents.env_access import bearing_env_of, world_of
-    from bearing_env.envs.bearing_slam import BEARING_FEATURES, observation_slices
+    from bearing_env.envs.observations import BEARING_FEATURES, observation_slices
     from bearing_env.slam import world_to_fl
 
     # The paper's runs have a fixed number of movements: no early stop on success.
