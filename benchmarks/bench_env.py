@@ -100,6 +100,7 @@ from bearing_env.benchmarks.bench_timing import (
     profile,
 )
 from bearing_env.envs.config import MAX_N_LANDMARKS
+from bearing_env.train.common.cli_parser import command_parser
 from bearing_env.train.common.cli_values import (
     COUNT,
     at_least,
@@ -145,18 +146,27 @@ def _check_env_kwargs(env_kwargs: dict[str, Any]) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="bearing-env bench",
-        description="BearingSLAM-v0 single-env, vector-env and PPO throughput, each as a ratio "
+    parser = command_parser(
+        "bearing-env bench",
+        "BearingSLAM-v0 single-env, vector-env and PPO throughput, each as a ratio "
         "to CartPole-v1 steps/s measured in the same run; printed as a table and written to "
         "JSON. (The world-model update() benchmark: bearing-env bench --slam.)",
     )
-    add = parser.add_argument
+    _add_run_options(parser.add_argument_group("the run"))
+    _add_env_options(parser.add_argument_group("single and vector env sections"))
+    _add_ppo_options(parser.add_argument_group("PPO section"))
+    _add_profile_options(parser.add_argument_group("profiling"))
+    return parser
+
+
+def _add_run_options(group: argparse._ArgumentGroup) -> None:
+    """What is measured, how long, and where the figures go."""
+    add = group.add_argument
     add(
         "--seconds",
         type=seconds,
         default=None,
-        help=f"time per measurement, finite and > 0 ({DEFAULT_SECONDS:g})",
+        help=f"time per measurement, finite and > 0 (default {DEFAULT_SECONDS:g})",
     )
     add("--json", type=Path, default=DEFAULT_JSON, help="output JSON (default %(default)s)")
     add("--no-json", action="store_true", help="do not write the JSON")
@@ -167,6 +177,21 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="SECTION",
         help=f"comma/space separated subset of {','.join(SECTIONS)} (default all)",
     )
+    add(
+        "--quick",
+        action="store_true",
+        help="tiny settings for tests: 0.05 s, 1 and 4 envs, PPO on 2 envs, 8-step rollouts",
+    )
+    add(
+        "--slam",
+        action="store_true",
+        help="run the world-model benchmark (bench_slam.py) instead, with the other arguments",
+    )
+
+
+def _add_env_options(group: argparse._ArgumentGroup) -> None:
+    """The envs of the single and vector sections."""
+    add = group.add_argument
     add(
         "--num-envs",
         nargs="+",
@@ -180,7 +205,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         metavar="N",
         help=f"landmark counts of the single-env random scenario, 3 to {MAX_N_LANDMARKS} "
-        "(default 4,16,64)",
+        "(default " + ",".join(map(str, DEFAULT_SINGLE_LANDMARKS)) + ")",
     )
     add(
         "--env-kwargs",
@@ -189,6 +214,11 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="K=V",
         help="env kwargs of the vector and PPO sections (default scenario=khepera)",
     )
+
+
+def _add_ppo_options(group: argparse._ArgumentGroup) -> None:
+    """The PPO section: its envs, steps, rounds, vec env kinds and hyperparameters."""
+    add = group.add_argument
     add("--ppo-envs", type=COUNT, default=None, help=f"PPO n_envs (default {DEFAULT_PPO_ENVS})")
     add(
         "--ppo-steps",
@@ -215,25 +245,21 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="*",
         default=[],
         metavar="K=V",
-        help="override ppo.yml entries (e.g. n_steps=128 batch_size=256)",
+        help="override ppo.yml entries (e.g. n_steps=128 batch_size=256; default: none)",
     )
-    add(
-        "--quick",
-        action="store_true",
-        help="tiny settings for tests: 0.05 s, 1 and 4 envs, PPO on 2 envs, 8-step rollouts",
-    )
-    add(
+
+
+def _add_profile_options(group: argparse._ArgumentGroup) -> None:
+    """``--profile``: a cProfile of one loop instead of the benchmark."""
+    group.add_argument(
         "--profile",
         choices=("single", "vector"),
-        help="cProfile that loop for --seconds, print the top 25 functions by tottime, exit",
+        help="cProfile that loop for --seconds, print the top 25 functions by tottime, exit "
+        "(default: no profile, the benchmark)",
     )
-    add("--profile-num-envs", type=COUNT, default=64, help="vector env size for --profile vector")
-    add(
-        "--slam",
-        action="store_true",
-        help="run the world-model benchmark (bench_slam.py) instead, with the other arguments",
+    group.add_argument(
+        "--profile-num-envs", type=COUNT, default=64, help="vector env size for --profile vector"
     )
-    return parser
 
 
 @dataclass(frozen=True)

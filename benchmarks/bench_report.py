@@ -12,7 +12,7 @@ import platform
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -22,6 +22,7 @@ from bearing_env.benchmarks.bench_timing import (
     ppo_label,
     vector_label,
 )
+from bearing_env.extras import available
 from bearing_env.train.common.files import atomic_write_text
 
 #: Relative to the working directory, so an installed package never writes into itself.
@@ -331,30 +332,19 @@ def format_target(target: dict[str, Any]) -> str:
 
 
 def print_table(results: dict[str, Any]) -> None:
-    """A rich table when stdout is a terminal wide enough for it, else plain text."""
-    rows = table_rows(results)
-    if sys.stdout.isatty():
-        try:
-            from rich.console import Console
-            from rich.table import Table
-        except ImportError:
-            pass
-        else:
-            console = Console()
-            needed = sum(column_widths([TABLE_HEADER, *rows])) + 3 * len(TABLE_HEADER) + 1
-            if console.width >= needed:
-                table = Table(title=references_line(results))
-                for index, name in enumerate(TABLE_HEADER):
-                    justify: Literal["right", "left"] = (
-                        "right" if index in NUMERIC_COLUMNS else "left"
-                    )
-                    table.add_column(name, justify=justify, no_wrap=True)
-                for row in rows:
-                    table.add_row(*row)
-                console.print(table)
-                for text in table_notes(results):
-                    console.print(text, markup=False, highlight=False)
-                return
+    """A rich table on a terminal (its last columns left out when it is too narrow for
+    them, numbers never split), else plain text."""
+    if sys.stdout.isatty() and available("rich"):
+        from rich.console import Console
+
+        from bearing_env.train.common.tables import print_table as print_rich_table
+
+        console = Console()
+        title = references_line(results)
+        print_rich_table(title, TABLE_HEADER, table_rows(results), console, NUMERIC_COLUMNS)
+        for text in table_notes(results):
+            console.print(text, markup=False, highlight=False)
+        return
     print(format_table(results))
 
 

@@ -27,6 +27,12 @@ import numpy as np
 
 from bearing_env.slam import FUSIONS, TRANSFERS
 from bearing_env.slam.audit import SearchReport, SearchSettings, search
+from bearing_env.train.common.cli_parser import (
+    add_json_output,
+    add_no_progress,
+    command_parser,
+    doc_summary,
+)
 from bearing_env.train.common.cli_values import COUNT, SEED
 from bearing_env.train.common.errors import exit_on_output_errors
 from bearing_env.train.common.files import write_json_atomically
@@ -65,12 +71,10 @@ def format_rows(reports: dict[str, SearchReport]) -> list[str]:
 
 
 def make_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="bearing-env region-search", description=__doc__.splitlines()[0]
-    )
+    parser = command_parser("bearing-env region-search", doc_summary(__doc__))
     parser.add_argument(
         "--movements", type=COUNT, default=2_000_000,
-        help="movements to check per transfer (default 2000000)",
+        help="movements to check per transfer (default %(default)s)",
     )
     parser.add_argument(
         "--transfers", nargs="+", choices=TRANSFERS, default=list(TRANSFERS),
@@ -81,14 +85,17 @@ def make_parser() -> argparse.ArgumentParser:
         "--moves", type=COUNT, default=1,
         help="movements per map before a fresh one (default 1: single movements)",
     )
-    parser.add_argument("--batch", type=COUNT, default=4096, help="maps per batch")
-    parser.add_argument("--seed", type=SEED, default=0, help="search seed")
+    parser.add_argument(
+        "--batch", type=COUNT, default=4096, help="maps per batch (default %(default)s)"
+    )
+    parser.add_argument("--seed", type=SEED, default=0, help="search seed (default %(default)s)")
     parser.add_argument(
         "--noise-fraction", type=float, default=1.0,
-        help="noise bound as a fraction of epsilon; containment is checked when <= 1",
+        help="noise bound as a fraction of epsilon; containment is checked when <= 1 "
+        "(default %(default)s)",
     )
-    parser.add_argument("--json", default=None, help="also write the counts here")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_json_output(parser, "the counts")
+    add_no_progress(parser)
     return parser
 
 

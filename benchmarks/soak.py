@@ -31,6 +31,12 @@ import gymnasium as gym
 import numpy as np
 
 import bearing_env  # noqa: F401  (registers the ids)
+from bearing_env.train.common.cli_parser import (
+    add_json_output,
+    add_no_progress,
+    command_parser,
+    doc_summary,
+)
 from bearing_env.train.common.cli_values import COUNT, SEED
 from bearing_env.train.common.errors import exit_on_output_errors
 from bearing_env.train.common.files import write_json_atomically
@@ -147,14 +153,18 @@ def run(steps: int, seed: int, episodes: int, progress: bool = False) -> SoakRep
 
 
 def make_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="bearing-env soak", description=__doc__.splitlines()[0])
+    parser = command_parser("bearing-env soak", doc_summary(__doc__))
     parser.add_argument(
-        "--steps", type=COUNT, default=1_000_000, help="env steps (default 1000000)"
+        "--steps", type=COUNT, default=1_000_000, help="env steps (default %(default)s)"
     )
-    parser.add_argument("--seed", type=SEED, default=0, help="seed of the configurations")
-    parser.add_argument("--episodes", type=COUNT, default=5, help="episodes per configuration")
-    parser.add_argument("--json", default=None, help="also write the counts here")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument(
+        "--seed", type=SEED, default=0, help="seed of the configurations (default %(default)s)"
+    )
+    parser.add_argument(
+        "--episodes", type=COUNT, default=5, help="episodes per configuration (default %(default)s)"
+    )
+    add_json_output(parser, "the counts")
+    add_no_progress(parser)
     return parser
 
 

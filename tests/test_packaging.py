@@ -76,7 +76,7 @@ def test_the_sdist_carries_the_tests_with_their_helpers(tmp_path: Path) -> None:
         }
     repository_tests = {f"tests/{p.name}" for p in (ROOT / "tests").glob("*.py")}
     assert repository_tests <= names, sorted(repository_tests - names)
-    assert {"LICENSE", "docs/design.md"} <= names
+    assert {"LICENSE", "CITATION.cff", "docs/design.md"} <= names
     assert not [n for n in names if n.endswith((".nbi", ".nbc", ".pyc"))]
 
 

@@ -11,13 +11,17 @@
                                   conservative guarantee at every step (benchmarks/soak.py)
     bearing-env compare [...]     exploration policies on the same evaluation episodes
     bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
+    bearing-env generalisation [...]  a policy trained on random layouts, across landmark
+                                  counts (train/studies/generalisation.py)
     bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (shipped rl-zoo3 files)
     bearing-env hyperparams ALGO  the path of a shipped rl-zoo3 hyperparameter file
     bearing-env rllib [...]       PPO with RLlib, locally or on a Ray cluster (train/ray/rllib.py)
     bearing-env sweep [...]       a Ray Tune grid of RLlib PPO runs (train/ray/sweep.py)
 
-Each subcommand forwards its remaining arguments to the module that implements it, so
-``bearing-env demo --help`` shows that module's options. A subcommand that needs an
+``bearing-env --version`` prints the package's version; ``bearing-env`` alone prints the
+usage and exits with status 2. Each subcommand forwards its remaining arguments to the
+module that implements it, so ``bearing-env demo --help`` shows that module's options,
+each with its default. A subcommand that needs an
 optional extra that is not installed (``train``: stable-baselines3, torch, matplotlib, ...;
 ``render``: pygame; ``ray``: ray, RLlib, Ray Tune) says which one to install,
 ``pip install "bearing_env[train]"``, and exits with status 2. A bad option value ends
@@ -27,10 +31,11 @@ as an argparse usage error (status 2) whose one error line names the option and 
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import sys
 
+from bearing_env import __version__
+from bearing_env.train.common.cli_parser import command_parser, doc_summary
 from bearing_env.train.common.errors import exit_on_missing_extra, exit_quietly_on_broken_pipe
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
@@ -78,21 +83,26 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "bearing_env.train.studies.figures",
         "reproduce the paper's Figs. 7, 10 and 11 in simulation",
     ),
+    "generalisation": (
+        "bearing_env.train.studies.generalisation",
+        "a shipped policy trained on random layouts, across landmark counts",
+    ),
 }
 
 
 def main(argv: list[str] | None = None) -> None:
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = argparse.ArgumentParser(prog="bearing-env", description=__doc__.splitlines()[0])
+    parser = command_parser("bearing-env", doc_summary(__doc__))
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument(
         "command",
         choices=sorted(SUBCOMMANDS),
         help="; ".join(f"{name}: {text}" for name, (_, text) in SUBCOMMANDS.items()),
     )
-    if not argv or argv[0] in ("-h", "--help"):
+    if argv[:1] in (["-h"], ["--help"]):
         parser.print_help()
         return
-    args = parser.parse_args(argv[:1])
+    args = parser.parse_args(argv[:1])  # no command: the usage, and exit status 2
     command, rest = args.command, argv[1:]
     if command == "bench" and "--slam" in rest:  # bearing-env bench --slam == bench-slam
         command, rest = "bench-slam", [arg for arg in rest if arg != "--slam"]

@@ -62,6 +62,7 @@ from pathlib import Path
 from typing import Any
 
 from bearing_env.extras import DISTRIBUTIONS, install_command
+from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import (
     COUNT,
     NON_NEGATIVE,
@@ -107,9 +108,9 @@ QUICK_MAX_MOVES = 10
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="bearing-env compare",
-        description="Compare exploration policies on the same evaluation episodes.",
+    parser = command_parser(
+        "bearing-env compare",
+        "Compare exploration policies on the same evaluation episodes.",
         epilog=(
             "Policy specs: random, parallax, greedy, oracle, lookahead, lookahead_oracle, "
             "pretrained:NAME, sb3:path=MODEL.zip, with options as NAME:key=value,... "
@@ -117,7 +118,16 @@ def build_parser() -> argparse.ArgumentParser:
             f"Evaluation seeds start at {EVAL_SEED_START:,}; training seeds stay below."
         ),
     )
-    parser.add_argument(
+    _add_episode_options(parser.add_argument_group("policies and episodes"))
+    _add_executor_options(parser.add_argument_group("where the episodes run"))
+    _add_output_options(parser.add_argument_group("outputs"))
+    _add_statistics_options(parser.add_argument_group("statistics"))
+    return parser
+
+
+def _add_episode_options(group: argparse._ArgumentGroup) -> None:
+    """What is compared: the policies, the env, the episodes and their seeds."""
+    group.add_argument(
         "--policies",
         nargs="+",
         default=None,
@@ -125,53 +135,69 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"policy specs (default: {' '.join(DEFAULT_POLICIES)}, and every model shipped "
         "in agents/pretrained/ that was trained on this env id and env kwargs)",
     )
-    parser.add_argument("--env", default=DEFAULT_ENV_ID, help="env id (default %(default)s)")
-    parser.add_argument(
+    group.add_argument("--env", default=DEFAULT_ENV_ID, help="env id (default %(default)s)")
+    group.add_argument(
         "--env-kwargs",
         nargs="*",
         default=None,
         metavar="KEY=VALUE",
         help="env kwargs (default: scenario=khepera)",
     )
-    parser.add_argument(
+    group.add_argument(
         "--episodes",
         type=COUNT,
         default=None,
-        help="evaluation episodes per policy (default 200; --quick 20)",
+        help=f"evaluation episodes per policy (default {DEFAULT_EPISODES}; --quick "
+        f"{QUICK_EPISODES})",
     )
-    parser.add_argument(
+    group.add_argument(
         "--seed-start",
         type=SEED,
         default=EVAL_SEED_START,
         help="seed of the first evaluation episode (default %(default)s)",
     )
-    parser.add_argument(
+    group.add_argument(
+        "--quick",
+        action="store_true",
+        help=f"a short run: {QUICK_EPISODES} episodes of {QUICK_MAX_MOVES} moves, "
+        f"policies {' '.join(QUICK_POLICIES)}, Khepera; overwrites its output",
+    )
+
+
+def _add_executor_options(group: argparse._ArgumentGroup) -> None:
+    """Where the episodes run: this process, a local pool, or Ray."""
+    group.add_argument(
         "--workers",
         type=COUNT,
         default=1,
         help="processes to run episodes in, >= 1 (default %(default)s)",
     )
-    parser.add_argument(
+    group.add_argument(
         "--executor",
         choices=EXECUTORS,
         default="local",
         help="local: this process, or --workers processes (default); ray: Ray tasks on a "
         "local Ray instance or the cluster of --ray-address (the ray extra)",
     )
-    parser.add_argument(
+    group.add_argument(
         "--ray-address",
         default=None,
         metavar="ADDRESS",
         help="with --executor ray: the running cluster to join (HOST:PORT, or auto); a "
-        f"HOST:PORT that does not answer within {RAY_CONNECT_TIMEOUT:g} s is refused",
+        f"HOST:PORT that does not answer within {RAY_CONNECT_TIMEOUT:g} s is refused "
+        "(default: a new local Ray instance)",
     )
-    parser.add_argument(
+
+
+def _add_output_options(group: argparse._ArgumentGroup) -> None:
+    """Where the outputs go, what happens to a comparison already there, and what is shown."""
+    group.add_argument(
         "--out",
         type=Path,
         default=None,
         help="output folder (default outputs/compare; with --quick outputs/compare_quick)",
     )
-    again = parser.add_mutually_exclusive_group()
+    again = group.add_mutually_exclusive_group()
     again.add_argument(
         "--resume",
         action="store_true",
@@ -180,34 +206,32 @@ def build_parser() -> argparse.ArgumentParser:
     again.add_argument(
         "--overwrite", action="store_true", help="discard the comparison already in --out"
     )
-    parser.add_argument(
+    group.add_argument(
         "--stop-after",
         type=NON_NEGATIVE,
         default=None,
         metavar="N",
-        help="run at most N new episodes, then write the outputs (resume later)",
+        help="run at most N new episodes, then write the outputs (resume later; "
+        "default: run them all)",
     )
-    parser.add_argument(
-        "--quick",
-        action="store_true",
-        help=f"a short run: {QUICK_EPISODES} episodes of {QUICK_MAX_MOVES} moves, "
-        f"policies {' '.join(QUICK_POLICIES)}, Khepera; overwrites its output",
-    )
-    parser.add_argument(
+    add_no_progress(group)
+    group.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+
+
+def _add_statistics_options(group: argparse._ArgumentGroup) -> None:
+    """The bootstrap behind the confidence intervals."""
+    group.add_argument(
         "--bootstrap",
         type=COUNT,
         default=DEFAULT_BOOTSTRAP,
         help="bootstrap resamples for the CIs, >= 1 (default %(default)s)",
     )
-    parser.add_argument(
+    group.add_argument(
         "--bootstrap-seed",
         type=SEED,
         default=DEFAULT_BOOTSTRAP_SEED,
         help="seed of the bootstrap resampling (default %(default)s)",
     )
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
-    parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
-    return parser
 
 
 def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:

@@ -21,6 +21,7 @@ from bearing_env.train.common.errors import (
     available,
 )
 from bearing_env.train.common.files import atomic_save_figure, atomic_write_text
+from bearing_env.train.common.tables import print_table
 from bearing_env.train.compare.config import CompareConfig
 
 
@@ -158,18 +159,12 @@ def print_tables(
             print(f"\n{title}\n\n{markdown_table(header, rows)}")
         return
     from rich.console import Console
-    from rich.table import Table
 
     console = Console()
     if not console.is_terminal:
         console = Console(width=160)  # a log file: no need to fold the tables
     for title, (header, rows) in tables:
-        table = Table(title=title, show_lines=False)
-        for index, column in enumerate(header):
-            table.add_column(column, no_wrap=index == 0, overflow="fold")
-        for row in rows:
-            table.add_row(*row)
-        console.print(table)
+        print_table(title, header, rows, console)
 
 
 def report_markdown(

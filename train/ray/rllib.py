@@ -51,6 +51,7 @@ from pathlib import Path
 from typing import Any
 
 from bearing_env.registration import ENV_IDS
+from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import COUNT, NON_NEGATIVE, SEED, parse_key_values
 from bearing_env.train.common.errors import exit_on_output_errors, fail, require
 from bearing_env.train.common.files import atomic_write_text
@@ -214,6 +215,85 @@ def _checkpoint_of(output: Path) -> Path | None:
     return None
 
 
+@dataclass
+class _RunFolder:
+    """A run folder while it trains: ``run.json``'s record and ``progress.jsonl``'s rows."""
+
+    output: Path
+    record: dict[str, Any]
+    rows: list[dict[str, Any]]
+    checkpoint: Path | None
+
+    @property
+    def checkpoint_iteration(self) -> int:
+        return int(self.record.get("checkpoint_iteration", 0))
+
+    def write_record(self, status: str) -> None:
+        self.record["status"] = status
+        atomic_write_text(self.output / RUN_NAME, json.dumps(self.record, indent=1) + "\n")
+
+    def append_row(self, row: dict[str, Any]) -> None:
+        """Keep one iteration's metrics, on disk at once (appended and fsynced)."""
+        self.rows.append(row)
+        with open(self.output / PROGRESS_NAME, "a", encoding="utf-8") as handle:
+            handle.write(json.dumps(row) + "\n")
+            handle.flush()
+            os.fsync(handle.fileno())
+
+
+def _open_run_folder(settings: RLlibSettings, output: Path, resume: bool) -> _RunFolder:
+    """The run folder ready for a new segment: the old record checked (``resume``) or no
+    run there (a new one), ``progress.jsonl`` cut back to the checkpoint, the segment's
+    seed recorded and ``run.json`` marked running."""
+    run_path = output / RUN_NAME
+    record: dict[str, Any] = {"settings": settings.to_json()}
+    checkpoint = _checkpoint_of(output)
+    if resume:
+        if checkpoint is None or not run_path.exists():
+            raise ValueError(f"cannot resume: {output} holds no checkpoint; drop --resume")
+        old = json.loads(run_path.read_text(encoding="utf-8"))
+        mismatched = {
+            key: (old["settings"].get(key), value)
+            for key, value in settings.to_json().items()
+            if key not in ("iterations", "checkpoint_every") and old["settings"].get(key) != value
+        }
+        if mismatched:
+            raise ValueError(f"cannot resume: the run in {output} has other settings {mismatched}")
+        record = {**old, "settings": settings.to_json()}
+    elif run_path.exists() or checkpoint is not None:
+        raise FileExistsError(f"{output} already holds a run; pass --resume to continue it")
+    done = int(record.get("checkpoint_iteration", 0))
+    rows = _read_progress(output / PROGRESS_NAME, done)
+    output.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(output / PROGRESS_NAME, "".join(json.dumps(row) + "\n" for row in rows))
+    folder = _RunFolder(output=output, record=record, rows=rows, checkpoint=checkpoint)
+    segment = {"start_iteration": done, "seed": settings.segment_seed(done)}
+    record.setdefault("segments", []).append(segment)
+    folder.write_record("running")
+    return folder
+
+
+def _train_iterations(
+    algo: Any, settings: RLlibSettings, folder: _RunFolder, target: int, progress: bool
+) -> None:
+    """Train up to iteration ``target``, logging each and checkpointing every
+    ``checkpoint_every`` iterations and at the last."""
+    iteration = done = folder.checkpoint_iteration
+    with progress_bar(
+        settings.iterations, initial=done, desc="rllib ppo", unit="iter", enabled=progress
+    ) as bar:
+        while iteration < target:
+            row = iteration_metrics(algo.train())
+            iteration = row["iteration"]
+            folder.append_row(row)
+            if iteration % settings.checkpoint_every == 0 or iteration >= target:
+                folder.checkpoint = _save_checkpoint(algo, folder.output)
+                folder.record.update(checkpoint_iteration=iteration, env_steps=row["env_steps"])
+                folder.write_record("running")
+            bar.update()
+            bar.set_postfix(ret=row["episode_return_mean"])
+
+
 def train_rllib(
     settings: RLlibSettings,
     output: Path,
@@ -238,76 +318,31 @@ def train_rllib(
         FileExistsError: ``output`` holds a run and ``resume`` is False.
         ValueError: ``resume`` with other settings, or without a checkpoint.
     """
-    output = Path(output)
-    run_path, progress_path = output / RUN_NAME, output / PROGRESS_NAME
-    record: dict[str, Any] = {"settings": settings.to_json()}
-    checkpoint = _checkpoint_of(output)
-    if resume:
-        if checkpoint is None or not run_path.exists():
-            raise ValueError(f"cannot resume: {output} holds no checkpoint; drop --resume")
-        old = json.loads(run_path.read_text(encoding="utf-8"))
-        mismatched = {
-            key: (old["settings"].get(key), value)
-            for key, value in settings.to_json().items()
-            if key not in ("iterations", "checkpoint_every") and old["settings"].get(key) != value
-        }
-        if mismatched:
-            raise ValueError(f"cannot resume: the run in {output} has other settings {mismatched}")
-        record = {**old, "settings": settings.to_json()}
-    elif run_path.exists() or checkpoint is not None:
-        raise FileExistsError(f"{output} already holds a run; pass --resume to continue it")
-    done = int(record.get("checkpoint_iteration", 0))
-    rows = _read_progress(progress_path, done)
-    output.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(progress_path, "".join(json.dumps(row) + "\n" for row in rows))
-
-    def write_record(status: str) -> None:
-        record["status"] = status
-        atomic_write_text(run_path, json.dumps(record, indent=1) + "\n")
-
-    segment_seed = settings.segment_seed(done)
-    record.setdefault("segments", []).append({"start_iteration": done, "seed": segment_seed})
-    write_record("running")
+    folder = _open_run_folder(settings, Path(output), resume)
+    done = folder.checkpoint_iteration
     target = settings.iterations
     if stop_after is not None:
         target = min(target, done + max(0, stop_after))
     with ray_session(address) as _ray:
-        algo = ppo_config(settings, segment_seed).build_algo()
+        algo = ppo_config(settings, settings.segment_seed(done)).build_algo()
         try:
-            if resume and checkpoint is not None:
-                algo.restore_from_path(str(checkpoint.resolve()))
-            iteration = done
-            with progress_bar(
-                settings.iterations, initial=done, desc="rllib ppo", unit="iter", enabled=progress
-            ) as bar:
-                while iteration < target:
-                    row = iteration_metrics(algo.train())
-                    iteration = row["iteration"]
-                    rows.append(row)
-                    with open(progress_path, "a", encoding="utf-8") as handle:
-                        handle.write(json.dumps(row) + "\n")
-                        handle.flush()
-                        os.fsync(handle.fileno())
-                    if iteration % settings.checkpoint_every == 0 or iteration >= target:
-                        checkpoint = _save_checkpoint(algo, output)
-                        record.update(checkpoint_iteration=iteration, env_steps=row["env_steps"])
-                        write_record("running")
-                    bar.update()
-                    bar.set_postfix(ret=row["episode_return_mean"])
+            if resume and folder.checkpoint is not None:
+                algo.restore_from_path(str(folder.checkpoint.resolve()))
+            _train_iterations(algo, settings, folder, target, progress)
         except KeyboardInterrupt:
-            write_record("interrupted")
+            folder.write_record("interrupted")
             raise
         finally:
             algo.stop()
-    complete = int(record.get("checkpoint_iteration", 0)) >= settings.iterations
-    write_record("finished" if complete else "stopped")
-    assert checkpoint is not None
+    complete = folder.checkpoint_iteration >= settings.iterations
+    folder.write_record("finished" if complete else "stopped")
+    assert folder.checkpoint is not None
     return RLlibResult(
-        output=output,
-        iterations=int(record.get("checkpoint_iteration", 0)),
-        env_steps=int(record.get("env_steps", 0)),
-        progress=rows,
-        checkpoint=checkpoint,
+        output=folder.output,
+        iterations=folder.checkpoint_iteration,
+        env_steps=int(folder.record.get("env_steps", 0)),
+        progress=folder.rows,
+        checkpoint=folder.checkpoint,
         complete=complete,
     )
 
@@ -380,7 +415,7 @@ def add_settings_arguments(parser: argparse.ArgumentParser) -> None:
         help="a running Ray cluster to join (HOST:PORT, or auto); default a local instance. "
         f"A HOST:PORT that does not answer within {RAY_CONNECT_TIMEOUT:g} s is refused",
     )
-    add("--no-progress", action="store_true", help="no progress bar")
+    add_no_progress(parser)
 
 
 def settings_from_args(args: argparse.Namespace, **overrides: Any) -> RLlibSettings:
@@ -405,9 +440,9 @@ def settings_from_args(args: argparse.Namespace, **overrides: Any) -> RLlibSetti
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="bearing-env rllib",
-        description="Train PPO with RLlib on this machine or a Ray cluster (the ray extra).",
+    parser = command_parser(
+        "bearing-env rllib",
+        "Train PPO with RLlib on this machine or a Ray cluster (the ray extra).",
     )
     add_settings_arguments(parser)
     add = parser.add_argument
@@ -430,7 +465,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=NON_NEGATIVE,
         default=None,
         metavar="N",
-        help="train at most N new iterations, then stop (resume later)",
+        help="train at most N new iterations, then stop (resume later; default: train "
+        "them all)",
     )
     return parser
 

@@ -29,6 +29,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from bearing_env.train.common.cli_parser import command_parser
 from bearing_env.train.common.cli_values import parse_literal
 from bearing_env.train.common.errors import exit_on_output_errors, fail, require
 from bearing_env.train.common.files import atomic_write_text
@@ -207,9 +208,9 @@ def parse_grid(items: Sequence[str], option: str) -> dict[str, list[Any]]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="bearing-env sweep",
-        description="A Ray Tune grid of RLlib PPO runs over hyperparameters or env kwargs.",
+    parser = command_parser(
+        "bearing-env sweep",
+        "A Ray Tune grid of RLlib PPO runs over hyperparameters or env kwargs.",
     )
     add_settings_arguments(parser)
     add = parser.add_argument
@@ -218,16 +219,16 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="*",
         default=[],
         metavar="KEY=V1,V2",
-        help=f"hyperparameter values to sweep; KEY in {', '.join(SWEEPABLE)}",
+        help=f"hyperparameter values to sweep; KEY in {', '.join(SWEEPABLE)} (default: none)",
     )
     add(
         "--env-grid",
         nargs="*",
         default=[],
         metavar="KEY=V1,V2",
-        help="env kwarg values to sweep (e.g. scenario=khepera,random)",
+        help="env kwarg values to sweep (e.g. scenario=khepera,random; default: none)",
     )
-    add("--out", type=Path, default=Path("runs/sweep"), help="output folder (%(default)s)")
+    add("--out", type=Path, default=Path("runs/sweep"), help="output folder (default %(default)s)")
     add("--resume", action="store_true", help="finish the sweep in --out")
     return parser
 

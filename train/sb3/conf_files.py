@@ -13,12 +13,12 @@ needs an optional extra.
 
 from __future__ import annotations
 
-import argparse
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
 from bearing_env.shipped import shipped_dir
+from bearing_env.train.common.cli_parser import command_parser
 
 #: The shipped rl-zoo3 hyperparameter files: ``<algo>.yml``, one entry per env id.
 HYPERPARAMS_DIR = shipped_dir("bearing_env.train.sb3", "hyperparams")
@@ -35,12 +35,16 @@ def default_conf_file(algo: str) -> Path:
 
 
 def main(argv: Sequence[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(
-        prog="bearing-env hyperparams",
-        description="Print the path of a shipped rl-zoo3 hyperparameter file "
+    parser = command_parser(
+        "bearing-env hyperparams",
+        "Print the path of a shipped rl-zoo3 hyperparameter file "
         "(for rl_zoo3.train --conf-file); without ALGO, list them.",
     )
-    parser.add_argument("algo", nargs="?", help=f"one of {', '.join(shipped_algorithms())}")
+    parser.add_argument(
+        "algo",
+        nargs="?",
+        help=f"one of {', '.join(shipped_algorithms())} (default: list them all)",
+    )
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
     if args.algo is None:
         for algo in shipped_algorithms():

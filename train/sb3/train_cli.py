@@ -16,6 +16,7 @@ import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
+from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import (
     COUNT,
     NON_NEGATIVE,
@@ -44,18 +45,44 @@ EXIT_INTERRUPTED = 130
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="bearing-env train",
-        description="Train PPO/SAC (BearingSLAM-v0) or DQN (BearingSLAMDiscrete-v0) with "
+    parser = command_parser(
+        "bearing-env train",
+        "Train PPO/SAC (BearingSLAM-v0) or DQN (BearingSLAMDiscrete-v0) with "
         "stable-baselines3; hyperparameters from the shipped <algo>.yml (rl-zoo3 format; "
         "bearing-env hyperparams ALGO prints its path). "
         "Ctrl-C saves a checkpoint; --resume continues from it.",
     )
-    add = parser.add_argument
-    add("--algo", required=True, choices=sorted(DEFAULT_ENV_IDS))
+    _add_experiment_options(parser.add_argument_group("what is trained"))
+    _add_run_folder_options(parser.add_argument_group("the run folder"))
+    _add_evaluation_options(parser.add_argument_group("evaluation and checkpoints"))
+    _add_process_options(parser.add_argument_group("this process"))
+    return parser
+
+
+def _add_experiment_options(group: argparse._ArgumentGroup) -> None:
+    """The algorithm, the env, the hyperparameters, the length and the seed."""
+    add = group.add_argument
+    add(
+        "--algo",
+        required=True,
+        choices=sorted(DEFAULT_ENV_IDS),
+        help="the algorithm; it picks the default env id and the shipped <algo>.yml",
+    )
     add("--env", help="env id (default BearingSLAM-v0; for dqn BearingSLAMDiscrete-v0)")
-    add("--env-kwargs", nargs="*", default=[], metavar="K=V", help="merged over the YAML's")
-    add("--hyperparams", nargs="*", default=[], metavar="K=V", help="override YAML entries")
+    add(
+        "--env-kwargs",
+        nargs="*",
+        default=[],
+        metavar="K=V",
+        help="merged over the YAML's (default: none)",
+    )
+    add(
+        "--hyperparams",
+        nargs="*",
+        default=[],
+        metavar="K=V",
+        help="override YAML entries (default: none)",
+    )
     add("--conf-file", type=Path, help="hyperparameter file (default: the shipped <algo>.yml)")
     add(
         "--timesteps",
@@ -64,7 +91,7 @@ def build_parser() -> argparse.ArgumentParser:
         "whole rollouts of n_steps x n_envs steps, so it may train a little more: it says "
         "so before it starts",
     )
-    add("--seed", type=SEED, default=0, help="default %(default)s")
+    add("--seed", type=SEED, default=0, help="seed of the run (default %(default)s)")
     add("--n-envs", type=COUNT, help="parallel envs (default the YAML's n_envs)")
     add(
         "--vec-env",
@@ -75,33 +102,56 @@ def build_parser() -> argparse.ArgumentParser:
         "dummy: all in this process; auto (default): batched when the id registers a "
         "batched vector env, else subproc",
     )
+
+
+def _add_run_folder_options(group: argparse._ArgumentGroup) -> None:
+    """Where the run is written, continued from, and exported to."""
+    add = group.add_argument
     add("--output", type=Path, help="run folder (default runs/<algo>_<env>_seed<seed>)")
     add("--resume", action="store_true", help="continue the run in --output from its checkpoint")
+    add(
+        "--export",
+        type=Path,
+        metavar="DIR/NAME",
+        help="after training, copy the best model to DIR/NAME.zip (+ _vecnormalize.pkl, "
+        ".json) (default: no export)",
+    )
+    add("--export-only", action="store_true", help="export the run in --output without training")
+
+
+def _add_evaluation_options(group: argparse._ArgumentGroup) -> None:
+    """How often the run is evaluated and checkpointed."""
+    add = group.add_argument
     add(
         "--eval-freq",
         type=NON_NEGATIVE,
         default=DEFAULT_EVAL_FREQ,
-        help="env steps (0: never; %(default)s)",
+        help="env steps between evaluations (0: never; default %(default)s)",
     )
     add(
         "--eval-episodes",
         type=at_least(1, MAX_VALIDATION_EPISODES),
         default=DEFAULT_EVAL_EPISODES,
-        help="default %(default)s",
+        help="episodes per evaluation (default %(default)s)",
     )
     add(
         "--checkpoint-freq",
         type=COUNT,
         default=DEFAULT_CHECKPOINT_FREQ,
-        help="env steps (%(default)s)",
+        help="env steps between checkpoints (default %(default)s)",
     )
     add(
         "--keep-checkpoints",
         type=COUNT,
         default=DEFAULT_KEEP_CHECKPOINTS,
-        help="default %(default)s",
+        help="checkpoints kept on disk (default %(default)s)",
     )
-    add("--no-progress", action="store_true", help="no progress bar")
+
+
+def _add_process_options(group: argparse._ArgumentGroup) -> None:
+    """What this process shows, logs and computes on."""
+    add = group.add_argument
+    add_no_progress(group)
     add("--no-tensorboard", action="store_true", help="no TensorBoard logs")
     add(
         "--device",
@@ -122,14 +172,6 @@ def build_parser() -> argparse.ArgumentParser:
         default=0,
         help="1: SB3 training tables; -1: no evaluation lines",
     )
-    add(
-        "--export",
-        type=Path,
-        metavar="DIR/NAME",
-        help="after training, copy the best model to DIR/NAME.zip (+ _vecnormalize.pkl, .json)",
-    )
-    add("--export-only", action="store_true", help="export the run in --output without training")
-    return parser
 
 
 def default_output(algo: str, env_id: str, seed: int) -> Path:

@@ -11,7 +11,6 @@ without it the demo runs, prints its tables, and says how to install it.
 
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import sys
@@ -24,6 +23,7 @@ from numpy.typing import NDArray
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.extras import MissingExtraError, available
+from bearing_env.train.common.cli_parser import command_parser, doc_summary
 from bearing_env.train.common.cli_values import COUNT, SEED
 from bearing_env.train.common.errors import fail, write_error_message
 
@@ -98,8 +98,10 @@ def save_animation(frames: list[NDArray[np.uint8]], path: Path) -> Path:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(prog="bearing-env demo", description=__doc__.splitlines()[0])
-    parser.add_argument("--episodes", type=COUNT, default=3, help="default %(default)s")
+    parser = command_parser("bearing-env demo", doc_summary(__doc__))
+    parser.add_argument(
+        "--episodes", type=COUNT, default=3, help="episodes to run (default %(default)s)"
+    )
     parser.add_argument(
         "--moves", type=COUNT, default=DEFAULT_MOVES, help="moves per episode (default %(default)s)"
     )

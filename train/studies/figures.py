@@ -52,9 +52,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env.extras import MissingExtraError, available
+from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import COUNT, SEED
 from bearing_env.train.common.errors import exit_on_output_errors, fail
 from bearing_env.train.common.files import atomic_save_figure, atomic_write_text
+from bearing_env.train.common.progress import NoProgress, progress_bar
 from bearing_env.train.common.seeds import EVAL_SEED_START
 from bearing_env.train.compare.runner import make_env
 
@@ -156,6 +158,18 @@ def random_polygonal_trace(
     )
 
 
+def random_polygonal_traces(
+    env_kwargs: dict[str, Any], seeds: Sequence[int], moves: int, bar: Any
+) -> list[Trace]:
+    """One :func:`random_polygonal_trace` per seed, advancing the progress ``bar`` by one
+    per run."""
+    traces = []
+    for seed in seeds:
+        traces.append(random_polygonal_trace(env_kwargs, seed, moves))
+        bar.update()
+    return traces
+
+
 def linear_fit(x: NDArray[np.float64], y: NDArray[np.float64]) -> dict[str, float]:
     """Least-squares line ``y = slope * x + intercept`` and its coefficient of determination."""
     slope, intercept = np.polyfit(x, y, 1)
@@ -208,6 +222,86 @@ def shows_shrinking(areas: NDArray[np.float64], movements: Sequence[int]) -> boo
     return bool(np.all(np.isfinite(panels[0])) and np.all(np.diff(panels, axis=0) < 0.0))
 
 
+def fig7_run(
+    env_kwargs: dict[str, Any], first_seed: int, max_tries: int
+) -> tuple[int, Trace]:
+    """The first seed from ``first_seed`` whose run shrinks both regions at every panel of
+    Fig. 7, and its trace; RuntimeError naming the range when none of ``max_tries`` does."""
+    moves = max(FIG7_MOVEMENTS)
+    for seed in range(first_seed, first_seed + max_tries):
+        trace = random_polygonal_trace(env_kwargs, seed, moves, keep_polygons=True)
+        if trace.areas.shape[0] > moves and shows_shrinking(trace.areas, FIG7_MOVEMENTS):
+            return seed, trace
+    raise RuntimeError(
+        f"no seed in {first_seed}..{first_seed + max_tries - 1} initialises L3 and L4 on "
+        "the first movement and shrinks both at every panel"
+    )
+
+
+def fig7_frame(trace: Trace) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The lower-left and upper-right corners shared by Fig. 7's panels: the landmarks,
+    the path and the panels' regions, padded."""
+    truth = trace.truth_fl
+    points = [truth, trace.trajectory_fl[: max(FIG7_MOVEMENTS) + 1]]
+    points += [p for m in FIG7_MOVEMENTS for p in trace.polygons[m] if p is not None]
+    cloud = np.concatenate(points)
+    # A huge first-movement region must not shrink everything else to a dot.
+    limit_low, limit_high = truth.min(axis=0) - 1.5, truth.max(axis=0) + 1.5
+    low = np.maximum(cloud.min(axis=0), limit_low) - np.array([0.3, 0.45])
+    high = np.minimum(cloud.max(axis=0), limit_high) + 0.3
+    return low, high
+
+
+FIG7_COLOURS = {"L3": "tab:red", "L4": "tab:blue"}
+
+
+def _draw_fig7_regions(axes: Any, trace: Trace, movement: int) -> None:
+    """A_L3 and A_L4 after ``movement`` movements, labelled, with their estimates."""
+    for j, name in enumerate(("L3", "L4")):
+        polygon = trace.polygons[movement][j]
+        if polygon is not None:
+            colour = FIG7_COLOURS[name]
+            closed = np.vstack([polygon, polygon[:1]])
+            axes.fill(closed[:, 0], closed[:, 1], color=colour, alpha=0.12)
+            axes.plot(closed[:, 0], closed[:, 1], color=colour, lw=1.3)
+            # Label beside the region's right-most vertex, clear of the landmark's name.
+            anchor = polygon[int(np.argmax(polygon[:, 0]))]
+            axes.annotate(
+                f"$A_{{{name}}}$",
+                anchor,
+                xytext=(4, 0),
+                textcoords="offset points",
+                color=colour,
+                fontsize=10,
+                va="center",
+            )
+        estimate = trace.estimates[movement][j]
+        if np.all(np.isfinite(estimate)):
+            axes.plot(*estimate, "o", mfc="none", mec="k", ms=7)
+
+
+def _draw_fig7_panel(
+    axes: Any, trace: Trace, movement: int, frame: tuple[NDArray[np.float64], ...]
+) -> None:
+    """One panel of Fig. 7: the regions, the true landmarks, the path so far, in FL."""
+    _draw_fig7_regions(axes, trace, movement)
+    truth = trace.truth_fl
+    axes.plot(truth[:, 0], truth[:, 1], "k*", ms=11)
+    for index, name in enumerate(("L1", "L2", "L3", "L4")):
+        axes.annotate(name, truth[index], xytext=(-6, -16), textcoords="offset points", fontsize=10)
+    for start, end in itertools.pairwise(trace.trajectory_fl[: movement + 1]):
+        axes.annotate("", end, start, arrowprops={"arrowstyle": "->", "color": "0.35", "lw": 1.1})
+    low, high = frame
+    axes.set_xlim(low[0], high[0])
+    axes.set_ylim(low[1], high[1])
+    axes.set_aspect("equal")
+    axes.tick_params(labelsize=8)
+    axes.set_xlabel("x in FL (FL units)", fontsize=8)
+    axes.set_ylabel("y in FL (FL units)", fontsize=8)
+    title = "initial movement" if movement == 1 else f"{movement} movements"
+    axes.set_title(f"Estimated uncertainty after {title}", fontsize=10)
+
+
 def figure7(
     out: Path,
     first_seed: int = 0,
@@ -217,65 +311,12 @@ def figure7(
 ) -> tuple[Path, dict[str, Any]]:
     """The regions of L3 and L4 after 1, 3, 6 and 9 movements of one run (4 panels)."""
     env_kwargs = figure_env_kwargs("paper_sim", transfer, epsilon_deg)
-    moves = max(FIG7_MOVEMENTS)
-    for seed in range(first_seed, first_seed + max_tries):
-        trace = random_polygonal_trace(env_kwargs, seed, moves, keep_polygons=True)
-        if trace.areas.shape[0] > moves and shows_shrinking(trace.areas, FIG7_MOVEMENTS):
-            break
-    else:
-        raise RuntimeError(
-            f"no seed in {first_seed}..{first_seed + max_tries - 1} initialises L3 and L4 on "
-            "the first movement and shrinks both at every panel"
-        )
+    seed, trace = fig7_run(env_kwargs, first_seed, max_tries)
     plt = _plt()
-    figure, axes_grid = plt.subplots(2, 2, figsize=(8.0, 7.2), dpi=FIGURE_DPI)
-    truth = trace.truth_fl
-    # One frame for all panels: the landmarks, the path and the final regions, padded.
-    points = [truth, trace.trajectory_fl[: moves + 1]]
-    points += [p for m in FIG7_MOVEMENTS for p in trace.polygons[m] if p is not None]
-    cloud = np.concatenate(points)
-    # A huge first-movement region must not shrink everything else to a dot.
-    limit_low, limit_high = truth.min(axis=0) - 1.5, truth.max(axis=0) + 1.5
-    low = np.maximum(cloud.min(axis=0), limit_low) - np.array([0.3, 0.45])
-    high = np.minimum(cloud.max(axis=0), limit_high) + 0.3
-    colours = {"L3": "tab:red", "L4": "tab:blue"}
+    figure, axes_grid = plt.subplots(2, 2, figsize=(8.0, 7.6), dpi=FIGURE_DPI)
+    frame = fig7_frame(trace)
     for axes, movement in zip(axes_grid.ravel(), FIG7_MOVEMENTS, strict=True):
-        for j, name in enumerate(("L3", "L4")):
-            polygon = trace.polygons[movement][j]
-            if polygon is not None:
-                closed = np.vstack([polygon, polygon[:1]])
-                axes.fill(closed[:, 0], closed[:, 1], color=colours[name], alpha=0.12)
-                axes.plot(closed[:, 0], closed[:, 1], color=colours[name], lw=1.3)
-                # Label beside the region's right-most vertex, clear of the landmark's name.
-                anchor = polygon[int(np.argmax(polygon[:, 0]))]
-                axes.annotate(
-                    f"$A_{{{name}}}$",
-                    anchor,
-                    xytext=(4, 0),
-                    textcoords="offset points",
-                    color=colours[name],
-                    fontsize=10,
-                    va="center",
-                )
-            estimate = trace.estimates[movement][j]
-            if np.all(np.isfinite(estimate)):
-                axes.plot(*estimate, "o", mfc="none", mec="k", ms=7)
-        axes.plot(truth[:, 0], truth[:, 1], "k*", ms=11)
-        for index, name in enumerate(("L1", "L2", "L3", "L4")):
-            axes.annotate(
-                name, truth[index], xytext=(-6, -16), textcoords="offset points", fontsize=10
-            )
-        path_fl = trace.trajectory_fl[: movement + 1]
-        for start, end in itertools.pairwise(path_fl):
-            axes.annotate(
-                "", end, start, arrowprops={"arrowstyle": "->", "color": "0.35", "lw": 1.1}
-            )
-        axes.set_xlim(low[0], high[0])
-        axes.set_ylim(low[1], high[1])
-        axes.set_aspect("equal")
-        axes.tick_params(labelsize=8)
-        title = "initial movement" if movement == 1 else f"{movement} movements"
-        axes.set_title(f"Estimated uncertainty after {title}", fontsize=10)
+        _draw_fig7_panel(axes, trace, movement, frame)
     handles = [
         plt.Line2D([], [], ls="none", marker="*", color="k", ms=10, label="actual position"),
         plt.Line2D([], [], ls="none", marker="o", mfc="none", mec="k", label="estimated position"),
@@ -336,10 +377,12 @@ def figure10(
     transfer: str = "paper",
     epsilon_deg: float = 2.0,
     moves: int = 10,
+    progress: bool = False,
 ) -> tuple[Path, dict[str, Any]]:
     """Area and error of L3 and L4 against movements, Khepera, median over ``seeds``."""
     env_kwargs = figure_env_kwargs("khepera", transfer, epsilon_deg)
-    traces = [random_polygonal_trace(env_kwargs, seed, moves) for seed in seeds]
+    with progress_bar(len(seeds), desc="fig. 10", unit="run", enabled=progress) as bar:
+        traces = random_polygonal_traces(env_kwargs, seeds, moves, bar)
     areas = np.stack([t.areas[: moves + 1] for t in traces])  # (seeds, moves+1, 2)
     errors = np.stack([t.errors[: moves + 1] for t in traces])
     plt = _plt()
@@ -371,7 +414,9 @@ def figure10(
         )
     top.set_ylabel("Area of polygon (FL units²)")
     bottom.set_ylabel("Distance from estimated\nto actual landmark (FL units)")
-    bottom.set_xlabel("Movements")
+    for axes in (top, bottom):  # the panels share x; both say what it is
+        axes.set_xlabel("Movements")
+        axes.tick_params(labelbottom=True)
     for axes, values in ((top, areas), (bottom, errors)):
         _clip_first_movements(axes, np.median(values[:, 1:, :], axis=0), skip=1)
     for axes in (top, bottom):
@@ -391,16 +436,17 @@ def figure10(
 # --------------------------------------------------------------------------------------
 
 
-def figure11(
-    out: Path,
+def fig11_runs(
     seeds: Sequence[int],
-    transfer: str = "paper",
-    noise_mode: str = "same",
-    epsilons: Sequence[float] = FIG11_EPSILONS,
-    moves: int = 10,
-) -> tuple[Path, dict[str, Any]]:
-    """Area (and error) of L3 against movements for each epsilon, and the final area
-    against epsilon with a linear fit: same trajectories and bearings for every epsilon."""
+    transfer: str,
+    noise_mode: str,
+    epsilons: Sequence[float],
+    moves: int,
+    bar: Any,
+) -> dict[float, dict[str, NDArray[np.float64]]]:
+    """Per epsilon, the area and error of L3 per run (rows) and movement (columns); with
+    ``noise_mode="same"``, AssertionError unless every epsilon saw the very same readings
+    (the protocol's premise). ``bar`` advances by one per run."""
     if noise_mode not in ("same", "scaled"):
         raise ValueError(f"noise_mode must be 'same' or 'scaled', got {noise_mode!r}")
     per_epsilon: dict[float, dict[str, NDArray[np.float64]]] = {}
@@ -409,9 +455,8 @@ def figure11(
         env_kwargs = figure_env_kwargs("khepera", transfer, epsilon)
         if noise_mode == "same":
             env_kwargs["noise"] = {"kind": "uniform", "bound_deg": PAPER_NOISE_DEG}
-        traces = [random_polygonal_trace(env_kwargs, seed, moves) for seed in seeds]
+        traces = random_polygonal_traces(env_kwargs, seeds, moves, bar)
         if noise_mode == "same":
-            # The protocol's premise, checked: every epsilon saw the very same readings.
             bearings = [t.bearings for t in traces]
             if reference_bearings is None:
                 reference_bearings = bearings
@@ -423,73 +468,115 @@ def figure11(
             "area": np.stack([t.areas[: moves + 1, 0] for t in traces]),
             "error": np.stack([t.errors[: moves + 1, 0] for t in traces]),
         }
-    x_eps = np.array([float(e) for e in epsilons])
-    final_median = np.array([np.median(per_epsilon[e]["area"][:, -1]) for e in x_eps])
-    finite = np.isfinite(final_median)
-    enough = finite.sum() >= 2
-    fit = linear_fit(x_eps[finite], final_median[finite]) if enough else {}
-    power = power_fit(x_eps[finite], final_median[finite]) if enough else {}
-    # The region's linear size, sqrt(area), for comparison with the area itself.
-    size_fit = linear_fit(x_eps[finite], np.sqrt(final_median[finite])) if enough else {}
+    return per_epsilon
 
-    plt = _plt()
-    figure, axes = plt.subplots(1, 3, figsize=(13.5, 4.3), dpi=FIGURE_DPI)
-    colours = plt.get_cmap("viridis")(np.linspace(0.0, 0.9, len(x_eps)))
+
+def fig11_fits(
+    x_eps: NDArray[np.float64], final_median: NDArray[np.float64]
+) -> dict[str, dict[str, float]]:
+    """The final median area against epsilon: its least-squares line, power law, and the
+    line of the region's linear size sqrt(area); empty fits with fewer than two finite
+    medians."""
+    finite = np.isfinite(final_median)
+    if finite.sum() < 2:
+        return {"linear_fit": {}, "power_fit": {}, "sqrt_area_linear_fit": {}}
+    x, y = x_eps[finite], final_median[finite]
+    return {
+        "linear_fit": linear_fit(x, y),
+        "power_fit": power_fit(x, y),
+        "sqrt_area_linear_fit": linear_fit(x, np.sqrt(y)),
+    }
+
+
+def _plot_fig11_movements(
+    axes: Any, per_epsilon: dict[float, dict[str, NDArray[np.float64]]], moves: int
+) -> None:
+    """The left two panels: median area and error of L3 against movements, per epsilon,
+    on log axes (across epsilons the areas span three decades, and a linear axis would
+    flatten the small-epsilon curves onto zero)."""
+    x_eps = np.array(list(per_epsilon))
+    colours = _plt().get_cmap("viridis")(np.linspace(0.0, 0.9, len(x_eps)))
     x = np.arange(1, moves + 1)
+    panels = ((axes[0], "area"), (axes[1], "error"))
     for colour, epsilon in zip(colours[::-1], x_eps[::-1], strict=True):
-        for panel, key in ((axes[0], "area"), (axes[1], "error")):
+        for panel, key in panels:
             median = np.median(per_epsilon[epsilon][key][:, 1:], axis=0)
-            panel.plot(
-                x,
-                np.where(np.isfinite(median), median, np.nan),
-                "-o",
-                ms=3,
-                color=colour,
-                label=f"ε={epsilon:g}",
-            )
-    # Log axes: across epsilons the areas span three decades, and a linear axis would
-    # flatten the small-epsilon curves onto zero.
-    for panel, key in ((axes[0], "area"), (axes[1], "error")):
+            shown = np.where(np.isfinite(median), median, np.nan)
+            panel.plot(x, shown, "-o", ms=3, color=colour, label=f"ε={epsilon:g}")
+    for panel, key in panels:
         panel.set_yscale("log")
         medians = np.stack([np.median(per_epsilon[e][key][:, 1:], axis=0) for e in x_eps])
         later = medians[:, 2:][np.isfinite(medians[:, 2:])]
         if later.size:
             # The first two movements can be unbounded-scale for large epsilon.
             panel.set_ylim(0.7 * float(later.min()), 3.0 * float(later.max()))
+        panel.set_xlabel("Movements")
+        panel.grid(alpha=0.3, which="both")
+        panel.legend(fontsize=7, ncol=2)
     axes[0].set_title("Area of polygon of the third landmark", fontsize=10)
     axes[0].set_ylabel("median area (FL units², log)")
     axes[1].set_title(
         "Distance from estimated to actual\nlandmark of the third landmark", fontsize=10
     )
     axes[1].set_ylabel("median error (FL units, log)")
-    for panel in axes[:2]:
-        panel.set_xlabel("Movements")
-        panel.grid(alpha=0.3, which="both")
-        panel.legend(fontsize=7, ncol=2)
-    axes[2].plot(x_eps, final_median, "ko", label=f"median area after {moves} movements")
+
+
+def _plot_fig11_final_area(
+    panel: Any,
+    x_eps: NDArray[np.float64],
+    final_median: NDArray[np.float64],
+    fits: dict[str, dict[str, float]],
+    moves: int,
+) -> None:
+    """The right panel: the final median area against epsilon, with the fitted line and
+    power law."""
+    panel.plot(x_eps, final_median, "ko", label=f"median area after {moves} movements")
+    fit, power = fits["linear_fit"], fits["power_fit"]
     if fit:
-        line = fit["slope"] * x_eps + fit["intercept"]
-        axes[2].plot(
+        panel.plot(
             x_eps,
-            line,
+            fit["slope"] * x_eps + fit["intercept"],
             "r-",
             label=f"linear fit: {fit['slope']:.3g} ε {fit['intercept']:+.3g}\n"
             f"$R^2$ = {fit['r_squared']:.3f}",
         )
         grid = np.linspace(x_eps.min(), x_eps.max(), 100)
-        axes[2].plot(
+        size_r_squared = fits["sqrt_area_linear_fit"]["r_squared"]
+        panel.plot(
             grid,
             power["coefficient"] * grid ** power["exponent"],
             "b--",
             lw=1,
             label=f"power law: ∝ ε^{power['exponent']:.2f}\n"
-            f"(√area vs ε: linear, $R^2$ = {size_fit['r_squared']:.3f})",
+            f"(√area vs ε: linear, $R^2$ = {size_r_squared:.3f})",
         )
-    axes[2].set_xlabel("ε (degrees)")
-    axes[2].set_ylabel("area of L3 (FL units²)")
-    axes[2].set_title("Final area against ε", fontsize=10)
-    axes[2].grid(alpha=0.3)
-    axes[2].legend(fontsize=8)
+    panel.set_xlabel("ε (degrees)")
+    panel.set_ylabel("area of L3 (FL units²)")
+    panel.set_title("Final area against ε", fontsize=10)
+    panel.grid(alpha=0.3)
+    panel.legend(fontsize=8)
+
+
+def figure11(
+    out: Path,
+    seeds: Sequence[int],
+    transfer: str = "paper",
+    noise_mode: str = "same",
+    epsilons: Sequence[float] = FIG11_EPSILONS,
+    moves: int = 10,
+    progress: bool = False,
+) -> tuple[Path, dict[str, Any]]:
+    """Area (and error) of L3 against movements for each epsilon, and the final area
+    against epsilon with a linear fit: same trajectories and bearings for every epsilon."""
+    runs = len(epsilons) * len(seeds)
+    with progress_bar(runs, desc="fig. 11", unit="run", enabled=progress) as bar:
+        per_epsilon = fig11_runs(seeds, transfer, noise_mode, epsilons, moves, bar)
+    x_eps = np.array([float(e) for e in epsilons])
+    final_median = np.array([np.median(per_epsilon[e]["area"][:, -1]) for e in x_eps])
+    fits = fig11_fits(x_eps, final_median)
+    figure, axes = _plt().subplots(1, 3, figsize=(13.5, 4.3), dpi=FIGURE_DPI)
+    _plot_fig11_movements(axes, per_epsilon, moves)
+    _plot_fig11_final_area(axes[2], x_eps, final_median, fits, moves)
     noise_text = (
         f"same bearings for every ε (true noise uniform ±{PAPER_NOISE_DEG:g}°)"
         if noise_mode == "same"
@@ -510,9 +597,7 @@ def figure11(
         "final_initialised_rate": [
             float(np.isfinite(per_epsilon[e]["area"][:, -1]).mean()) for e in x_eps
         ],
-        "linear_fit": fit,
-        "power_fit": power,
-        "sqrt_area_linear_fit": size_fit,
+        **fits,
     }
     return path, data
 
@@ -533,13 +618,13 @@ ROBUST_NOISE_FACTORS: tuple[float, ...] = (1.0, 1.25, 1.5, 2.0)
 
 
 def robustness_point(
-    env_kwargs: dict[str, Any], seeds: Sequence[int], moves: int
+    env_kwargs: dict[str, Any], seeds: Sequence[int], moves: int, bar: Any = None
 ) -> dict[str, float]:
     """Containment (share of initialised regions holding the truth) and median total
-    area after ``moves`` random polygonal moves, over ``seeds``."""
+    area after ``moves`` random polygonal moves, over ``seeds`` (``bar``, if given,
+    advances by one per run)."""
     held, total_areas = [], []
-    for seed in seeds:
-        trace = random_polygonal_trace(env_kwargs, seed, moves)
+    for trace in random_polygonal_traces(env_kwargs, seeds, moves, bar or NoProgress()):
         initialised = np.isfinite(trace.areas[-1])
         held.extend(trace.contains[-1][initialised].tolist())
         total_areas.append(float(np.sum(np.where(initialised, trace.areas[-1], 0.0))))
@@ -549,8 +634,31 @@ def robustness_point(
     }
 
 
+def plain_log_ticks(axes: Any) -> None:
+    """A log y axis whose ticks read as plain numbers (0.05, 0.2, 1.5): over about a
+    decade matplotlib's default labels read "2×10⁰". Minor ticks are labelled all
+    within one decade, at 2 and 5 within two, not at all beyond, so they never crowd."""
+    from matplotlib.ticker import FuncFormatter
+
+    def minor_label(value: float, _position: int) -> str:
+        low, high = axes.get_ylim()
+        mantissa = round(value / 10 ** math.floor(math.log10(value)), 6)
+        span = high / low if low > 0 else math.inf
+        shown = span <= 10 or (span <= 100 and mantissa in (2.0, 5.0))
+        return f"{value:.3g}" if shown else ""
+
+    axes.set_yscale("log")
+    axes.yaxis.set_major_formatter(FuncFormatter(lambda value, _position: f"{value:.3g}"))
+    axes.yaxis.set_minor_formatter(FuncFormatter(minor_label))
+    axes.tick_params(axis="y", which="minor", labelsize=7)
+
+
 def figure_robustness(
-    out: Path, seeds: Sequence[int], epsilon_deg: float = 2.0, moves: int = 20
+    out: Path,
+    seeds: Sequence[int],
+    epsilon_deg: float = 2.0,
+    moves: int = 20,
+    progress: bool = False,
 ) -> tuple[Path, dict[str, Any]]:
     """Containment and median area against the outlier rate and the true noise bound."""
     base = {"scenario": "khepera", "epsilon_deg": epsilon_deg, "transfer": "conservative"}
@@ -565,28 +673,34 @@ def figure_robustness(
         ),
     }
     data: dict[str, Any] = {"env_kwargs": base, "seeds": [seeds[0], seeds[-1]], "moves": moves}
-    plt = _plt()
-    figure, axes = plt.subplots(2, 2, figsize=(9.6, 6.6), dpi=FIGURE_DPI, sharex="col")
-    for column, (sweep, (values, noise_of)) in enumerate(sweeps.items()):
-        data[sweep] = {"values": list(values)}
-        for label, fusion in ROBUST_FUSIONS.items():
-            points = [
-                robustness_point({**base, **fusion, "noise": noise_of(v)}, seeds, moves)
-                for v in values
-            ]
-            data[sweep][label] = points
-            x = [100 * v for v in values] if sweep == "outlier_rate" else list(values)
-            axes[0, column].plot(x, [100 * p["containment"] for p in points], "-o", label=label)
-            axes[1, column].plot(x, [p["median_total_area"] for p in points], "-o", label=label)
-        axes[1, column].set_xlabel(
-            "outlier rate (% of readings)" if sweep == "outlier_rate" else "true noise bound / ε"
-        )
-    axes[0, 0].set_ylabel("regions holding the truth (%)")
-    axes[1, 0].set_ylabel("median total area (FL units²)")
+    figure, axes = _plt().subplots(2, 2, figsize=(9.6, 6.6), dpi=FIGURE_DPI, sharex="col")
+    runs = sum(len(values) for values, _ in sweeps.values()) * len(ROBUST_FUSIONS) * len(seeds)
+    bar_context = progress_bar(runs, desc="robustness", unit="run", enabled=progress)
+    with bar_context as bar:
+        for column, (sweep, (values, noise_of)) in enumerate(sweeps.items()):
+            data[sweep] = {"values": list(values)}
+            for label, fusion in ROBUST_FUSIONS.items():
+                points = [
+                    robustness_point({**base, **fusion, "noise": noise_of(v)}, seeds, moves, bar)
+                    for v in values
+                ]
+                data[sweep][label] = points
+                x = [100 * v for v in values] if sweep == "outlier_rate" else list(values)
+                contained = [100 * p["containment"] for p in points]
+                axes[0, column].plot(x, contained, "-o", label=label)
+                axes[1, column].plot(x, [p["median_total_area"] for p in points], "-o", label=label)
+            x_label = "outlier rate (% of readings)" if sweep == "outlier_rate" else (
+                "true noise bound / ε"
+            )
+            for row in (0, 1):
+                axes[row, column].set_xlabel(x_label)
+                axes[row, column].tick_params(labelbottom=True)
+    for column in (0, 1):
+        axes[0, column].set_ylabel("regions holding the truth (%)")
+        axes[1, column].set_ylabel("median total area (FL units², log)")
+        plain_log_ticks(axes[1, column])
     for ax in axes.flat:
         ax.grid(alpha=0.3)
-    axes[1, 1].set_yscale("log")
-    axes[1, 0].set_yscale("log")
     axes[0, 0].legend(fontsize=8)
     figure.suptitle(
         f"Robustness: Khepera field, ε = {epsilon_deg:g}°, {len(seeds)} random polygonal runs "
@@ -606,12 +720,10 @@ def _json_float(value: float) -> float | None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="bearing-env figures",
-        description=(
-            "Reproduce the paper's Figs. 7, 10 and 11 in simulation, and the map's "
-            "robustness to outliers (PNG)."
-        ),
+    parser = command_parser(
+        "bearing-env figures",
+        "Reproduce the paper's Figs. 7, 10 and 11 in simulation, and the map's "
+        "robustness to outliers (PNG).",
     )
     parser.add_argument(
         "--out",
@@ -624,7 +736,7 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="+",
         choices=("7", "10", "11", "robust"),
         default=None,
-        help="make only these figures",
+        help="make only these figures (default: all)",
     )
     parser.add_argument(
         "--seeds",
@@ -661,6 +773,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help=f"{QUICK_SEEDS} runs instead of {DEFAULT_SEEDS} (a smoke test)",
     )
+    add_no_progress(parser)
     return parser
 
 
@@ -683,16 +796,19 @@ def make_figures(args: argparse.Namespace, seeds: list[int], wanted: set[str]) -
     """Draw the ``wanted`` figures into ``args.out`` and merge their numbers into
     ``figures.json`` there."""
     out: Path = args.out
+    progress = not args.no_progress
     out.mkdir(parents=True, exist_ok=True)
     results: dict[str, Any] = {}
     if "7" in wanted:
         path, results["fig7"] = figure7(out, args.fig7_seed, args.transfer)
         print(f"wrote {path}")
     if "10" in wanted:
-        path, results["fig10"] = figure10(out, seeds, args.transfer)
+        path, results["fig10"] = figure10(out, seeds, args.transfer, progress=progress)
         print(f"wrote {path}")
     if "11" in wanted:
-        path, results["fig11"] = figure11(out, seeds, args.transfer, args.fig11_noise)
+        path, results["fig11"] = figure11(
+            out, seeds, args.transfer, args.fig11_noise, progress=progress
+        )
         fit = results["fig11"]["linear_fit"]
         exponent = results["fig11"]["power_fit"].get("exponent", math.nan)
         print(
@@ -700,7 +816,7 @@ def make_figures(args: argparse.Namespace, seeds: list[int], wanted: set[str]) -
             f"R^2 = {fit.get('r_squared', math.nan):.3f}, power-law exponent {exponent:.2f}"
         )
     if "robust" in wanted:
-        path, results["robust"] = figure_robustness(out, seeds)
+        path, results["robust"] = figure_robustness(out, seeds, progress=progress)
         print(f"wrote {path}")
     summary_path = out / "figures.json"
     previous = json.loads(summary_path.read_text()) if summary_path.exists() else {}

@@ -7,8 +7,8 @@ median total area after 10 moves per policy and count, and writes it to
 and each policy's median over GreedyOneStep's but random polygonal's, with the model's
 training range shaded).
 
-    python -m bearing_env.train.studies.generalisation --model ppo_random \\
-        --counts 3 4 6 8 10 --episodes 50
+    bearing-env generalisation --model ppo_random --counts 3 4 6 8 10 --episodes 50
+    python -m bearing_env.train.studies.generalisation ...     # the same
 
 The total area is summed over the mapped landmarks (L3, L4, ...), so it grows with the
 count; compare policies within a column. Every count runs with the env kwargs the model
@@ -23,15 +23,18 @@ import argparse
 import json
 import subprocess
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from bearing_env.agents.sb3 import pretrained_names, pretrained_record
 from bearing_env.envs.config import EnvConfig
 from bearing_env.extras import available
-from bearing_env.train.common.cli_values import format_key_values
+from bearing_env.train.common.cli_parser import command_parser, doc_summary
+from bearing_env.train.common.cli_values import COUNT, format_key_values
 from bearing_env.train.common.errors import MissingExtraError, fail
 from bearing_env.train.common.files import write_json_atomically
+from bearing_env.train.common.tables import print_table
 
 DEFAULT_BASELINES = ("random", "parallax", "greedy")
 #: The label the ratio panel divides by (GreedyOneStep's report label).
@@ -119,15 +122,54 @@ def plot_medians(
     return save_and_close(figure, path, rect=(0, 0, 1, 0.94))
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--model", default="ppo_random", help="shipped model name")
-    parser.add_argument("--counts", type=int, nargs="+", default=[3, 4, 6, 8, 10])
-    parser.add_argument("--episodes", type=int, default=50)
-    parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--out", type=Path, default=Path("outputs/generalisation"))
+def build_parser() -> argparse.ArgumentParser:
+    parser = command_parser("bearing-env generalisation", doc_summary(__doc__))
+    parser.add_argument(
+        "--model",
+        default="ppo_random",
+        help=f"shipped model name: {', '.join(pretrained_names())} (default %(default)s)",
+    )
+    parser.add_argument(
+        "--counts",
+        type=COUNT,
+        nargs="+",
+        default=[3, 4, 6, 8, 10],
+        metavar="N",
+        help="landmark counts, each in [3, the model's max_landmarks] (default 3 4 6 8 10)",
+    )
+    parser.add_argument(
+        "--episodes", type=COUNT, default=50, help="evaluation episodes per count and policy"
+    )
+    parser.add_argument(
+        "--workers", type=COUNT, default=2, help="processes per comparison, >= 1"
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("outputs/generalisation"),
+        help="output folder: one comparison per count, the table and the plot",
+    )
     parser.add_argument("--resume", action="store_true", help="continue interrupted counts")
-    args = parser.parse_args()
+    return parser
+
+
+def print_medians(medians: dict[int, dict[str, float]]) -> None:
+    """The medians as one table: a row per landmark count, a column per policy."""
+    labels = list(next(iter(medians.values())))
+    rows = [
+        [str(count), *(f"{row[label]:.3g}" for label in labels)]
+        for count, row in medians.items()
+    ]
+    print_table(
+        "median total area after 10 moves, random layouts (evaluation seeds)",
+        ["landmarks", *labels],
+        rows,
+    )
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    parser = build_parser()
+    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
     if args.model not in pretrained_names():
         parser.error(f"unknown model {args.model!r}; shipped: {', '.join(pretrained_names())}")
     # The env's own resolution of the training settings: their counts and observation slots.
@@ -141,20 +183,10 @@ def main() -> None:
     for module in ("stable_baselines3", "torch", "rich", "matplotlib"):
         if not available(module):
             fail(parser.prog, str(MissingExtraError(module, "this command")))
-    from rich.console import Console
-    from rich.table import Table
-
     medians = run_counts(
         args.model, args.counts, args.episodes, args.workers, args.out, args.resume
     )
-    labels = list(next(iter(medians.values())))
-    table = Table(title="median total area after 10 moves, random layouts (evaluation seeds)")
-    table.add_column("landmarks")
-    for label in labels:
-        table.add_column(label, justify="right")
-    for count, row in medians.items():
-        table.add_row(str(count), *(f"{row[label]:.3g}" for label in labels))
-    Console().print(table)
+    print_medians(medians)
     write_json_atomically(args.out / "generalisation.json", {str(k): v for k, v in medians.items()})
     figure = plot_medians(
         medians, args.model, trained.landmark_counts, args.out / "generalisation.png"
