@@ -7,14 +7,14 @@ STAMP := $(VENV)/.installed
 # of bearing_env (setuptools package-dir), so the view links them in under that name.
 TYPECHECK_VIEW := $(VENV)/typecheck
 
-.PHONY: test demo lint typecheck bench bench-slam clean
+.PHONY: test demo docs lint typecheck bench bench-slam clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	# torch first, from the pin, so nothing later resolves a CUDA build
 	$(PY) -m pip install --quiet -c constraints.txt torch==2.13.0
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[render,train,dev,ray]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[render,train,dev,ray,docs]"
 	touch $(STAMP)
 
 # Two workers, one per core; a test module stays on one worker (its fixtures run once).
@@ -25,6 +25,12 @@ demo: $(STAMP)
 	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.studies.demo
 	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.compare.cli --quick
 
+# The documentation site, incremental (tests/tools/test_docs_site.py builds it afresh with
+# warnings as errors and checks its links and images).
+docs: $(STAMP)
+	$(PY) -m sphinx -W --keep-going -q -j auto -b html docs docs/_build/html
+	@echo "docs/_build/html/index.html"
+
 bench: $(STAMP)
 	$(PY) -m bearing_env.benchmarks.bench_env
 
@@ -32,7 +38,7 @@ bench-slam: $(STAMP)
 	$(PY) -m bearing_env.benchmarks.bench_slam
 
 lint: $(STAMP)
-	$(PY) -m ruff check bearing_env agents train tests benchmarks
+	$(PY) -m ruff check bearing_env agents train tests benchmarks docs/conf.py
 
 typecheck: $(STAMP)
 	rm -rf $(TYPECHECK_VIEW) && mkdir -p $(TYPECHECK_VIEW)/bearing_env
@@ -42,4 +48,4 @@ typecheck: $(STAMP)
 		--cache-dir $(CURDIR)/.mypy_cache -p bearing_env
 
 clean:
-	rm -rf $(VENV) .pytest_cache .hypothesis build *.egg-info
+	rm -rf $(VENV) .pytest_cache .hypothesis build *.egg-info docs/_build

@@ -358,7 +358,7 @@ class GreedyOracle(GreedyOneStep):
 
     Same candidates and the same scoring (simulated updates of the robot's current map),
     but the bearings are simulated from the true landmark positions and the true robot
-    pose, the FL scale is the true |L1 - L2|, and each candidate's length is cut where
+    pose, the FL scale is the true ``|L1 - L2|``, and each candidate's length is cut where
     the true arena wall would stop it. It reads ground truth, so it is not a robot
     policy: it bounds what one-step planning could do.
     """

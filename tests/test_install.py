@@ -9,6 +9,8 @@ from the repository's folders. Checked:
   and the wheel's own RECORD);
 - the sdist installs the very files of the wheel (same paths, same sha256);
 - ``import bearing_env; gym.make("BearingSLAM-v0")`` works in both, and resets and steps;
+- the README's quick start (its one Python block under "Quick start") runs as written
+  from the wheel;
 - in both, ``bearing-env compare --quick`` (3 episodes) runs the three heuristics, says it
   skipped the shipped models, and writes its report below the working directory, and
   ``bearing-env demo`` names the ``render`` extra and shows no traceback;
@@ -27,6 +29,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 import tarfile
@@ -39,6 +42,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 CONSTRAINTS = ROOT / "constraints.txt"
+README = ROOT / "README.md"
 KINDS = ("wheel", "sdist")
 #: Installed with the sdist, to collect its tests (pinned by constraints.txt).
 TEST_REQUIREMENTS = ("pytest", "hypothesis")
@@ -69,6 +73,14 @@ print(json.dumps({
                if importlib.util.find_spec(n) is not None],
 }))
 """
+
+
+def readme_quick_start() -> str:
+    """The Python block of the README's "Quick start" section, as written."""
+    text = README.read_text(encoding="utf-8")
+    section = text.split("\n## Quick start\n", 1)[1].split("\n## ", 1)[0]
+    (block,) = re.findall(r"```python\n(.*?)```", section, re.S)
+    return block
 
 
 @dataclass
@@ -146,6 +158,9 @@ def _install_and_check(kind: str, dist: Path, base: Path, numba_cache: Path) -> 
     run.results["gym_make"] = _run([python, "-c", GYM_MAKE, "--step"], work, env)
     _run_commands(run, env)
     if kind == "wheel":
+        quick_start = work / "quick_start.py"
+        quick_start.write_text(readme_quick_start(), encoding="utf-8")
+        run.results["quick_start"] = _run([python, str(quick_start)], work, env)
         return run
     _checked(_run([*pip, *TEST_REQUIREMENTS], work, env))
     tests = work / "sdist_tests"
@@ -269,6 +284,18 @@ def test_gym_make_works_without_extras(installed: dict[str, InstalledRun], kind:
     assert report["in_space"] is True  # it reset and stepped
 
 
+def test_the_readme_quick_start_runs_as_written_from_the_wheel(
+    installed: dict[str, InstalledRun],
+) -> None:
+    block = readme_quick_start()
+    assert 'gym.make("BearingSLAM-v0"' in block and "env.step(" in block
+    result = _checked(installed["wheel"].results["quick_start"])
+    assert "Traceback" not in result.stderr
+    # It prints the final areas and containment flags of L3 and L4.
+    printed = result.stdout.strip().splitlines()[-1]
+    assert printed.startswith("[") and "True" in printed, printed
+
+
 @pytest.mark.parametrize("kind", KINDS)
 def test_compare_quick_runs_the_heuristics_and_skips_the_shipped_models(
     installed: dict[str, InstalledRun], kind: str
@@ -313,6 +340,10 @@ def test_the_sdist_tests_import_against_the_installed_package(
         for line in result.stdout.splitlines()
         if "::" in line
     }
-    repository_tests = {p.name for p in (ROOT / "tests").glob("test_*.py")}
+    repository_tests = {
+        path.relative_to(ROOT / "tests").as_posix()
+        for path in (ROOT / "tests").rglob("test_*.py")
+        if "__pycache__" not in path.parts
+    }
     assert collected == repository_tests - set(NEEDS_TRAIN_EXTRA) - set(NEEDS_RAY_EXTRA)
     assert len(result.stdout.splitlines()) > 400

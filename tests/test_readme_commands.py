@@ -1,10 +1,12 @@
-"""Every shell command in the README runs, or at least parses, as written.
+"""Every shell command in the README and the documentation pages runs, or at least
+parses, as written.
 
-The commands are read from the README itself: every line of its ``bash`` blocks (with
-``\\`` continuations joined, comments dropped), and every inline `` `bearing-env ...` ``,
-`` `python -m ...` `` and `` `make ...` ``. Each one must be listed in :data:`CHECKS`,
-which says how it is checked; a README that gains a command the list lacks (or loses one
-the list still has) fails :func:`test_every_readme_command_has_a_check`.
+The commands are read from the documents themselves (:data:`DOCUMENTS`: the README and
+the pages of ``docs/``): every line of their ``bash`` blocks (with ``\\`` continuations
+joined, comments dropped), and every inline `` `bearing-env ...` ``, `` `python -m ...` ``
+and `` `make ...` ``. Each one must be listed in :data:`CHECKS`, which says how it is
+checked; a document that gains a command the list lacks (or the documents losing one the
+list still has) fails :func:`test_every_readme_command_has_a_check`.
 
 How each kind is checked, cheaply:
 
@@ -17,7 +19,11 @@ How each kind is checked, cheaply:
 - ``help``: the program's ``--help`` (with its subcommand) runs: Ray's own CLI, and the
   long benchmark;
 - ``copy``: a ``cp`` of a comparison plot, whose destination folder is in the repository
-  and whose source is written by a README ``compare`` command.
+  and whose source is written by a documented ``compare`` command;
+- ``pip``: a ``pip install`` of the package, whose extras are all in ``pyproject.toml``.
+
+CI's entry point, ``.ci/run``, runs exactly the README's test command
+(:func:`test_ci_runs_the_readme_test_command`).
 """
 
 from __future__ import annotations
@@ -33,11 +39,19 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
+#: The README and the documentation pages. ``docs/play.md`` and ``docs/tasks/`` are left
+#: out: they document the play and suite commands, written with those commands.
+DOCUMENTS = [README] + [
+    page for page in sorted((ROOT / "docs").glob("*.md")) if page.name != "play.md"
+]
 BIN = Path(sys.executable).parent
 
-#: README command -> (kind, extra arguments for a "run").
+#: Documented command -> (kind, extra arguments for a "run").
 CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
+    "pip install bearing_env": ("pip", ()),
+    'pip install "bearing_env[render,train]"': ("pip", ()),
     "make test": ("make", ()),
+    "make docs": ("make", ()),
     "make demo": ("make", ()),
     "make bench": ("make", ()),
     "make bench-slam": ("make", ()),
@@ -60,6 +74,8 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
         ("--movements", "300", "--no-progress"),
     ),
     "bearing-env soak --steps 1000000 --seed 2026": ("run", ("--steps", "30", "--no-progress")),
+    "bearing-env region-search": ("run", ("--movements", "300", "--no-progress")),
+    "bearing-env soak": ("run", ("--steps", "30", "--no-progress")),
     "python -m bearing_env.train.studies.demo": ("run", ("--episodes", "1", "--moves", "3")),
     "bearing-env compare --episodes 200 --workers 2 --out outputs/compare_khepera": (
         "parse",
@@ -127,7 +143,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
 
 
 def readme_commands(text: str) -> list[str]:
-    """The shell commands of a README, in order, without duplicates."""
+    """The shell commands of a Markdown document, in order, without duplicates."""
     commands: list[str] = []
     for block in re.findall(r"```(?:bash|sh|shell)\n(.*?)```", text, re.S):
         pending = ""
@@ -140,7 +156,8 @@ def readme_commands(text: str) -> list[str]:
             if command and not command.startswith("#"):
                 commands.append(command)
             pending = ""
-    commands += re.findall(r"`((?:bearing-env|python -m|make) [^`]+)`", text)
+    inline = re.findall(r"`((?:bearing-env|python -m|make) [^`]+)`", text)
+    commands += [" ".join(command.split()) for command in inline]  # one line each
     return list(dict.fromkeys(commands))
 
 
@@ -158,10 +175,27 @@ def test_the_extractor_reads_blocks_continuations_comments_and_inline_commands()
     ]
 
 
+def documented_commands() -> set[str]:
+    return {
+        command
+        for document in DOCUMENTS
+        for command in readme_commands(document.read_text(encoding="utf-8"))
+    }
+
+
 def test_every_readme_command_has_a_check() -> None:
-    commands = set(readme_commands(README.read_text(encoding="utf-8")))
-    assert sorted(commands - CHECKS.keys()) == [], "README commands without a check"
-    assert sorted(CHECKS.keys() - commands) == [], "checks of commands the README lost"
+    commands = documented_commands()
+    assert sorted(commands - CHECKS.keys()) == [], "documented commands without a check"
+    assert sorted(CHECKS.keys() - commands) == [], "checks of commands the documents lost"
+
+
+def test_the_readme_gives_the_two_make_commands_and_ci_runs_its_test_command() -> None:
+    readme = readme_commands(README.read_text(encoding="utf-8"))
+    assert {"make test", "make demo"} <= set(readme)
+    ci_lines = (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+    commands = [line.strip() for line in ci_lines if line.strip()]
+    commands = [line for line in commands if not line.startswith(("#", "set ", "cd "))]
+    assert commands == ["make test"]
 
 
 def _parse(argv: list[str]) -> None:
@@ -234,13 +268,21 @@ def test_readme_command_runs_or_parses(command: str, tmp_path: Path) -> None:
         )
         assert result.returncode == 0, result.stderr
         assert result.stdout.strip()
+    elif kind == "pip":
+        tomllib = pytest.importorskip("tomllib")  # Python 3.11+
+        extras = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+        optional = extras["project"]["optional-dependencies"]
+        requirement = re.fullmatch(r"bearing_env(?:\[([\w,]+)\])?", argv[-1])
+        assert argv[:2] == ["pip", "install"] and requirement is not None, argv
+        named = (requirement.group(1) or "").split(",")
+        assert sorted(set(filter(None, named)) - optional.keys()) == []
     elif kind == "copy":
         source, destination = Path(argv[1]), Path(argv[2])
         assert (ROOT / destination.parent).is_dir()
         out_option = f"--out {source.parent}"
         writers = ("bearing-env compare", "python -m bearing_env.train.studies.generalisation")
         producers = [c for c in CHECKS if c.startswith(writers) and out_option in c]
-        assert producers, f"no README command writes {source}"
+        assert producers, f"no documented command writes {source}"
     elif kind == "parse":
         _parse(argv + list(extra))
     elif kind == "help":
