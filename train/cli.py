@@ -11,6 +11,7 @@
                                   conservative guarantee at every step (benchmarks/soak.py)
     bearing-env compare [...]     exploration policies on the same evaluation episodes
     bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
+    bearing-env play [...]        move the robot by hand in a pygame window (the render extra)
     bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (shipped rl-zoo3 files)
     bearing-env hyperparams ALGO  the path of a shipped rl-zoo3 hyperparameter file
     bearing-env rllib [...]       PPO with RLlib, locally or on a Ray cluster (train/ray/rllib.py)
@@ -77,6 +78,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "figures": (
         "bearing_env.train.studies.figures",
         "reproduce the paper's Figs. 7, 10 and 11 in simulation",
+    ),
+    "play": (
+        "bearing_env.train.studies.play",
+        "move the robot by hand in a pygame window (keys or mouse clicks)",
     ),
 }
 
