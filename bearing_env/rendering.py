@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 import shapely
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.extras import require
 from bearing_env.world import Arena
@@ -57,6 +57,54 @@ def landmark_colour(index: int) -> tuple[int, int, int]:
     if index < 2:
         return FRAME_LANDMARK
     return PALETTE[(index - 2) % len(PALETTE)]
+
+
+@dataclass(frozen=True)
+class FieldLayout:
+    """Where the arena lies in a frame: the frame size and the world <-> pixel mapping.
+
+    Pure arithmetic (no pygame), so a window that shows the env's frames (``bearing-env
+    play``) maps mouse clicks to the world and draws over the field exactly as the
+    renderer does.
+    """
+
+    #: Frame (width, height) in pixels.
+    size: tuple[int, int]
+    #: The field's (left, top, width, height) in pixels.
+    field_box: tuple[int, int, int, int]
+    pixels_per_metre: float
+
+    @classmethod
+    def for_arena(cls, arena: Arena) -> FieldLayout:
+        usable = FRAME_WIDTH - 2 * PADDING
+        pixels_per_metre = usable / arena.width
+        field_height = round(arena.height * pixels_per_metre)
+        return cls(
+            size=(FRAME_WIDTH, HEADER_HEIGHT + field_height + FOOTER_HEIGHT),
+            field_box=(PADDING, HEADER_HEIGHT, usable, field_height),
+            pixels_per_metre=pixels_per_metre,
+        )
+
+    def to_pixels(self, points: ArrayLike) -> FloatArray:
+        """World (..., 2) metres -> pixel (..., 2) (y down)."""
+        p = np.asarray(points, dtype=np.float64)
+        left, top, _, height = self.field_box
+        x = left + p[..., 0] * self.pixels_per_metre
+        y = top + height - p[..., 1] * self.pixels_per_metre
+        return np.stack([x, y], axis=-1)
+
+    def to_world(self, pixels: ArrayLike) -> FloatArray:
+        """Pixel (..., 2) -> world (..., 2) metres: the inverse of :meth:`to_pixels`."""
+        p = np.asarray(pixels, dtype=np.float64)
+        left, top, _, height = self.field_box
+        x = (p[..., 0] - left) / self.pixels_per_metre
+        y = (top + height - p[..., 1]) / self.pixels_per_metre
+        return np.stack([x, y], axis=-1)
+
+    def in_field(self, pixel: tuple[float, float]) -> bool:
+        """Whether a pixel lies on the field (edges included)."""
+        left, top, width, height = self.field_box
+        return left <= pixel[0] <= left + width and top <= pixel[1] <= top + height
 
 
 @dataclass(frozen=True)
@@ -110,11 +158,10 @@ class Renderer:
         self.render_mode = render_mode
         self.arena = arena
         self.fps = fps
-        usable = FRAME_WIDTH - 2 * PADDING
-        self.pixels_per_metre = usable / arena.width
-        field_height = round(arena.height * self.pixels_per_metre)
-        self.field_rect = pygame.Rect(PADDING, HEADER_HEIGHT, usable, field_height)
-        self.size = (FRAME_WIDTH, HEADER_HEIGHT + field_height + FOOTER_HEIGHT)
+        self.layout = FieldLayout.for_arena(arena)
+        self.pixels_per_metre = self.layout.pixels_per_metre
+        self.field_rect = pygame.Rect(*self.layout.field_box)
+        self.size = self.layout.size
         pygame.font.init()
         self._font = pygame.font.Font(None, 22)
         self._small_font = pygame.font.Font(None, 18)
@@ -133,10 +180,7 @@ class Renderer:
 
     def to_pixels(self, points: FloatArray) -> FloatArray:
         """World (..., 2) metres -> pixel (..., 2) (y down)."""
-        p = np.asarray(points, dtype=np.float64)
-        x = self.field_rect.left + p[..., 0] * self.pixels_per_metre
-        y = self.field_rect.bottom - p[..., 1] * self.pixels_per_metre
-        return np.stack([x, y], axis=-1)
+        return self.layout.to_pixels(points)
 
     def _clipped_outline(self, polygon: FloatArray) -> list[tuple[float, float]] | None:
         """The polygon clipped to a margin around the field, in pixels.

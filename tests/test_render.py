@@ -118,3 +118,23 @@ def test_record_video(tmp_path: os.PathLike[str]) -> None:
     videos = [name for name in os.listdir(folder) if name.endswith(".mp4")]
     assert videos
     assert all(os.path.getsize(os.path.join(folder, name)) > 1000 for name in videos)
+
+
+def test_the_field_layout_maps_pixels_back_to_the_world() -> None:
+    from bearing_env.rendering import FieldLayout
+
+    env = gym.make("BearingSLAM-v0", scenario="khepera", render_mode="rgb_array")
+    env.reset(seed=0)
+    env.render()
+    renderer = env.unwrapped._renderer
+    layout = FieldLayout.for_arena(env.unwrapped.arena)
+    assert layout == renderer.layout and layout.size == renderer.size
+    corners = np.array([[0.0, 0.0], [1.05, 0.68]])
+    left, top, width, height = layout.field_box
+    # The field's height in pixels is rounded: the far corner is within half a pixel.
+    expected = [[left, top + height], [left + width, top]]
+    np.testing.assert_allclose(layout.to_pixels(corners), expected, atol=0.5)
+    points = np.random.default_rng(0).uniform([0, 0], [1.05, 0.68], size=(20, 2))
+    np.testing.assert_allclose(layout.to_world(layout.to_pixels(points)), points, atol=1e-12)
+    assert layout.in_field((left, top)) and not layout.in_field((left - 1, top))
+    env.close()

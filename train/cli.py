@@ -13,6 +13,7 @@
     bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
     bearing-env generalisation [...]  a policy trained on random layouts, across landmark
                                   counts (train/studies/generalisation.py)
+    bearing-env play [...]        move the robot by hand in a pygame window (the render extra)
     bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (shipped rl-zoo3 files)
     bearing-env hyperparams ALGO  the path of a shipped rl-zoo3 hyperparameter file
     bearing-env rllib [...]       PPO with RLlib, locally or on a Ray cluster (train/ray/rllib.py)
@@ -86,6 +87,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "generalisation": (
         "bearing_env.train.studies.generalisation",
         "a shipped policy trained on random layouts, across landmark counts",
+    ),
+    "play": (
+        "bearing_env.train.studies.play",
+        "move the robot by hand in a pygame window (keys or mouse clicks)",
     ),
 }
 

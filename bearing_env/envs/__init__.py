@@ -11,6 +11,8 @@
 - :mod:`~bearing_env.envs.bearing_slam`, :mod:`~bearing_env.envs.bearing_slam_discrete`:
   the single envs (a batch of one);
 - :mod:`~bearing_env.envs.bearing_slam_vector`: the batched vector envs.
+- :mod:`~bearing_env.envs.manual_control`: a pygame window to play the single envs by
+  hand (``bearing-env play``).
 """
 
 from bearing_env.envs.bearing_slam import BearingSLAMEnv

@@ -1,1 +1,1 @@
-"""The paper studies: its figures, the generalisation study and the demo."""
+"""The paper studies: its figures, the generalisation study and the demo; and manual play."""
