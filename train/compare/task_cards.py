@@ -318,7 +318,8 @@ def task_card(
             f"![a rendered frame of {task.id}]({frame_name(task)})",
             "",
             f"The first evaluation episode (seed {seeds[0]}) after {FRAME_MOVES} moves of "
-            "`greedy`: landmarks as stars, their regions, the robot and its path.",
+            "`greedy`: the true landmarks (stars), their uncertainty regions and centroids, the "
+            "latest bearing cones (±ε), the robot and its path.",
             "",
         ]
     if command:
