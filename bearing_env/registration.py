@@ -4,11 +4,18 @@ Called on ``import bearing_env``. ``gym.make("bearing_env:BearingSLAM-v0")`` wor
 importing first because Gymnasium imports the module named before the colon (Gymnasium
 1.x no longer loads ``gymnasium.envs`` entry-point plugins). Importing this module stays
 cheap: the environment modules load on first make.
+
+Besides the two base ids (one per action kind), every task of :mod:`bearing_env.tasks`
+(``BearingSLAM-Khepera-v0``, ``BearingSLAM-Random8-v0``, ...) is registered as its own id:
+its base id's env and vector env with the task's settings as ``kwargs``, as Minigrid
+registers its variants.
 """
 
 from __future__ import annotations
 
 import gymnasium as gym
+
+from bearing_env.tasks import TASKS
 
 #: The registered ids and their entry points. They register ``max_episode_steps=None``:
 #: the envs' own ``max_moves`` is the one episode cap (a registered TimeLimit would cut
@@ -26,14 +33,24 @@ VECTOR_ENTRY_POINTS: dict[str, str] = {
 
 
 def register_envs() -> None:
-    """Register the bearing_env ids; safe to call more than once."""
+    """Register the bearing_env ids and the task ids; safe to call more than once."""
     for env_id, entry_point in ENV_IDS.items():
-        # Registering an existing id again would make Gymnasium warn about overriding it.
-        if env_id in gym.registry:
-            continue
-        gym.register(
-            id=env_id,
-            entry_point=entry_point,
-            vector_entry_point=VECTOR_ENTRY_POINTS[env_id],
-            max_episode_steps=None,
-        )
+        _register(env_id, entry_point, VECTOR_ENTRY_POINTS[env_id], {})
+    for task in TASKS:
+        base = task.base_id
+        _register(task.id, ENV_IDS[base], VECTOR_ENTRY_POINTS[base], task.kwargs())
+
+
+def _register(
+    env_id: str, entry_point: str, vector_entry_point: str, kwargs: dict[str, object]
+) -> None:
+    # Registering an existing id again would make Gymnasium warn about overriding it.
+    if env_id in gym.registry:
+        return
+    gym.register(
+        id=env_id,
+        entry_point=entry_point,
+        vector_entry_point=vector_entry_point,
+        max_episode_steps=None,
+        kwargs=kwargs,
+    )

@@ -61,6 +61,8 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env demo": ("run", ("--episodes", "1", "--moves", "3")),
     "bearing-env compare": ("parse", ()),
     "bearing-env compare --quick": ("parse", ()),
+    "bearing-env suite": ("parse", ()),
+    "bearing-env suite --episodes 50 --workers 2": ("parse", ()),
     "bearing-env bench": ("parse", ()),
     "bearing-env bench --sections startup": ("parse", ()),
     "bearing-env bench --sections slam,planning --seconds 1": ("parse", ()),
@@ -233,6 +235,10 @@ def _parse(argv: list[str]) -> None:
         from bearing_env.train.compare import cli as compare
 
         compare.config_from_args(compare.build_parser().parse_args(arguments))
+    elif command == "suite":
+        from bearing_env.train.compare import suite
+
+        suite.suite_configs(suite.build_parser().parse_args(arguments))
     elif command == "train":
         from bearing_env.train.sb3 import train_cli
 

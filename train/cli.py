@@ -10,6 +10,8 @@
     bearing-env soak [...]        the envs over random configurations, checking the
                                   conservative guarantee at every step (benchmarks/soak.py)
     bearing-env compare [...]     exploration policies on the same evaluation episodes
+    bearing-env suite [...]       the baselines on every registered task, with the task
+                                  cards in docs/tasks/ (compare once per task)
     bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
     bearing-env generalisation [...]  a policy trained on random layouts, across landmark
                                   counts (train/studies/generalisation.py)
@@ -71,6 +73,11 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "compare": (
         "bearing_env.train.compare.cli",
         "compare exploration policies on fixed evaluation episodes",
+    ),
+    "suite": (
+        "bearing_env.train.compare.suite",
+        "run the baselines (random, parallax, greedy, lookahead, matching shipped models) "
+        "on every registered task, 50 episodes each by default, and write the task cards",
     ),
     "rllib": (
         "bearing_env.train.ray.rllib",

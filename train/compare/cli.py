@@ -258,7 +258,12 @@ def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
 def shipped_policies(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
     """The shipped models to compare by default: :func:`matching_pretrained`, or none,
     with a note on stderr, when stable-baselines3 (the ``train`` extra) is missing."""
-    specs = matching_pretrained(env_id, env_kwargs)
+    return installed_models(matching_pretrained(env_id, env_kwargs))
+
+
+def installed_models(specs: list[str]) -> list[str]:
+    """The ``pretrained:NAME`` specs, or none, with a note on stderr, when
+    stable-baselines3 (the ``train`` extra) is missing."""
     if specs and not available("stable_baselines3", "torch"):
         missing = "stable_baselines3" if not available("stable_baselines3") else "torch"
         names = ", ".join(spec.split(":", 1)[1] for spec in specs)
@@ -309,20 +314,26 @@ _PROCESS_ONLY_FLAGS = ("--resume", "--overwrite", "--no-progress")
 _PROCESS_ONLY_OPTIONS = ("--stop-after", "--executor", "--ray-address")
 
 
-def reproducing_command(argv: Sequence[str]) -> str:
-    """``bearing-env compare ...`` with the arguments that determine the results."""
+def reproducing_command(
+    argv: Sequence[str],
+    prog: str = "bearing-env compare",
+    process_flags: Sequence[str] = _PROCESS_ONLY_FLAGS,
+    process_options: Sequence[str] = _PROCESS_ONLY_OPTIONS,
+) -> str:
+    """``prog ...`` with the arguments that determine the results: ``argv`` less the
+    ``process_flags`` and the ``process_options`` with their values."""
     kept: list[str] = []
     skip_value = False
     for arg in argv:
         if skip_value:
             skip_value = False
-        elif arg in _PROCESS_ONLY_FLAGS:
+        elif arg in process_flags:
             pass
-        elif arg in _PROCESS_ONLY_OPTIONS:
+        elif arg in process_options:
             skip_value = True
-        elif not arg.startswith(tuple(f"{option}=" for option in _PROCESS_ONLY_OPTIONS)):
+        elif not arg.startswith(tuple(f"{option}=" for option in process_options)):
             kept.append(arg)
-    return " ".join(["bearing-env compare", *kept])
+    return " ".join([prog, *kept])
 
 
 def main(argv: Sequence[str] | None = None) -> None:

@@ -63,6 +63,7 @@ def run_comparison(
     plots: bool = True,
     command: str | None = None,
     executor: EpisodeExecutor = run_locally,
+    desc: str = "compare",
 ) -> CompareResult:
     """Run (or finish) a comparison and write every output file.
 
@@ -80,6 +81,7 @@ def run_comparison(
         executor: what runs the episodes (``runner.EpisodeExecutor``): the local
             worker pool by default, given ``workers``; ``runner.executor_named``
             gives the Ray one.
+        desc: the progress bar's label (``bearing-env suite``: the task id).
     """
     out = Path(out)
     log = EpisodeLog(out / LOG_NAME)
@@ -116,7 +118,7 @@ def run_comparison(
     n_total = len(config.seeds) * len(config.policies)
     done_before = n_total - len(pending)
     with progress_bar(
-        n_total, initial=done_before, desc="compare", unit="episode", enabled=progress
+        n_total, initial=done_before, desc=desc, unit="episode", enabled=progress
     ) as bar:
         for record in executor(tasks, workers):
             log.append(record)  # fsynced before the next one: a kill loses no logged episode

@@ -1,0 +1,445 @@
+"""The task cards ``bearing-env suite`` writes: ``<task id>.md`` per task (what the agent
+sees, does and is rewarded for, the settings, the baseline tables with bootstrap CIs, a
+rendered frame and the area plot as PNGs beside it) and ``index.md``, the task table.
+
+Plain MyST-compatible Markdown with relative links. A card quotes only reproducible
+numbers (no timings), so regenerating it with the same command gives the same text.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from bearing_env.tasks import Task
+from bearing_env.train.common.errors import available
+from bearing_env.train.common.files import atomic_path, atomic_write_text
+from bearing_env.train.compare.comparison import CompareResult
+from bearing_env.train.compare.config import CompareConfig
+from bearing_env.train.compare.report import (
+    area_mean_rows,
+    area_median_rows,
+    markdown_table,
+    outcome_table_rows,
+)
+from bearing_env.train.compare.runner import make_env
+
+INDEX_NAME = "index.md"
+#: Moves of the greedy policy before the card's frame is rendered.
+FRAME_MOVES = 5
+
+
+def card_name(task: Task) -> str:
+    return f"{task.id}.md"
+
+
+def area_plot_name(task: Task) -> str:
+    return f"{task.id}_area.png"
+
+
+def frame_name(task: Task) -> str:
+    return f"{task.id}_frame.png"
+
+
+# ----------------------------------------------------------------------------------------
+# What the agent faces, from the resolved settings
+# ----------------------------------------------------------------------------------------
+
+
+def _number(value: float) -> str:
+    return f"{value:g}"
+
+
+def settings_rows(config: Any, task: Task) -> list[list[str]]:
+    """The settings a score depends on, resolved (``EnvConfig``), as table rows."""
+    noise = config.noise
+    if noise.kind == "uniform":
+        bound = "ε" if noise.bound_deg is None else f"{_number(noise.bound_deg)}°"
+        sensor = f"uniform within ±{bound}"
+    elif noise.kind == "gaussian":
+        sigma = "ε/2" if noise.sigma_deg is None else f"{_number(noise.sigma_deg)}°"
+        sensor = f"Gaussian, sigma = {sigma}"
+    else:
+        sensor = "none"
+    lo, hi = config.landmark_counts
+    if config.landmarks is not None:
+        positions = ", ".join(f"({_number(x)}, {_number(y)})" for x, y in config.landmarks)
+        layout = f"{lo} fixed landmarks at {positions} m (L1, L2, ...)"
+    else:
+        count = f"{lo}" if lo == hi else f"{lo} to {hi}"
+        layout = f"a new random layout of {count} landmarks every episode"
+    rows = [
+        ["registered settings", f"`{task.settings_text()}` on `{task.base_id}`"],
+        ["scenario", f"`{config.scenario}`: {layout}"],
+        ["arena", f"{_number(config.arena.width)} x {_number(config.arena.height)} m"],
+        ["bearing error bound ε (`epsilon_deg`)", f"{_number(config.epsilon_deg)}°"],
+        ["true sensor noise (`noise`)", sensor],
+        ["outliers (`noise.outlier_rate`)", f"{100 * noise.outlier_rate:g}% of bearings"],
+        ["detection (`noise.detection_rate`)", f"{100 * noise.detection_rate:g}% of readings"],
+        ["fusion", f"`{config.fusion}`"],
+    ]
+    if config.fusion == "relaxed":
+        rows.append(["`max_outliers`", str(config.max_outliers)])
+    rows += [
+        ["transfer", f"`{config.transfer}`"],
+        ["on inconsistency", f"`{config.on_inconsistency}`"],
+        ["move length", f"{_number(config.move_length[0])} to {_number(config.move_length[1])} m"],
+        ["`max_moves`", str(config.max_moves)],
+        ["`target_area`", f"{_number(config.target_area)} FL units²"],
+        ["`area_cap`", f"{_number(config.area_cap)} FL units²"],
+        ["observation", f"`{config.observation}`, `max_landmarks` = {config.max_landmarks}"],
+    ]
+    if task.action_kind == "discrete":
+        rows.append(["action grid", f"{config.n_turns} turns x {config.n_move_lengths} lengths"])
+    return rows
+
+
+def space_text(space: Any) -> str:
+    """A space in a few words: ``Box((63,), float32)``, ``Discrete(24)``, ``Dict(...)``
+    (a Box's bounds are in the env's docstring, not repeated here)."""
+    from gymnasium import spaces
+
+    if isinstance(space, spaces.Box):
+        return f"Box({space.shape}, {space.dtype})"
+    if isinstance(space, spaces.Dict):
+        items = ", ".join(f"{key}: {space_text(sub)}" for key, sub in space.spaces.items())
+        return f"Dict({items})"
+    return str(space)
+
+
+def observation_text(config: Any, space: Any) -> str:
+    from bearing_env.envs.observations import (
+        BEARING_FEATURES,
+        ENTITY_FEATURES,
+        LANDMARK_FEATURES,
+        ROBOT_FEATURES,
+    )
+
+    m = config.max_landmarks
+    robot = (
+        f"the robot block ({len(ROBOT_FEATURES)} numbers: its position estimate, region "
+        "log-area and heading in the landmark frame FL, where L1 = (0, 0) and L2 = (1, 0), "
+        "the progress through the episode and flags of the last move)"
+    )
+    if config.observation == "entities":
+        layout = (
+            f'a `Dict` of {robot} under `"robot"` and a landmark table under '
+            f'`"landmarks"`, {m} rows of {len(ENTITY_FEATURES)} columns '
+            f"({', '.join(ENTITY_FEATURES)}), flattened"
+        )
+    else:
+        layout = (
+            f"{robot}, then {m - 2} blocks of {len(LANDMARK_FEATURES)} for the mapped "
+            f"landmarks L3 .. L{m} ({', '.join(LANDMARK_FEATURES)}), then {m} blocks of "
+            f"{len(BEARING_FEATURES)} for the latest bearings of L1 .. L{m} "
+            f"({', '.join(BEARING_FEATURES)})"
+        )
+    return (
+        f"`{space_text(space)}`: {layout}. Only what the robot can know, never ground truth; slots "
+        "beyond the episode's landmarks are zeros. The full table is in "
+        "`BearingSLAMEnv`'s docstring."
+    )
+
+
+def action_text(config: Any, space: Any, task: Task) -> str:
+    lo, hi = (_number(v) for v in config.move_length)
+    if task.action_kind == "discrete":
+        step = 360.0 / config.n_turns
+        return (
+            f"`{space_text(space)}`: action `a` turns on the spot by "
+            f"`turns[a // {config.n_move_lengths}]` ({config.n_turns} relative headings, "
+            f"every {_number(step)}°), then moves straight by "
+            f"`lengths[a % {config.n_move_lengths}]` ({config.n_move_lengths} lengths "
+            f"evenly spaced over {lo} to {hi} m), stopped at the wall."
+        )
+    return (
+        f"`{space_text(space)}` in [-1, 1]: turn on the spot by `π · a[0]` radians, then "
+        f"move straight by `{lo} + (a[1] + 1) / 2 · ({hi} - {lo})` metres, stopped at the "
+        "wall. A reading is taken before and after the move, and the map updated."
+    )
+
+
+def reward_text(config: Any) -> str:
+    cap = _number(config.area_cap)
+    if config.reward == "log_area":
+        text = (
+            "The decrease of the potential Φ = Σ over landmarks L3, L4, ... of "
+            f"log(min(area, {cap})), an uninitialised landmark counting at {cap} FL units²; "
+            "an episode's return is Φ(start) - Φ(end)."
+        )
+    else:
+        text = (
+            "The decrease of the potential Φ = Σ over landmarks L3, L4, ... of "
+            f"min(area, {cap}), an uninitialised landmark counting at {cap} FL units²."
+        )
+    costs = []
+    if config.path_cost:
+        costs.append(f"{_number(config.path_cost)} per metre travelled")
+    if config.move_cost:
+        costs.append(f"{_number(config.move_cost)} per move")
+    if costs:
+        text += " Less " + " and ".join(costs) + "."
+    return text
+
+
+def termination_text(config: Any) -> str:
+    return (
+        "Terminated (success) when every landmark L3, L4, ... is initialised and its "
+        f"region's area is at most `target_area` = {_number(config.target_area)} FL units². "
+        f"Truncated after `max_moves` = {config.max_moves} moves, the one episode cap (the id "
+        "registers no `TimeLimit`; `env.spec.max_episode_steps` reads `max_moves`)."
+    )
+
+
+# ----------------------------------------------------------------------------------------
+# Pictures
+# ----------------------------------------------------------------------------------------
+
+
+def render_frame(config: CompareConfig, seed: int, path: Path) -> bool:
+    """Render the first evaluation episode after :data:`FRAME_MOVES` moves of the greedy
+    policy to ``path`` (PNG); False, writing nothing, without pygame or Pillow."""
+    if not available("pygame", "PIL"):
+        return False
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    from PIL import Image
+
+    from bearing_env.agents.registry import make_policy
+
+    env = make_env(config.env_id, {**config.env_kwargs, "render_mode": "rgb_array"})
+    with contextlib.closing(env):
+        policy = make_policy("greedy", env)
+        observation, info = env.reset(seed=seed)
+        policy.reset(seed=seed)
+        for _ in range(FRAME_MOVES):
+            observation, _, terminated, truncated, info = env.step(policy.act(observation, info))
+            if terminated or truncated:
+                break
+        frame = env.render()
+    if not isinstance(frame, np.ndarray):
+        raise TypeError(f"expected an rgb_array frame from render(), got {type(frame).__name__}")
+    with atomic_path(path, suffix=".png") as temporary:
+        Image.fromarray(frame).save(temporary, format="PNG")
+    return True
+
+
+# ----------------------------------------------------------------------------------------
+# The card and the index
+# ----------------------------------------------------------------------------------------
+
+
+def task_card(
+    task: Task,
+    config: CompareConfig,
+    summary: Mapping[str, Any],
+    command: str | None,
+    frame: bool,
+    plot: bool,
+) -> str:
+    """The Markdown of a task's card."""
+    from bearing_env.envs.config import EnvConfig
+
+    resolved = EnvConfig.create(**{**task.kwargs(), **config.env_kwargs})
+    env = make_env(config.env_id, config.env_kwargs)
+    with contextlib.closing(env):
+        observation_space, action_space = env.observation_space, env.action_space
+    seeds = config.seeds
+    policies = ", ".join(f"`{label}` = `{spec}`" for label, spec in config.policies.items())
+    overrides = (
+        f" with `{', '.join(f'{k}={v!r}' for k, v in config.env_kwargs.items())}`"
+        if config.env_kwargs
+        else ""
+    )
+    parts = [
+        f"# {task.id}",
+        "",
+        f"{task.description[0].upper()}{task.description[1:]}.",
+        "",
+        "```python",
+        "import gymnasium as gym",
+        "",
+        f'env = gym.make("bearing_env:{task.id}")',
+        f'envs = gym.make_vec("bearing_env:{task.id}", num_envs=8)  # the batched vector env',
+        "```",
+        "",
+        "## Observation",
+        "",
+        observation_text(resolved, observation_space),
+        "",
+        "## Action",
+        "",
+        action_text(resolved, action_space, task),
+        "",
+        "## Reward",
+        "",
+        reward_text(resolved),
+        "",
+        "## Episode end",
+        "",
+        termination_text(resolved),
+        "",
+        "## Settings",
+        "",
+        markdown_table(["setting", "value"], settings_rows(resolved, task)),
+        "",
+        "## Baselines",
+        "",
+        f"{config.episodes} evaluation episodes per policy on `{task.id}`{overrides}, "
+        f"the same for every policy: episode i resets the env with seed {seeds[0]} + i "
+        f"(seeds {seeds[0]}..{seeds[-1]}), and each policy's own randomness is seeded from "
+        "the episode's seed. Policies: "
+        f"{policies}. Total area: the sum of the region areas of L3, L4, ... (FL units², "
+        "|L1 - L2| = 1), each capped at `area_cap`, which also counts for a landmark not "
+        "yet initialised; lower is better. Confidence intervals: 95% percentile bootstrap "
+        f"of the mean ({config.bootstrap} resamples, seed {config.bootstrap_seed}).",
+        "",
+        "Mean total area [95% bootstrap CI] after n moves:",
+        "",
+        markdown_table(*area_mean_rows(summary, config)),
+        "",
+        "Median total area after n moves:",
+        "",
+        markdown_table(*area_median_rows(summary, config)),
+        "",
+        "Outcomes:",
+        "",
+        markdown_table(*outcome_table_rows(summary, config)),
+        "",
+    ]
+    if plot:
+        parts += [f"![total area versus moves, {task.id}]({area_plot_name(task)})", ""]
+    if frame:
+        parts += [
+            f"![a rendered frame of {task.id}]({frame_name(task)})",
+            "",
+            f"The first evaluation episode (seed {seeds[0]}) after {FRAME_MOVES} moves of "
+            "`greedy`: the true landmarks (stars), their uncertainty regions and centroids, the "
+            "latest bearing cones (±ε), the robot and its path.",
+            "",
+        ]
+    if command:
+        parts += ["Regenerate with:", "", "```bash", command, "```", ""]
+    return "\n".join(parts)
+
+
+def write_task_card(
+    task: Task,
+    config: CompareConfig,
+    result: CompareResult,
+    folder: Path,
+    docs: Path,
+    command: str | None,
+) -> Path:
+    """Write the card of a finished task, its frame and its area plot (from the
+    comparison in ``folder``) into ``docs``; the card's path."""
+    from bearing_env.train.compare.suite import copy_file
+
+    plot_source = folder / "area_vs_moves.png"
+    plot = plot_source.is_file()
+    if plot:
+        copy_file(plot_source, docs / area_plot_name(task))
+    frame = render_frame(config, config.seeds[0], docs / frame_name(task))
+    path = docs / card_name(task)
+    atomic_write_text(path, task_card(task, config, result.summary, command, frame, plot))
+    return path
+
+
+def final_area_cell(stats: Mapping[str, Any], move: str) -> str:
+    entry = stats["area_after"].get(move)
+    if entry is None or entry["mean"] is None:
+        return "-"
+    return f"{entry['mean']:.3g} [{entry['ci_low']:.3g}, {entry['ci_high']:.3g}]"
+
+
+def overview_rows(
+    results: Sequence[tuple[Task, Mapping[str, Any]]],
+) -> tuple[list[str], list[list[str]]]:
+    """Per task, the mean total area [95% CI] of each policy after the last reported
+    move count: the header and the rows (``-`` where a policy did not run)."""
+    labels: list[str] = []
+    for _, summary in results:
+        labels += [label for label in summary["policies"] if label not in labels]
+    header = ["task", "moves", "episodes", *labels]
+    rows = []
+    for task, summary in results:
+        policies = summary["policies"]
+        moves = sorted({int(k) for p in policies.values() for k in p["area_after"]})
+        last = str(moves[-1]) if moves else ""
+        episodes = sorted({int(p["episodes"]) for p in policies.values()})
+        cells = [task.id, last, "/".join(str(n) for n in episodes)]
+        for label in labels:
+            cells.append(final_area_cell(policies[label], last) if label in policies else "-")
+        rows.append(cells)
+    return header, rows
+
+
+def overview_table(results: Sequence[tuple[Task, Mapping[str, Any]]]) -> str:
+    """:func:`overview_rows` as a Markdown table with its title."""
+    return (
+        "Mean total area [95% bootstrap CI] after the last move (FL units², lower is "
+        "better):\n\n" + markdown_table(*overview_rows(results))
+    )
+
+
+def finished_summary(folder: Path) -> dict[str, Any] | None:
+    """The summary of a task folder whose comparison is complete (every policy has every
+    episode of its config), or None."""
+    from bearing_env.train.compare.suite import read_summary
+
+    summary = read_summary(folder)
+    if summary is None:
+        return None
+    episodes = int(summary["config"]["episodes"])
+    wanted = set(summary["config"]["policies"])
+    policies = summary["policies"]
+    if set(policies) != wanted or any(int(p["episodes"]) != episodes for p in policies.values()):
+        return None
+    return summary
+
+
+def index_page(tasks: Sequence[Task], docs: Path, out: Path) -> str:
+    """The Markdown of ``index.md``: the task table (linking the cards that exist in
+    ``docs``) and the baselines at a glance (from the finished comparisons in ``out``)."""
+    from bearing_env.tasks import NAMING_RULE
+
+    rows = []
+    for task in tasks:
+        card = docs / card_name(task)
+        link = f"[card]({card_name(task)})" if card.is_file() else "no card yet"
+        rows.append(
+            [f"`{task.id}`", task.action_kind, task.description, f"`{task.settings_text()}`", link]
+        )
+    finished = [
+        (task, summary)
+        for task in tasks
+        if (summary := finished_summary(out / task.id)) is not None
+        and (docs / card_name(task)).is_file()
+    ]
+    parts = [
+        "# Tasks",
+        "",
+        "Named, versioned tasks to compare on. Each id is registered with Gymnasium "
+        '(`gym.make("bearing_env:ID")`, `gym.make_vec("bearing_env:ID", num_envs=N)`) '
+        "as its base id with the settings below; `gym.make(ID, **more)` overrides them. "
+        "Each card gives the observation, action, reward, episode end, every setting, "
+        "and the baselines' scores with 95% bootstrap confidence intervals "
+        "(`bearing-env suite`).",
+        "",
+        markdown_table(["id", "actions", "description", "settings", "card"], rows),
+        "",
+        "Naming rule: " + NAMING_RULE,
+    ]
+    if finished:
+        parts += ["## Baselines at a glance", "", overview_table(finished), ""]
+    return "\n".join(parts)
+
+
+def write_index(tasks: Sequence[Task], docs: Path, out: Path) -> Path:
+    path = docs / INDEX_NAME
+    atomic_write_text(path, index_page(tasks, docs, out))
+    return path
