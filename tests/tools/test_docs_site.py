@@ -129,7 +129,12 @@ def test_the_readme_is_short_and_has_the_first_hour() -> None:
         assert needle in text, needle
     # The README links every page of the site but the API reference, generated there.
     linked = set(re.findall(r"\]\(docs/([\w/]+\.md)\)", text))
-    pages = {p.relative_to(DOCS).as_posix() for p in DOCS.rglob("*.md") if "_build" not in p.parts}
+    # The task cards are linked from the task index, which the README links.
+    pages = {
+        p.relative_to(DOCS).as_posix()
+        for p in DOCS.rglob("*.md")
+        if "_build" not in p.parts and (p.parent.name != "tasks" or p.name == "index.md")
+    }
     assert sorted(pages - linked - {"index.md", "api.md"}) == []
 
 

@@ -436,6 +436,12 @@ def index_page(tasks: Sequence[Task], docs: Path, out: Path) -> str:
     ]
     if finished:
         parts += ["## Baselines at a glance", "", overview_table(finished), ""]
+    # The docs site lists the cards under this page (a hidden toctree: the table links them).
+    cards = [
+        card_name(task).removesuffix(".md") for task in tasks if (docs / card_name(task)).is_file()
+    ]
+    if cards:
+        parts += ["```{toctree}", ":hidden:", "", *cards, "```", ""]
     return "\n".join(parts)
 
 
