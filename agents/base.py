@@ -81,8 +81,8 @@ class ActionCodec:
         self.spec: ActionSpec = base.action_spec
         self.config = base.config
         self.length_range: tuple[float, float] = (
-            float(base.move_length[0]),
-            float(base.move_length[1]),
+            float(base.config.actions.move_length[0]),
+            float(base.config.actions.move_length[1]),
         )
         self.discrete = self.spec.kind == "discrete"
         if self.discrete:

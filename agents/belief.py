@@ -91,7 +91,9 @@ class ObservationReader:
 
     def __init__(self, env: gym.Env) -> None:
         base = bearing_env_of(env)
-        self.bearing_block = observation_slices(int(base.max_landmarks))["bearings"]
+        self.bearing_block = observation_slices(int(base.config.observations.max_landmarks))[
+            "bearings"
+        ]
 
     def read(self, observation: NDArray[np.float32] | Mapping[str, Any]) -> ObservationView:
         """The view of a flat observation, or of an entity one (``observation="entities"``)."""

@@ -22,7 +22,7 @@ import gymnasium as gym
 from bearing_env.envs import robot_map
 from bearing_env.envs.bearing_slam import BearingSLAMEnv
 from bearing_env.envs.core import WorldView
-from bearing_env.slam import PolygonSLAM
+from bearing_env.slam import MapSettings, PolygonSLAM
 
 #: The one key of an info that robot policies read: the robot's own map.
 ROBOT_MAP_KEY = robot_map.KEY
@@ -58,8 +58,8 @@ class MapReader:
 
     def __init__(self, env: gym.Env) -> None:
         base = bearing_env_of(env)
-        #: The world model's keyword settings (epsilon, transfer, fusion, ...).
-        self.map_settings = dict(base.config.map_settings)
+        #: The world model's settings (epsilon, transfer, fusion, ...).
+        self.map_settings: MapSettings = base.config.map_settings
 
     def read(self, info: Mapping[str, Any], n_landmarks: int) -> PolygonSLAM:
         """The map of an info (an independent copy: the policy may update it)."""

@@ -317,9 +317,9 @@ class GreedyOneStep(BeliefPolicy):
         if int(n_turns) < 1:
             raise ValueError(f"n_turns must be >= 1, got {n_turns!r}")
         self.candidates = self.codec.candidates(int(n_turns), lengths)
-        self.area_cap = float(bearing_env_of(env).area_cap)
+        self.area_cap = float(bearing_env_of(env).config.task.area_cap)
         # Score moves with the potential the env rewards (reward="log_area" or "area").
-        self.log_area = bearing_env_of(env).config.reward == "log_area"
+        self.log_area = bearing_env_of(env).config.task.reward == "log_area"
 
     def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
         view = self.reader.read(observation)

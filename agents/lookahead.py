@@ -189,7 +189,7 @@ class Lookahead(GreedyOneStep):
             int_at_least(value, 1, label)
         super().__init__(env, n_turns=n_turns, lengths=lengths)
         self.depth, self.width, self.hypotheses = depth, width, hypotheses
-        self.min_baseline = float(bearing_env_of(env).arena.min_baseline)
+        self.min_baseline = float(bearing_env_of(env).config.layout.arena.min_baseline)
         self.planning_times: list[float] = []
 
     def reset(self, seed: int | None = None) -> None:

@@ -13,14 +13,20 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.extras import require
+from bearing_env.slam import fl_to_world
 from bearing_env.world import Arena
+
+if TYPE_CHECKING:
+    from bearing_env.envs.config import EnvConfig
+    from bearing_env.envs.state import BatchState
+    from bearing_env.slam import PolygonSLAM
 
 FloatArray = NDArray[np.float64]
 
@@ -135,6 +141,41 @@ class Scene:
     n_initialised: int
     frame_changed: bool
     robot_radius: float
+
+
+def scene(state: BatchState, row: int, config: EnvConfig, slam: PolygonSLAM) -> Scene:
+    """What the renderer draws for row ``row`` of an env batch's state: the truth from
+    ``state``, the robot's map ``slam``, the settings from ``config``. Rendering reads
+    the envs' functional core; the core never imports rendering."""
+    n = int(state.n_landmarks[row])
+    landmarks = state.landmarks[row, :n].copy()
+    l1, l2 = landmarks[0], landmarks[1]
+
+    def to_world(points: FloatArray | None) -> FloatArray | None:
+        return None if points is None else fl_to_world(points, l1, l2)
+
+    has_moved = bool(np.all(np.isfinite(state.start_positions[row])))
+    areas = slam.areas
+    return Scene(
+        arena=config.layout.arena,
+        landmarks=landmarks,
+        estimates=fl_to_world(slam.estimates, l1, l2),
+        regions=[to_world(polygon) for polygon in slam.polygons],
+        robot_region=to_world(slam.robot_polygon),
+        robot_position=state.positions[row].copy(),
+        robot_heading=float(state.headings[row]),
+        trajectory=state.trajectory[row, : state.trajectory_length[row]].copy(),
+        start_position=state.start_positions[row].copy() if has_moved else None,
+        start_bearings=state.start_bearings[row, :n].copy() if has_moved else None,
+        end_bearings=state.latest_bearings[row, :n].copy(),
+        epsilon=config.epsilon,
+        moves=int(state.moves[row]),
+        max_moves=config.task.max_moves,
+        total_area=float(np.sum(areas)),
+        n_initialised=int(np.sum(slam.initialised)),
+        frame_changed=bool(state.frame_changed[row]),
+        robot_radius=config.layout.arena.wall_margin,
+    )
 
 
 class Renderer:

@@ -18,7 +18,7 @@ from bearing_env.envs import (
     BearingSLAMEnv,
     BearingSLAMVectorEnv,
 )
-from bearing_env.envs.config import MAX_AREA_CAP, MAX_N_LANDMARKS, EnvConfig
+from bearing_env.envs.config import FIELDS, MAX_AREA_CAP, MAX_N_LANDMARKS, SETTINGS, EnvConfig
 from bearing_env.world import Arena, NoiseModel
 
 
@@ -34,7 +34,7 @@ def test_create_resolves_the_scenario_defaults() -> None:
     assert config.epsilon == pytest.approx(math.radians(2.0))
     random = EnvConfig.create(n_landmarks=(4, 12))
     assert random.scenario == "random" and random.landmarks is None
-    assert random.has_count_range and random.max_landmarks == 12
+    assert random.layout.has_count_range and random.max_landmarks == 12
     assert EnvConfig.create(landmarks=[[0.1, 0.1], [0.5, 0.1], [0.3, 0.4]]).scenario == "custom"
 
 
@@ -73,9 +73,14 @@ def test_replace_and_direct_construction_are_validated(
     with pytest.raises(error, match=fragment):
         config.replace(**change)
     if "no_such_field" not in change:
-        fields = {f.name: getattr(config, f.name) for f in dataclasses.fields(config)}
+        # Directly: the changed field's group built with the bad value (the groups
+        # validate themselves; EnvConfig what spans them, such as max_landmarks >= count).
+        ((name, value),) = change.items()
+        group = FIELDS[name].group
+        groups = {f.name: getattr(config, f.name) for f in dataclasses.fields(config)}
         with pytest.raises(error, match=fragment):
-            EnvConfig(**{**fields, **change})
+            changed = dataclasses.replace(groups[group], **{name: value})
+            EnvConfig(**{**groups, group: changed})
 
 
 def test_fixed_landmarks_must_match_the_count() -> None:
@@ -114,9 +119,7 @@ def test_the_largest_accepted_area_cap_keeps_area_rewards_finite() -> None:
 @pytest.mark.parametrize(
     ("env_id", "extra"), [("BearingSLAM-v0", {}), ("BearingSLAMDiscrete-v0", {"n_turns": 4})]
 )
-def test_an_env_from_a_config_equals_one_from_keywords(
-    env_id: str, extra: dict[str, Any]
-) -> None:
+def test_an_env_from_a_config_equals_one_from_keywords(env_id: str, extra: dict[str, Any]) -> None:
     kwargs = {"scenario": "khepera", "path_cost": 0.5, "noise": "gaussian", **extra}
     config = EnvConfig.create(**kwargs)
     from_config = gym.make(env_id, config=config)
@@ -147,11 +150,12 @@ def test_a_config_and_keywords_together_are_refused() -> None:
 
 
 def test_the_constructors_show_the_settings_of_envconfig_create() -> None:
-    """The settings are written once (EnvConfig.create); the envs' signatures are made
-    from it, so help() and inspect show every setting with its default."""
+    """The settings are written once (the groups' fields, SETTINGS); create's and the
+    envs' signatures are made from them, so help() and inspect show every setting."""
     import inspect
 
     create = inspect.signature(EnvConfig.create).parameters
+    assert list(create) == [spec.keyword for spec in SETTINGS]
     continuous = inspect.signature(BearingSLAMEnv).parameters
     discrete = inspect.signature(BearingSLAMDiscreteEnv).parameters
     assert list(discrete) == ["render_mode", "config", *create]

@@ -93,8 +93,8 @@ def test_the_robot_map_codec_round_trips_a_map_through_an_info(fusion: str) -> N
     one_env = {name: values[0] for name, values in data.items()}
     assert one_env["counts"].shape == (8,) and np.all(one_env["counts"][3:] == 0)
     assert np.all(np.isinf(one_env["areas"][3:]))
-    settings = {"epsilon": batch.epsilon, "transfer": batch.transfer, "fusion": fusion}
-    back = robot_map.decode(one_env, 5, settings).batch
+    back = robot_map.decode(one_env, 5, batch.settings).batch
+    assert back.settings == batch.settings and back.fusion == fusion
     for name in batch.state_names:
         np.testing.assert_array_equal(
             np.nan_to_num(getattr(back, name)), np.nan_to_num(getattr(batch, name)), err_msg=name

@@ -76,7 +76,7 @@ class ContinuousActions:
             # float64 only (numba has no float16 or longdouble). Cast; the range check follows.
             values = values.astype(np.float64)
         turns, lengths = np.empty(values.shape[0]), np.empty(values.shape[0])
-        lo, hi = config.move_length
+        lo, hi = config.actions.move_length
         outcome = kernels.decode_continuous(values, lo, hi, turns, lengths)
         if outcome == kernels.ACTIONS_NOT_FINITE:
             raise ValueError(f"actions must be finite, got {actions!r}")
@@ -87,7 +87,7 @@ class ContinuousActions:
     def encode(self, config: EnvConfig, turn: float, length: float) -> NDArray[np.float32]:
         """The action nearest "turn by ``turn``, move ``length``" (lengths clipped to the
         ``move_length`` range)."""
-        lo, hi = config.move_length
+        lo, hi = config.actions.move_length
         turn_unit = wrap(turn) / math.pi
         length_unit = 1.0 if hi <= lo else 2.0 * (length - lo) / (hi - lo) - 1.0
         return np.clip(np.array([turn_unit, length_unit]), -1.0, 1.0).astype(np.float32)
@@ -101,25 +101,26 @@ class DiscreteActions:
     shape: ClassVar[tuple[int, ...]] = ()
 
     def space(self, config: EnvConfig) -> spaces.Space[Any]:
-        return spaces.Discrete(config.n_turns * config.n_move_lengths)
+        return spaces.Discrete(config.actions.n_turns * config.actions.n_move_lengths)
 
     def tables(self, config: EnvConfig) -> tuple[FloatArray, FloatArray]:
         """The grid: (turn angles (n_turns,), move lengths (n_move_lengths,))."""
-        lo, hi = config.move_length
-        turns = wrap_angle(2.0 * math.pi * np.arange(config.n_turns) / config.n_turns)
-        return turns, np.linspace(lo, hi, config.n_move_lengths)
+        grid = config.actions
+        lo, hi = grid.move_length
+        turns = wrap_angle(2.0 * math.pi * np.arange(grid.n_turns) / grid.n_turns)
+        return turns, np.linspace(lo, hi, grid.n_move_lengths)
 
     def check_one(self, config: EnvConfig, action: Any) -> NDArray[Any]:
         """One action index as an array of shape () (ValueError otherwise)."""
         values = np.asarray(action)
         if values.shape != ():
-            n_actions = config.n_turns * config.n_move_lengths
+            n_actions = config.actions.n_turns * config.actions.n_move_lengths
             raise ValueError(f"action must be an integer in [0, {n_actions}), got {action!r}")
         return values
 
     def decode(self, config: EnvConfig, actions: Any) -> tuple[FloatArray, FloatArray]:
         """(turn angles, move lengths) of action indices (N,)."""
-        n_actions = config.n_turns * config.n_move_lengths
+        n_actions = config.actions.n_turns * config.actions.n_move_lengths
         values = real_values(actions, f"actions (integers in [0, {n_actions}))")
         if values.dtype.kind == "f":
             if not np.all(np.isfinite(values)) or np.any(values != np.round(values)):
@@ -130,7 +131,7 @@ class DiscreteActions:
                 f"actions {actions!r} are outside the action space Discrete({n_actions})"
             )
         turns, lengths = self.tables(config)
-        turn_index, length_index = np.divmod(index, config.n_move_lengths)
+        turn_index, length_index = np.divmod(index, config.actions.n_move_lengths)
         return turns[turn_index], lengths[length_index]
 
     def encode(self, config: EnvConfig, turn: float, length: float) -> int:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 from collections.abc import Collection, Mapping
-from typing import Any, ClassVar, Generic, SupportsFloat, TypeVar, cast
+from typing import Any, ClassVar, SupportsFloat, cast
 
 import gymnasium as gym
 import numpy as np
@@ -30,7 +30,9 @@ from bearing_env.envs.config import (
     MAX_AREA_CAP,
     MAX_N_LANDMARKS,
     REWARDS,
+    SETTINGS,
     EnvConfig,
+    SettingSpec,
     settings_signature,
 )
 from bearing_env.envs.core import MapBank, WorldView
@@ -46,7 +48,6 @@ from bearing_env.envs.observations import (
 )
 from bearing_env.envs.state import BatchState
 from bearing_env.slam import PolygonSLAM
-from bearing_env.world import Arena, NoiseModel
 
 __all__ = [
     "AREA_FLOOR",
@@ -69,35 +70,31 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
-T = TypeVar("T")
 
 
-class Setting(Generic[T]):
-    """An env attribute backed by a field of the env's config: reading gives the field;
-    assigning replaces ``env.config`` by a validated copy with the field changed."""
+class Setting:
+    """An env attribute backed by a field of the env's config (one per
+    :data:`~bearing_env.envs.config.SETTINGS` entry, installed by
+    ``BearingSLAMEnv.__init_subclass__``): reading gives the field; assigning replaces
+    ``env.config`` by a validated copy with the field changed."""
 
-    def __init__(self, field: str, read_only: str | None = None) -> None:
-        self.field = field
+    def __init__(self, spec: SettingSpec) -> None:
+        self.spec = spec
+        #: The config field (``config.replace`` takes it).
+        self.field = spec.field
         #: Why the attribute cannot be assigned (None: it can).
-        self.read_only = read_only
+        self.read_only = spec.read_only
+        self.__doc__ = f"The ``{spec.keyword}`` setting (``config.{spec.group}.{spec.field}``)."
 
-    def __set_name__(self, owner: type, name: str) -> None:
-        self.name = name
-
-    def __get__(self, env: Any, owner: type | None = None) -> T:
+    def __get__(self, env: Any, owner: type | None = None) -> Any:
         if env is None:
-            # why: read on the class, a descriptor gives itself (as property does), not a T
-            return self  # type: ignore[return-value]
-        return getattr(env.config, self.field)
+            return self  # read on the class, a descriptor gives itself (as property does)
+        return getattr(getattr(env.config, self.spec.group), self.field)
 
-    def __set__(self, env: Any, value: T) -> None:
+    def __set__(self, env: Any, value: Any) -> None:
         if self.read_only is not None:
-            raise AttributeError(f"{self.name} is read-only: {self.read_only}")
+            raise AttributeError(f"{self.spec.attribute} is read-only: {self.read_only}")
         env.config = env.config.replace(**{self.field: value})
-
-
-#: Why ``max_landmarks`` cannot change on a live env.
-FIXES_THE_SPACES = "it fixes the observation space; make a new env"
 
 
 def settings_from(config: EnvConfig | None, settings: Mapping[str, Any], grid: bool) -> EnvConfig:
@@ -312,12 +309,15 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
       the same keywords; giving both is refused). Invalid settings raise `TypeError` or
       `ValueError` naming the value.
 
-    The settings are written once, as `EnvConfig.create`'s parameters: the constructor
-    takes `**settings` and its signature (`inspect.signature(BearingSLAMEnv)`, `help()`)
-    is generated from `EnvConfig.create`'s.
+    The settings are written once, as the fields of `EnvConfig`'s groups (`layout`,
+    `sensor`, `mapping`, `task`, `actions`, `observations`; see
+    `bearing_env.envs.config`): the constructor takes `**settings`, `EnvConfig.create`
+    routes each to its group, and the constructor's signature
+    (`inspect.signature(BearingSLAMEnv)`, `help()`) is generated from the groups.
 
-    Every setting is also an attribute (`env.area_cap`, `env.path_cost`, ...; `reward`
-    is `env.reward_kind`); assigning one replaces `env.config` with a validated copy.
+    Every setting but `landmarks` is also an attribute (`env.area_cap`, `env.path_cost`,
+    ...; `reward` is `env.reward_kind`, `n_landmarks` is `env.landmark_counts`), generated
+    from the same groups; assigning one replaces `env.config` with a validated copy.
     `max_landmarks` and `observation_kind` (the `observation` setting) are read-only
     (they fix the observation space). A change of `epsilon_deg`, `transfer`, `fusion`,
     `max_outliers` or `on_inconsistency` gives the env a new, empty map.
@@ -329,29 +329,13 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     #: The action kind: its space, decoding and encoding (:mod:`bearing_env.envs.actions`).
     action_spec: ClassVar[ActionSpec] = CONTINUOUS
-    #: The constructor's keywords, generated from ``EnvConfig.create`` below the class.
+    #: The constructor's keywords, generated from the config's groups (:func:`install_settings`).
     __signature__: ClassVar[inspect.Signature]
     metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 4}  # noqa: RUF012
 
-    # Every setting is an attribute backed by the config (see the Arguments section).
-    scenario: Setting[str] = Setting("scenario")
-    landmark_counts: Setting[tuple[int, int]] = Setting("landmark_counts")
-    arena: Setting[Arena] = Setting("arena")
-    epsilon_deg: Setting[float] = Setting("epsilon_deg")
-    noise: Setting[NoiseModel] = Setting("noise")
-    transfer: Setting[str] = Setting("transfer")
-    reward_kind: Setting[str] = Setting("reward")
-    target_area: Setting[float] = Setting("target_area")
-    max_moves: Setting[int] = Setting("max_moves")
-    move_length: Setting[tuple[float, float]] = Setting("move_length")
-    path_cost: Setting[float] = Setting("path_cost")
-    move_cost: Setting[float] = Setting("move_cost")
-    area_cap: Setting[float] = Setting("area_cap")
-    max_landmarks: Setting[int] = Setting("max_landmarks", read_only=FIXES_THE_SPACES)
-    fusion: Setting[str] = Setting("fusion")
-    max_outliers: Setting[int] = Setting("max_outliers")
-    on_inconsistency: Setting[str] = Setting("on_inconsistency")
-    observation_kind: Setting[str] = Setting("observation", read_only=FIXES_THE_SPACES)
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        install_settings(cls)
 
     def __init__(
         self, *, render_mode: str | None = None, config: EnvConfig | None = None, **settings: Any
@@ -378,8 +362,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         self.observation_space = cast(Any, self.observation_spec.space(config))
         #: The batch of one this env is; its row index array, for the core's functions.
         self._rows = np.array([0])
-        self._state = BatchState.empty(1, config.max_landmarks)
-        self._state.n_landmarks[:] = config.landmark_counts[1]
+        self._state = BatchState.empty(1, config.observations.max_landmarks)
+        self._state.n_landmarks[:] = config.layout.landmark_counts[1]
         self._maps = MapBank(1)
         self._world: WorldView | None = None
         self._renderer: Any = None
@@ -402,6 +386,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         core.check_config_switch(self._config, config, action_grid_fixed=grid_fixed)
         core.switch_maps(self._state, self._maps, 0, self._config, config)
         self._config = config
+        if self._world is not None:
+            self._world.config = config
 
     @property
     def epsilon(self) -> float:
@@ -411,7 +397,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     @property
     def fixed_landmarks(self) -> FloatArray | None:
         """The scenario's fixed landmark positions (n, 2), metres; None if random."""
-        return self.config.fixed_landmarks
+        return self.config.layout.fixed_landmarks
 
     @property
     def n_landmarks(self) -> int:
@@ -432,9 +418,6 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         """
         return self._world
 
-    def _row_config(self, row: int) -> EnvConfig:
-        return self.config
-
     # ------------------------------------------------------------------------------------
     # Gymnasium API
     # ------------------------------------------------------------------------------------
@@ -447,7 +430,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         rows, config = self._rows, self.config
         core.reset_rows(self._state, rows, config, [self.np_random], self._maps)
         if self._world is None:
-            self._world = WorldView(self, 0)
+            self._world = WorldView(self._state, 0, config)
         group = self._maps.group(self._state, rows, config)
         observation = core.observations(self._state, group)[0]
         infos = core.infos(self._state, group, core.reset_outcome(1))
@@ -482,7 +465,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     def _observation(self, flat: NDArray[np.float32]) -> Any:
         """The observation of the env's kind from the flat vector."""
-        return self.observation_spec.convert(flat, self.config.max_landmarks)
+        return self.observation_spec.convert(flat, self.config.observations.max_landmarks)
 
     def render(self) -> NDArray[np.uint8] | None:
         if self.render_mode is None:
@@ -496,8 +479,11 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         if self._renderer is None:
             from bearing_env.rendering import Renderer
 
-            self._renderer = Renderer(self.render_mode, self.arena, fps=self.metadata["render_fps"])
-        return self._renderer.render(core.scene(self._state, 0, self.config, self.slam))
+            arena = self.config.layout.arena
+            self._renderer = Renderer(self.render_mode, arena, fps=self.metadata["render_fps"])
+        from bearing_env.rendering import scene
+
+        return self._renderer.render(scene(self._state, 0, self.config, self.slam))
 
     def close(self) -> None:
         if self._renderer is not None:
@@ -515,7 +501,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         spec = self._spec
         if spec is None or spec.max_episode_steps is not None:
             return spec
-        return dataclasses.replace(spec, max_episode_steps=self.config.max_moves)
+        return dataclasses.replace(spec, max_episode_steps=self.config.task.max_moves)
 
     @spec.setter
     def spec(self, spec: EnvSpec | None) -> None:
@@ -526,12 +512,6 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         state = self.__dict__.copy()
         state["_renderer"] = None
         return state
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__dict__.update(state)
-        # An out-of-band pickle may hand back read-only buffers: the arrays the env
-        # writes are copied then (the others are kept as they are, without a copy).
-        self._state = self._state.writable()
 
     # ------------------------------------------------------------------------------------
     # Actions
@@ -567,8 +547,8 @@ def check_reset_options(options: object, known: Collection[str] = ()) -> Mapping
 
 def constructor_signature(env_class: type[BearingSLAMEnv]) -> inspect.Signature:
     """The signature ``inspect.signature(env_class)`` and ``help()`` show: ``render_mode``
-    and ``config``, then every setting of :meth:`EnvConfig.create` the class takes
-    (generated, so the settings are written once)."""
+    and ``config``, then every setting the class takes (generated from the config's
+    groups, so the settings are written once)."""
     keyword = inspect.Parameter.KEYWORD_ONLY
     leading = [
         inspect.Parameter("render_mode", keyword, default=None, annotation="str | None"),
@@ -577,4 +557,16 @@ def constructor_signature(env_class: type[BearingSLAMEnv]) -> inspect.Signature:
     return settings_signature(grid=env_class.action_spec.grid_fixed, leading=leading)
 
 
-BearingSLAMEnv.__signature__ = constructor_signature(BearingSLAMEnv)
+def install_settings(env_class: type[BearingSLAMEnv]) -> None:
+    """Give an env class its setting attributes (a :class:`Setting` per
+    :data:`~bearing_env.envs.config.SETTINGS` entry that has an attribute; the grid's
+    only if the class has a grid) and its constructor signature. Every subclass gets
+    them (``__init_subclass__``), after its class body has set its ``action_spec``."""
+    grid = env_class.action_spec.grid_fixed
+    for spec in SETTINGS:
+        if spec.attribute is not None and (grid or not spec.grid):
+            setattr(env_class, spec.attribute, Setting(spec))
+    env_class.__signature__ = constructor_signature(env_class)
+
+
+install_settings(BearingSLAMEnv)

@@ -5,13 +5,7 @@ from __future__ import annotations
 from typing import ClassVar
 
 from bearing_env.envs.actions import DISCRETE, ActionSpec
-from bearing_env.envs.bearing_slam import (
-    FIXES_THE_SPACES,
-    BearingSLAMEnv,
-    FloatArray,
-    Setting,
-    constructor_signature,
-)
+from bearing_env.envs.bearing_slam import BearingSLAMEnv, FloatArray
 from bearing_env.envs.config import DEFAULT_N_MOVE_LENGTHS, DEFAULT_N_TURNS
 
 __all__ = ["DEFAULT_N_MOVE_LENGTHS", "DEFAULT_N_TURNS", "BearingSLAMDiscreteEnv"]
@@ -73,10 +67,8 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
     * v0: Initial version.
     """
 
-    # The grid sizes fix the action space.
-    n_turns: Setting[int] = Setting("n_turns", read_only=FIXES_THE_SPACES)
-    n_move_lengths: Setting[int] = Setting("n_move_lengths", read_only=FIXES_THE_SPACES)
-
+    # Its setting attributes, the grid's read-only ones (n_turns, n_move_lengths)
+    # included, and its signature are installed by BearingSLAMEnv.__init_subclass__.
     action_spec: ClassVar[ActionSpec] = DISCRETE
 
     @property
@@ -88,7 +80,3 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
     def move_lengths(self) -> FloatArray:
         """The move lengths of the action grid, metres."""
         return DISCRETE.tables(self.config)[1]
-
-
-
-BearingSLAMDiscreteEnv.__signature__ = constructor_signature(BearingSLAMDiscreteEnv)

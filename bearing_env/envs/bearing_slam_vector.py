@@ -164,19 +164,21 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         #: The distinct configs of the sub-envs, and which one each sub-env has.
         self._config_table: list[EnvConfig] = [first]
         self._config_index = np.zeros(self.num_envs, dtype=np.int64)
-        self._state = BatchState.empty(self.num_envs, first.max_landmarks)
-        self._state.n_landmarks[:] = first.landmark_counts[1]
+        observations, layout = first.observations, first.layout
+        self._state = BatchState.empty(self.num_envs, observations.max_landmarks)
+        self._state.n_landmarks[:] = layout.landmark_counts[1]
         self._maps = MapBank(self.num_envs)
         self._rngs: list[np.random.Generator | None] = [None] * self.num_envs
-        self._worlds = [WorldView(self, row) for row in range(self.num_envs)]
+        self._worlds = [WorldView(self._state, row, first) for row in range(self.num_envs)]
         self._renderers: list[Any] = [None] * self.num_envs
 
         #: Landmark slots of the per-landmark info arrays when counts vary per episode.
-        self._info_slots = first.max_landmarks - 2 if first.has_count_range else None
+        slots = observations.max_landmarks
+        self._info_slots = slots - 2 if layout.has_count_range else None
         #: The sub-envs' observations, flat (the observation kind cannot change per env).
-        self._flat_shape = (self.num_envs, observation_size(first.max_landmarks))
+        self._flat_shape = (self.num_envs, observation_size(slots))
         self._observation_spec = prototype.observation_spec
-        self._max_landmarks = first.max_landmarks
+        self._max_landmarks = slots
         self._autoreset_envs = np.zeros(self.num_envs, dtype=bool)
         self._elapsed_steps = np.zeros(self.num_envs, dtype=np.int64)
         self._has_reset = False
@@ -295,16 +297,16 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             raise RuntimeError("call reset() before render()")
         frames = []
         for row in range(self.num_envs):
-            if self._renderers[row] is None:
-                from bearing_env.rendering import Renderer
+            from bearing_env.rendering import Renderer, scene
 
+            if self._renderers[row] is None:
                 self._renderers[row] = Renderer(
                     self.render_mode,
-                    self._row_config(row).arena,
+                    self._row_config(row).layout.arena,
                     fps=BearingSLAMEnv.metadata["render_fps"],
                 )
             slam = self._slam(row)
-            frame = core.scene(self._state, row, self._row_config(row), slam)
+            frame = scene(self._state, row, self._row_config(row), slam)
             frames.append(self._renderers[row].render(frame))
         return tuple(frames)
 
@@ -371,8 +373,8 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
-        # An out-of-band pickle may hand back read-only buffers: copy what is written.
-        self._state = self._state.writable()
+        # An out-of-band pickle may hand back read-only buffers: copy what is written
+        # (the batch state does so itself, keeping its identity for the world views).
         self._config_index = np.require(self._config_index, requirements=["W"])
         self._autoreset_envs = np.require(self._autoreset_envs, requirements=["W"])
         self._elapsed_steps = np.require(self._elapsed_steps, requirements=["W"])
@@ -386,6 +388,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
     def _set_row_config(self, row: int, config: EnvConfig) -> None:
         core.switch_maps(self._state, self._maps, row, self._row_config(row), config)
+        self._worlds[row].config = config
         if config not in self._config_table:
             self._config_table.append(config)
         self._config_index[row] = self._config_table.index(config)

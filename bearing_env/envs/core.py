@@ -31,12 +31,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env.envs import kernels, robot_map
-from bearing_env.envs.config import AREA_FLOOR, EnvConfig, MapSettings
+from bearing_env.envs.config import AREA_FLOOR, EnvConfig
 from bearing_env.envs.kernels import Settings
 from bearing_env.envs.observations import FL_COORD_LIMIT, observation_size
 from bearing_env.envs.state import BatchState
 from bearing_env.numerics import wrap_angle
-from bearing_env.slam import PolygonSLAM
+from bearing_env.slam import MapSettings, PolygonSLAM
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
     BatchedPolygonSLAM,
@@ -63,8 +63,9 @@ ComplexArray = NDArray[np.complex128]
 
 
 class MapBank:
-    """The robots' maps: one :class:`BatchedPolygonSLAM` per (landmark count, epsilon,
-    transfer), each with a row per env (row ``i`` of every batch belongs to env ``i``).
+    """The robots' maps: one :class:`BatchedPolygonSLAM` per (landmark count,
+    :class:`~bearing_env.slam.MapSettings`), each with a row per env (row ``i`` of every
+    batch belongs to env ``i``).
 
     Envs whose landmark count varies switch batches at reset; their rows in the other
     batches are simply left idle. The bank also keeps each (config, landmark count)'s
@@ -90,12 +91,12 @@ class MapBank:
         return Group(rows, config, n, last[3], last[4])
 
     def batch(self, n_landmarks: int, config: EnvConfig) -> BatchedPolygonSLAM:
-        return self._batch_for((int(n_landmarks), config.map_settings))
+        return self._batch_for(int(n_landmarks), config.map_settings)
 
     def _inputs_for(
         self, n: int, config: EnvConfig, state_ref: BatchState
     ) -> tuple[BatchedPolygonSLAM, kernels.Inputs]:
-        batch = self._batch_for((n, config.map_settings))
+        batch = self._batch_for(n, config.map_settings)
         maps_ref = batch._kernel_state()
         kept = self._inputs.get((n, config))
         if kept is None or kept[0] is not state_ref or kept[1] is not maps_ref:
@@ -104,10 +105,12 @@ class MapBank:
             kept = self._inputs[n, config] = (state_ref, maps_ref, inputs)
         return batch, kept[2]
 
-    def _batch_for(self, key: tuple[int, MapSettings]) -> BatchedPolygonSLAM:
+    def _batch_for(self, n_landmarks: int, settings: MapSettings) -> BatchedPolygonSLAM:
+        key = (n_landmarks, settings)
         if key not in self.batches:
-            n_landmarks, settings = key
-            self.batches[key] = BatchedPolygonSLAM(self.num_rows, n_landmarks, **dict(settings))
+            self.batches[key] = BatchedPolygonSLAM.from_settings(
+                self.num_rows, n_landmarks, settings
+            )
         return self.batches[key]
 
     def view(self, n_landmarks: int, config: EnvConfig, row: int) -> PolygonSLAM:
@@ -137,21 +140,21 @@ class Group(NamedTuple):
 
 def kernel_settings(n_landmarks: int, config: EnvConfig) -> Settings:
     """The kernels' settings of a group of ``config`` with ``n_landmarks`` landmarks."""
-    arena = config.arena
+    arena, task = config.layout.arena, config.task
     return Settings(
         n=int(n_landmarks),
-        n_slots=int(config.max_landmarks),
+        n_slots=int(config.observations.max_landmarks),
         width=float(arena.width),
         height=float(arena.height),
         margin=float(arena.wall_margin),
         min_baseline=float(arena.min_baseline),
-        log_area=config.reward == "log_area",
+        log_area=task.reward == "log_area",
         floor=AREA_FLOOR,
-        cap=float(config.area_cap),
-        target_area=float(config.target_area),
-        max_moves=int(config.max_moves),
-        path_cost=float(config.path_cost),
-        move_cost=float(config.move_cost),
+        cap=float(task.area_cap),
+        target_area=float(task.target_area),
+        max_moves=int(task.max_moves),
+        path_cost=float(task.path_cost),
+        move_cost=float(task.move_cost),
         coordinate_limit=FL_COORD_LIMIT,
         tolerance=CONTAINMENT_TOLERANCE,
     )
@@ -163,23 +166,23 @@ def check_config_switch(old: EnvConfig, new: EnvConfig, action_grid_fixed: bool)
     the action grid cannot change."""
     if not isinstance(new, EnvConfig):
         raise TypeError(f"config must be an EnvConfig, got {new!r}")
-    if new.max_landmarks != old.max_landmarks:
+    was, now = old.observations, new.observations
+    if now.max_landmarks != was.max_landmarks:
         raise ValueError(
-            f"max_landmarks cannot change ({old.max_landmarks} -> {new.max_landmarks}): "
+            f"max_landmarks cannot change ({was.max_landmarks} -> {now.max_landmarks}): "
             "it fixes the observation space; make a new env"
         )
-    if new.observation != old.observation:
+    if now.observation != was.observation:
         raise ValueError(
-            f"observation cannot change ({old.observation!r} -> {new.observation!r}): "
+            f"observation cannot change ({was.observation!r} -> {now.observation!r}): "
             "it fixes the observation space; make a new env"
         )
-    if action_grid_fixed and (new.n_turns, new.n_move_lengths) != (
-        old.n_turns,
-        old.n_move_lengths,
-    ):
+    grid_was = (old.actions.n_turns, old.actions.n_move_lengths)
+    grid_now = (new.actions.n_turns, new.actions.n_move_lengths)
+    if action_grid_fixed and grid_now != grid_was:
         raise ValueError(
-            f"n_turns and n_move_lengths cannot change ({old.n_turns}, {old.n_move_lengths} "
-            f"-> {new.n_turns}, {new.n_move_lengths}): they fix the action space"
+            f"n_turns and n_move_lengths cannot change ({grid_was[0]}, {grid_was[1]} "
+            f"-> {grid_now[0]}, {grid_now[1]}): they fix the action space"
         )
 
 
@@ -199,36 +202,30 @@ def switch_maps(state: BatchState, maps: MapBank, row: int, old: EnvConfig, new:
 class WorldView:
     """One row's ground truth (true landmarks, the robot's true pose), read-only and live.
 
-    It reads the batch's arrays, so it follows the episode; it offers what
+    It is given what it reads: the batch ``state`` (the very object the env steps, so
+    the view follows the episode), its ``row``, and the row's ``config``, which the
+    owning env sets again whenever the row's config changes. It offers what
     :class:`~bearing_env.world.World` offers for reading. :meth:`copy` (and
     ``copy.deepcopy``) give an independent, mutable :class:`World`.
     """
 
-    def __init__(self, state_owner: Any, row: int) -> None:
-        # The owner (an env) is held rather than its state: the state object is
-        # replaced when the env is unpickled or its trajectory grows.
-        self._owner = state_owner
-        self._row = row
-
-    @property
-    def _state(self) -> BatchState:
-        return self._owner._state
-
-    @property
-    def _config(self) -> EnvConfig:
-        return self._owner._row_config(self._row)
+    def __init__(self, state: BatchState, row: int, config: EnvConfig) -> None:
+        self._state = state
+        self._row = int(row)
+        #: The row's settings (arena, noise, epsilon); its env keeps it current.
+        self.config = config
 
     @property
     def arena(self) -> Arena:
-        return self._config.arena
+        return self.config.layout.arena
 
     @property
     def noise(self) -> NoiseModel:
-        return self._config.noise
+        return self.config.sensor.noise
 
     @property
     def epsilon(self) -> float:
-        return self._config.epsilon
+        return self.config.epsilon
 
     @property
     def n_landmarks(self) -> int:
@@ -291,15 +288,16 @@ def reset_rows(
     count range), its layout (``"random"``), its start pose, then its first reading.
     Afterwards the rows may have different landmark counts (see :func:`group_rows`).
     """
-    lo, hi = config.landmark_counts
-    fixed = config.fixed_landmarks
+    layout, noise = config.layout, config.sensor.noise
+    lo, hi = layout.landmark_counts
+    fixed = layout.fixed_landmarks
     state.landmarks[rows] = 0.0
     state.landmarks_fl[rows] = 0.0
     for row, rng in zip(rows.tolist(), rngs, strict=True):
         # Rejection sampling makes the draws per row: a layout's draw count varies.
         count = int(rng.integers(lo, hi + 1)) if hi > lo else hi
-        landmarks = fixed if fixed is not None else random_layout(rng, config.arena, count)
-        position, heading = random_start(rng, config.arena, landmarks)
+        landmarks = fixed if fixed is not None else random_layout(rng, layout.arena, count)
+        position, heading = random_start(rng, layout.arena, landmarks)
         state.n_landmarks[row] = count
         state.landmarks[row, :count] = landmarks
         state.positions[row] = position
@@ -325,7 +323,7 @@ def reset_rows(
             state.landmarks[group, :n], state.positions[group], state.headings[group]
         )
         group_rngs = [rng_of[i] for i in group.tolist()]
-        readings = config.noise.corrupt_rows(group_rngs, truth, config.epsilon)
+        readings = noise.corrupt_rows(group_rngs, truth, config.epsilon)
         state.latest_bearings[group] = 0.0
         state.latest_bearings[group, :n] = readings
         rows_group = maps.group(state, group, config)
@@ -378,7 +376,7 @@ def step(
     rows, config, n = group.rows, group.config, group.n
     size = rows.size
     # Each row draws its first reading's noise, then its second's, from its generator.
-    first, second = config.noise.draw_movement_rows(rngs, n, config.epsilon)
+    first, second = config.sensor.noise.draw_movement_rows(rngs, n, config.epsilon)
     travelled, start, end = np.empty(size), np.empty((size, n)), np.empty((size, n))
     kernels.move_and_read(
         rows,
@@ -396,7 +394,7 @@ def step(
     # A move that could not start took both readings from the same place: there is no
     # robot frame (R1 = R2), so the SLAM must not see it. The robot knows it did not move
     # (it is stuck against the wall).
-    changes_map = travelled >= config.arena.min_baseline
+    changes_map = travelled >= config.layout.arena.min_baseline
     frame_changed = np.zeros(size, dtype=bool)
     inconsistent = np.zeros(size, dtype=np.int64)
     batch = group.batch
@@ -466,7 +464,7 @@ def potentials(state: BatchState, group: Group) -> FloatArray:
 def observations(state: BatchState, group: Group) -> NDArray[np.float32]:
     """Observations (len(rows), observation_size) of a group (see the env's Observation
     Space section)."""
-    size = observation_size(group.config.max_landmarks)
+    size = observation_size(group.config.observations.max_landmarks)
     out = np.zeros((group.rows.size, size), dtype=np.float32)
     kernels.write_observations(group.rows, group.inputs, out)
     return out
@@ -492,7 +490,7 @@ def infos(state: BatchState, group: Group, outcome: StepOutcome) -> dict[str, An
         "inconsistent": outcome.inconsistent,
         "outliers": batch.outliers[rows],
         "path_length": outcome.travelled,
-        robot_map.KEY: robot_map.encode(batch, rows, group.config.max_landmarks - 2),
+        robot_map.KEY: robot_map.encode(batch, rows, group.config.observations.max_landmarks - 2),
         "rewards": {
             "uncertainty": outcome.uncertainty,
             "path_cost": outcome.path_cost,
@@ -512,44 +510,3 @@ def row_info(batched: dict[str, Any], row: int) -> dict[str, Any]:
         else:
             info[key] = value[row].item()
     return info
-
-
-# ----------------------------------------------------------------------------------------
-# Rendering
-# ----------------------------------------------------------------------------------------
-
-
-def scene(state: BatchState, row: int, config: EnvConfig, slam: PolygonSLAM) -> Any:
-    """What the renderer draws for one row (pygame is only imported here)."""
-    from bearing_env.rendering import Scene
-    from bearing_env.slam import fl_to_world
-
-    n = int(state.n_landmarks[row])
-    landmarks = state.landmarks[row, :n].copy()
-    l1, l2 = landmarks[0], landmarks[1]
-
-    def to_world(points: FloatArray | None) -> FloatArray | None:
-        return None if points is None else fl_to_world(points, l1, l2)
-
-    has_moved = bool(np.all(np.isfinite(state.start_positions[row])))
-    areas = slam.areas
-    return Scene(
-        arena=config.arena,
-        landmarks=landmarks,
-        estimates=fl_to_world(slam.estimates, l1, l2),
-        regions=[to_world(polygon) for polygon in slam.polygons],
-        robot_region=to_world(slam.robot_polygon),
-        robot_position=state.positions[row].copy(),
-        robot_heading=float(state.headings[row]),
-        trajectory=state.trajectory[row, : state.trajectory_length[row]].copy(),
-        start_position=state.start_positions[row].copy() if has_moved else None,
-        start_bearings=state.start_bearings[row, :n].copy() if has_moved else None,
-        end_bearings=state.latest_bearings[row, :n].copy(),
-        epsilon=config.epsilon,
-        moves=int(state.moves[row]),
-        max_moves=config.max_moves,
-        total_area=float(np.sum(areas)),
-        n_initialised=int(np.sum(slam.initialised)),
-        frame_changed=bool(state.frame_changed[row]),
-        robot_radius=config.arena.wall_margin,
-    )

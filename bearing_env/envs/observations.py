@@ -93,7 +93,7 @@ class FlatObservation:
 
     def space(self, config: EnvConfig) -> spaces.Space[Any]:
         """The Box of envs with ``config`` (the env's Observation Space section)."""
-        log_min, log_max = math.log(AREA_FLOOR), math.log(config.area_cap)
+        log_min, log_max = math.log(AREA_FLOOR), math.log(config.task.area_cap)
         limit = FL_COORD_LIMIT
         # (low, high) per feature, in the order of ROBOT_, LANDMARK_ and BEARING_FEATURES.
         robot_low = [-limit, -limit, log_min, 0, -1, -1, 0, 0, 0]
@@ -101,7 +101,7 @@ class FlatObservation:
         landmark_low = [0, 0, -limit, -limit, min(log_min, 0.0)]
         landmark_high = [1, 1, limit, limit, max(log_max, 0.0)]
         bearing_low, bearing_high = [0, -1, -1], [1, 1, 1]
-        n_slots = config.max_landmarks
+        n_slots = config.observations.max_landmarks
         low = np.concatenate(
             [robot_low, np.tile(landmark_low, n_slots - 2), np.tile(bearing_low, n_slots)]
         )
@@ -132,7 +132,7 @@ class EntityObservation:
         (each table column's bounds are its extremes over the slots)."""
         flat = FLAT.space(config)
         assert isinstance(flat, spaces.Box)
-        slots = config.max_landmarks
+        slots = config.observations.max_landmarks
         low, high = self.convert(flat.low, slots), self.convert(flat.high, slots)
         rows = (slots, len(ENTITY_FEATURES))
         table_low = np.minimum(low["landmarks"], high["landmarks"]).reshape(rows).min(axis=0)
@@ -181,13 +181,13 @@ class EntityObservation:
 FLAT = FlatObservation()
 ENTITIES = EntityObservation()
 ObservationSpec = FlatObservation | EntityObservation
-#: The spec of each ``config.observation`` kind.
+#: The spec of each ``config.observations.observation`` kind.
 SPECS: dict[str, ObservationSpec] = {spec.kind: spec for spec in (FLAT, ENTITIES)}
 
 
 def spec_for(config: EnvConfig) -> ObservationSpec:
     """The observation spec of envs with ``config``."""
-    return SPECS[config.observation]
+    return SPECS[config.observations.observation]
 
 
 def entity_observations(flat: NDArray[np.float32], max_landmarks: int) -> dict[str, Any]:

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from bearing_env.slam import PolygonSLAM
+from bearing_env.slam import MapSettings, PolygonSLAM
 from bearing_env.slam.batch import LANDMARK_AXES, VERTEX_COUNTS, BatchedPolygonSLAM
 
 #: The info key of the robot's own map: the one key of an info robot policies read.
@@ -64,12 +64,11 @@ def encode(batch: BatchedPolygonSLAM, rows: NDArray[np.int64], slots: int) -> di
     return out
 
 
-def decode(
-    data: Mapping[str, Any], n_landmarks: int, map_settings: Mapping[str, Any]
-) -> PolygonSLAM:
+def decode(data: Mapping[str, Any], n_landmarks: int, settings: MapSettings) -> PolygonSLAM:
     """A new map (an independent copy) holding one env's ``info[KEY]`` data, for
-    ``n_landmarks`` landmarks and the world model's keyword settings."""
-    slam = PolygonSLAM(int(n_landmarks), **map_settings)
+    ``n_landmarks`` landmarks and the world model's ``settings``
+    (``EnvConfig.map_settings``)."""
+    slam = PolygonSLAM.from_settings(int(n_landmarks), settings)
     batch, mapped = slam.batch, int(n_landmarks) - 2
     for name in batch.state_names:
         target = getattr(batch, name)

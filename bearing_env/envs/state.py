@@ -100,14 +100,6 @@ class BatchState:
     def num_rows(self) -> int:
         return int(self.n_landmarks.shape[0])
 
-    def writable(self) -> BatchState:
-        """This state with every array writable: read-only arrays (e.g. from an
-        out-of-band pickle with read-only buffers) are copied, the others kept."""
-        arrays = {
-            f.name: np.require(getattr(self, f.name), requirements=["W"]) for f in fields(self)
-        }
-        return BatchState(**arrays)
-
     def append_positions(self, rows: IntArray) -> None:
         """Record the rows' current positions in their trajectories."""
         if not kernels.append_positions(
@@ -135,6 +127,19 @@ class BatchState:
     def __getstate__(self) -> dict[str, Any]:
         # The kernels' reference cannot be pickled; it is made again on first use.
         return {key: value for key, value in self.__dict__.items() if key != "_ref"}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        # An out-of-band pickle may hand back read-only buffers: the arrays (all written)
+        # are copied then, the writable ones kept. In place, so that the state keeps its
+        # identity: the env's world views hold it.
+        self.__dict__.update(
+            {
+                key: np.require(value, requirements=["W"])
+                if isinstance(value, np.ndarray)
+                else value
+                for key, value in state.items()
+            }
+        )
 
 
 #: The state's arrays, in field order.

@@ -6,6 +6,8 @@ robot as well as on the simulator's.
 Public API:
 
 * :class:`PolygonSLAM` and :class:`UpdateResult`: the map, fused over movements.
+* :class:`MapSettings`: a map's settings (epsilon, transfer, fusion, ...), one frozen,
+  validated, hashable object (``PolygonSLAM.from_settings``).
 * :class:`BatchedPolygonSLAM`: many maps updated in one computation (the engine under
   every ``PolygonSLAM``, which is a batch of one, and under the batched vector env).
 * :func:`fr_region`: the FR region of one landmark from a bearing pair.
@@ -43,6 +45,7 @@ from bearing_env.slam.polygon_slam import (
     fl_to_world,
     world_to_fl,
 )
+from bearing_env.slam.settings import MapSettings
 from bearing_env.slam.transfer import TRANSFERS
 
 __all__ = [
@@ -64,6 +67,7 @@ __all__ = [
     "TRANSFERS",
     "BatchUpdateResult",
     "BatchedPolygonSLAM",
+    "MapSettings",
     "PolygonSLAM",
     "UpdateResult",
     "fl_to_world",

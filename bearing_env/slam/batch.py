@@ -16,6 +16,7 @@ environment reproduce the single environment bit for bit.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,8 +24,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.slam import kernels
+from bearing_env.slam.settings import (
+    DEFAULT_MAX_OUTLIERS,
+    DEFAULT_WINDOW,
+    FUSIONS,
+    INCONSISTENCY_POLICIES,
+    MapSettings,
+)
 from bearing_env.slam.transfer import TRANSFERS
-from bearing_env.validation import epsilon_radians, int_at_least
+from bearing_env.validation import int_at_least
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -65,27 +73,6 @@ LANDMARK_STATUSES: tuple[str, ...] = _names_by_code(
 )
 LANDMARK_CODE = {name: code for code, name in enumerate(LANDMARK_STATUSES)}
 
-INCONSISTENCY_POLICIES = ("restart", "keep")
-
-#: How a landmark's regions from successive movements are combined: ``"intersect"``, the
-#: paper's intersection, or ``"relaxed"``, the q-relaxed intersection over a window.
-FUSIONS = ("intersect", "relaxed")
-
-# The kernels take the transfer, the policy and the fusion as indices into these tuples.
-if (
-    TRANSFERS.index("conservative") != kernels.TRANSFER_CONSERVATIVE
-    or TRANSFERS.index("paper") != kernels.TRANSFER_PAPER
-    or INCONSISTENCY_POLICIES.index("restart") != kernels.INCONSISTENCY_RESTART
-    or INCONSISTENCY_POLICIES.index("keep") != kernels.INCONSISTENCY_KEEP
-    or FUSIONS.index("intersect") != kernels.FUSION_INTERSECT
-    or FUSIONS.index("relaxed") != kernels.FUSION_RELAXED
-):
-    raise ImportError("the kernels' transfer, policy or fusion codes disagree with the names")
-
-#: The relaxed fusion's defaults: movements kept per map, and the most regions per
-#: landmark it may leave out of the window.
-DEFAULT_WINDOW = 8
-DEFAULT_MAX_OUTLIERS = 2
 
 #: Batches of at least this many maps are updated on all of numba's threads
 #: (``NUMBA_NUM_THREADS``; see :func:`bearing_env.slam.kernels.threads`).
@@ -113,7 +100,9 @@ class BatchUpdateResult:
 class BatchedPolygonSLAM:
     """``num_maps`` independent polygon-SLAM maps, updated together.
 
-    Args mirror :class:`~bearing_env.slam.PolygonSLAM`, plus ``num_maps``.
+    Args mirror :class:`~bearing_env.slam.PolygonSLAM`, plus ``num_maps``; they are
+    validated as one :class:`~bearing_env.slam.settings.MapSettings` (:attr:`settings`),
+    and :meth:`from_settings` takes one whole.
 
     The state is public, as arrays with the map axis first (read them; write them only
     through :meth:`update` and :meth:`reset`): ``vertices`` (maps, landmarks, CAPACITY)
@@ -137,33 +126,23 @@ class BatchedPolygonSLAM:
     ) -> None:
         self.num_maps = int_at_least(num_maps, 1, "num_maps")
         self.n_landmarks = int_at_least(n_landmarks, 3, "n_landmarks", "(L1, L2 and one more)")
-        epsilon = epsilon_radians(epsilon)
-        if transfer not in TRANSFERS:
-            raise ValueError(f"transfer must be one of {TRANSFERS}, got {transfer!r}")
-        if on_inconsistency not in INCONSISTENCY_POLICIES:
-            raise ValueError(
-                f"on_inconsistency must be one of {INCONSISTENCY_POLICIES}, "
-                f"got {on_inconsistency!r}"
-            )
-        self.epsilon = epsilon
-        self.transfer = transfer
-        self.edge_samples = int_at_least(edge_samples, 1, "edge_samples")
-        if self.edge_samples > kernels.MAX_EDGE_SAMPLES:
-            raise ValueError(
-                f"edge_samples must be <= {kernels.MAX_EDGE_SAMPLES}, got {edge_samples!r}"
-            )
-        self.on_inconsistency = on_inconsistency
-        if fusion not in FUSIONS:
-            raise ValueError(f"fusion must be one of {FUSIONS}, got {fusion!r}")
-        self.fusion = fusion
-        self.window = int_at_least(window, 1, "window")
-        if self.window > kernels.MAX_WINDOW:
-            raise ValueError(f"window must be <= {kernels.MAX_WINDOW}, got {window!r}")
-        self.max_outliers = int_at_least(max_outliers, 0, "max_outliers")
-        if self.max_outliers >= self.window:
-            raise ValueError(
-                f"max_outliers must be < window ({self.window}), got {max_outliers!r}"
-            )
+        #: The map's settings, validated (the attributes below are their values).
+        self.settings = settings = MapSettings(
+            epsilon,
+            transfer=transfer,
+            edge_samples=edge_samples,
+            on_inconsistency=on_inconsistency,
+            fusion=fusion,
+            max_outliers=max_outliers,
+            window=window,
+        )
+        self.epsilon = settings.epsilon
+        self.transfer = settings.transfer
+        self.edge_samples = settings.edge_samples
+        self.on_inconsistency = settings.on_inconsistency
+        self.fusion = settings.fusion
+        self.max_outliers = settings.max_outliers
+        self.window = settings.window
         n, m, cap = self.num_maps, self.n_landmarks - 2, kernels.CAPACITY
         self.vertices = np.zeros((n, m, cap), dtype=np.complex128)
         self.counts = np.zeros((n, m), dtype=np.int64)
@@ -178,7 +157,7 @@ class BatchedPolygonSLAM:
         self.n_frame_changes = np.empty(n, dtype=np.int64)
         self.n_inconsistent = np.empty(n, dtype=np.int64)
         # The relaxed fusion's window and bases (empty window axis for "intersect").
-        w = self.window if fusion == "relaxed" else 0
+        w = self.window if self.fusion == "relaxed" else 0
         self.window_vertices = np.zeros((n, w, m, cap), dtype=np.complex128)
         self.window_counts = np.zeros((n, w, m), dtype=np.int64)
         self.window_inlier = np.zeros((n, w, m), dtype=bool)
@@ -192,19 +171,18 @@ class BatchedPolygonSLAM:
         self._state_ref: kernels.State | None = None
         self.reset()
 
+    @classmethod
+    def from_settings(
+        cls, num_maps: int, n_landmarks: int, settings: MapSettings
+    ) -> BatchedPolygonSLAM:
+        """A batch of ``num_maps`` empty maps with ``settings``."""
+        if not isinstance(settings, MapSettings):
+            raise TypeError(f"settings must be a MapSettings, got {settings!r}")
+        return cls(num_maps, n_landmarks, **dataclasses.asdict(settings))
+
     def empty_like(self, num_maps: int) -> BatchedPolygonSLAM:
         """A new batch of ``num_maps`` empty maps with this batch's settings."""
-        return BatchedPolygonSLAM(
-            num_maps,
-            self.n_landmarks,
-            self.epsilon,
-            transfer=self.transfer,
-            edge_samples=self.edge_samples,
-            on_inconsistency=self.on_inconsistency,
-            fusion=self.fusion,
-            max_outliers=self.max_outliers,
-            window=self.window,
-        )
+        return BatchedPolygonSLAM.from_settings(num_maps, self.n_landmarks, self.settings)
 
     @property
     def initialised(self) -> NDArray[np.bool_]:
@@ -302,9 +280,7 @@ class BatchedPolygonSLAM:
                 f"points must have shape ({rows.size}, {self.n_landmarks - 2}), got {z.shape}"
             )
         inside = np.empty(z.shape, dtype=bool)
-        kernels.contains_points(
-            self.vertices, self.counts, rows, z, CONTAINMENT_TOLERANCE, inside
-        )
+        kernels.contains_points(self.vertices, self.counts, rows, z, CONTAINMENT_TOLERANCE, inside)
         return inside
 
     def polygon(self, map_index: int, landmark: int) -> NDArray[np.complex128]:
@@ -368,9 +344,7 @@ class BatchedPolygonSLAM:
         rows = np.ascontiguousarray(raw, dtype=np.int64)
         problem = kernels.check_indices(rows, self.num_maps, distinct)
         if problem == kernels.INDEX_OUT_OF_RANGE:
-            raise ValueError(
-                f"maps must be indices in [0, {self.num_maps}), got {rows.tolist()}"
-            )
+            raise ValueError(f"maps must be indices in [0, {self.num_maps}), got {rows.tolist()}")
         if problem == kernels.INDEX_REPEATED:
             raise ValueError(f"maps must not repeat a map, got {rows.tolist()}")
         return rows
@@ -444,7 +418,5 @@ def check_bearings(bearings: ArrayLike, shape: tuple[int, ...], name: str) -> Fl
     if arr.shape != shape:
         raise ValueError(f"{name} must have shape {shape}, got {arr.shape}")
     if np.any(np.isinf(arr)):
-        raise ValueError(
-            f"{name} must be finite or NaN (a missed reading), got {arr.tolist()}"
-        )
+        raise ValueError(f"{name} must be finite or NaN (a missed reading), got {arr.tolist()}")
     return np.ascontiguousarray(arr)

@@ -11,14 +11,17 @@ from numpy.typing import ArrayLike, NDArray
 from bearing_env.slam import kernels
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
-    DEFAULT_MAX_OUTLIERS,
-    DEFAULT_WINDOW,
     FRAME_STATUSES,
-    FUSIONS,
-    INCONSISTENCY_POLICIES,
     LANDMARK_STATUSES,
     BatchedPolygonSLAM,
     check_bearings,
+)
+from bearing_env.slam.settings import (
+    DEFAULT_MAX_OUTLIERS,
+    DEFAULT_WINDOW,
+    FUSIONS,
+    INCONSISTENCY_POLICIES,
+    MapSettings,
 )
 from bearing_env.validation import int_at_least
 
@@ -151,6 +154,8 @@ class PolygonSLAM:
             window may leave out (0 <= max_outliers < window).
         window: with ``fusion="relaxed"``, the movements kept per map, 1..32.
 
+    These are the fields of :class:`~bearing_env.slam.settings.MapSettings`, which
+    validates them (the map's :attr:`settings`); :meth:`from_settings` takes one whole.
     A bearing given as NaN is a missed reading: that landmark is skipped for the
     movement (status ``"missing"``), and a missed L1 or L2 skips the movement
     (``"l1_missing"``, ``"l2_missing"``).
@@ -185,6 +190,8 @@ class PolygonSLAM:
         self._index = index
         self._rows = np.array([index])
         self.n_landmarks = batch.n_landmarks
+        #: The map's settings (validated); the attributes below are their values.
+        self.settings: MapSettings = batch.settings
         self.epsilon = batch.epsilon
         self.transfer = batch.transfer
         self.edge_samples = batch.edge_samples
@@ -192,6 +199,11 @@ class PolygonSLAM:
         self.fusion = batch.fusion
         self.max_outliers = batch.max_outliers
         self.window = batch.window
+
+    @classmethod
+    def from_settings(cls, n_landmarks: int, settings: MapSettings) -> PolygonSLAM:
+        """An empty map of ``n_landmarks`` landmarks with ``settings``."""
+        return cls.view(BatchedPolygonSLAM.from_settings(1, n_landmarks, settings), 0)
 
     @classmethod
     def view(cls, batch: BatchedPolygonSLAM, index: int) -> PolygonSLAM:

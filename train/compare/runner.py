@@ -64,7 +64,7 @@ def run_episode(policy: Any, env: gym.Env, seed: int) -> dict[str, Any]:
     holds the truth).
     """
     base = bearing_env_of(env)
-    area_cap = float(base.area_cap)
+    area_cap = float(base.config.task.area_cap)
     observation, info = env.reset(seed=seed)
     policy.reset(seed=seed)
     series: dict[str, list[Any]] = {"area": [], "uninitialised": [], "error": [], "contained": []}
@@ -96,7 +96,7 @@ def run_episode(policy: Any, env: gym.Env, seed: int) -> dict[str, Any]:
     return {
         "seed": int(seed),
         "moves": moves,
-        "max_moves": int(base.max_moves),
+        "max_moves": int(base.config.task.max_moves),
         "n_mapped": int(base.n_landmarks) - 2,
         "success": bool(terminated),
         "moves_to_success": moves if terminated else None,

@@ -117,7 +117,7 @@ def random_polygonal_trace(
     env = make_env("bearing_env:BearingSLAM-v0", kwargs)
     base = bearing_env_of(env)
     policy = RandomPolygonal(env)
-    bearing_block = observation_slices(base.max_landmarks)["bearings"]
+    bearing_block = observation_slices(base.config.observations.max_landmarks)["bearings"]
     observation, info = env.reset(seed=seed)
     policy.reset(seed=seed)
     world = world_of(env)

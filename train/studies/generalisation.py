@@ -174,7 +174,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         parser.error(f"unknown model {args.model!r}; shipped: {', '.join(pretrained_names())}")
     # The env's own resolution of the training settings: their counts and observation slots.
     trained = EnvConfig.create(**pretrained_record(args.model).get("env_kwargs", {}))
-    max_landmarks = trained.max_landmarks
+    max_landmarks = trained.observations.max_landmarks
     if min(args.counts) < 3 or max(args.counts) > max_landmarks:
         parser.error(
             f"--counts must lie in [3, {max_landmarks}]: {args.model} has "
@@ -189,7 +189,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     print_medians(medians)
     write_json_atomically(args.out / "generalisation.json", {str(k): v for k, v in medians.items()})
     figure = plot_medians(
-        medians, args.model, trained.landmark_counts, args.out / "generalisation.png"
+        medians, args.model, trained.layout.landmark_counts, args.out / "generalisation.png"
     )
     print(f"wrote {args.out / 'generalisation.json'} and {figure}")
 
