@@ -238,7 +238,7 @@ class ManualControl:
         self._pygame = pygame
         self.env = env
         self._base = base
-        self.layout = FieldLayout.for_arena(base.arena)
+        self.layout = FieldLayout.for_arena(base.config.layout.arena)
         self.turns, self.lengths = self._tables()
         self.seed = seed
         self.episode = 0
@@ -253,7 +253,7 @@ class ManualControl:
         pygame.key.set_repeat(KEY_REPEAT_DELAY_MS, KEY_REPEAT_INTERVAL_MS)
         self._font = pygame.font.Font(None, 21)
         self._redraw = True
-        lo, hi = base.move_length
+        lo, hi = base.config.actions.move_length
         self.aim = self._expressible(0.0, 0.5 * (lo + hi))
         self._start_episode()
 
@@ -264,7 +264,7 @@ class ManualControl:
         spec, config = self._base.action_spec, self._base.config
         if isinstance(spec, DiscreteActions):
             return spec.tables(config)
-        lo, hi = config.move_length
+        lo, hi = config.actions.move_length
         n_turns = round(360.0 / TURN_STEP_DEG)
         turns = wrap_angle(TWO_PI * np.arange(n_turns) / n_turns)
         return turns, np.unique(np.linspace(lo, hi, LENGTH_STEPS + 1))
@@ -354,7 +354,7 @@ class ManualControl:
         distance = math.hypot(float(offset[0]), float(offset[1]))
         if distance < _SAME:
             return
-        lo, hi = self._base.move_length
+        lo, hi = self._base.config.actions.move_length
         turn = wrap(math.atan2(float(offset[1]), float(offset[0])) - world.heading)
         self.aim = self._expressible(turn, min(max(distance, lo), hi))
         self._move()
@@ -363,7 +363,7 @@ class ManualControl:
 
     def panel_rows(self) -> list[list[tuple[str, tuple[int, int, int]]]]:
         """The panel's text: rows of (text, colour) items."""
-        max_moves = self._base.max_moves
+        max_moves = self._base.config.task.max_moves
         reward = "-" if math.isnan(self.last_reward) else f"{self.last_reward:+.3f}"
         seed = "unseeded" if self.seed is None else f"seed {self.seed + self.episode}"
         status = [
@@ -372,7 +372,7 @@ class ManualControl:
             (f"last reward {reward}", TEXT),
             (f"return {self.episode_return:+.3f}", TEXT),
         ]
-        lo, hi = self._base.move_length
+        lo, hi = self._base.config.actions.move_length
         aim = [
             (
                 f"next move: turn {math.degrees(self.aim.turn):+.1f} deg, "

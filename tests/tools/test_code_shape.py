@@ -15,11 +15,8 @@ from tests.tools.code_shape import (
     too_many_parameters,
 )
 
-#: Functions allowed over a limit for now, each with the branch that removes it.
-ALLOWED_WIDE = {
-    # fixed on branch i19-config: EnvConfig.create takes its settings as one record there
-    "bearing_env/envs/config.py:EnvConfig.create",
-}
+#: Functions allowed over a limit for now, each with the reason (none today).
+ALLOWED_WIDE: set[str] = set()
 
 
 def test_no_function_outside_the_kernels_is_longer_than_80_lines() -> None:

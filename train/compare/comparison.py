@@ -84,6 +84,36 @@ def run_comparison(
         desc: the progress bar's label (``bearing-env suite``: the task id).
     """
     out = Path(out)
+    log = _open_run(config, out, resume, overwrite)
+
+    records = log.load()
+    done = {(r["policy"], int(r["seed"])) for r in records}
+    pending = episode_tasks(config, done)
+    tasks = pending if stop_after is None else pending[: max(0, stop_after)]
+    n_total = len(config.seeds) * len(config.policies)
+    done_before = n_total - len(pending)
+    with progress_bar(
+        n_total, initial=done_before, desc=desc, unit="episode", enabled=progress
+    ) as bar:
+        for record in executor(tasks, workers):
+            log.append(record)  # fsynced before the next one: a kill loses no logged episode
+            records.append(record)
+            bar.update()
+    # Task order (seed-major), whatever order the executor finished them in.
+    position = {(task.label, task.seed): i for i, task in enumerate(episode_tasks(config, set()))}
+    records.sort(key=lambda r: position.get((r["policy"], int(r["seed"])), len(position)))
+
+    summary = summarise(records, config)
+    wanted = {(label, seed) for label in config.policies for seed in config.seeds}
+    finished = {(r["policy"], int(r["seed"])) for r in records} & wanted
+    timing = policy_ms_per_move(records, config)
+    write_outputs(summary, records, config, out, timing, plots, command)
+    return CompareResult(summary, records, finished == wanted, out, timing)
+
+
+def _open_run(config: CompareConfig, out: Path, resume: bool, overwrite: bool) -> EpisodeLog:
+    """The episode log of a comparison in ``out``, after checking that ``resume`` /
+    ``overwrite`` fit what ``out`` holds, with ``config`` written there."""
     log = EpisodeLog(out / LOG_NAME)
     config_path = out / CONFIG_NAME
     if resume and overwrite:
@@ -110,27 +140,4 @@ def run_comparison(
             ) from None
         _check_resumable(existing, config)
     atomic_write_text(config_path, json.dumps(config.to_json(), indent=2) + "\n")
-
-    records = log.load()
-    done = {(r["policy"], int(r["seed"])) for r in records}
-    pending = episode_tasks(config, done)
-    tasks = pending if stop_after is None else pending[: max(0, stop_after)]
-    n_total = len(config.seeds) * len(config.policies)
-    done_before = n_total - len(pending)
-    with progress_bar(
-        n_total, initial=done_before, desc=desc, unit="episode", enabled=progress
-    ) as bar:
-        for record in executor(tasks, workers):
-            log.append(record)  # fsynced before the next one: a kill loses no logged episode
-            records.append(record)
-            bar.update()
-    # Task order (seed-major), whatever order the executor finished them in.
-    position = {(task.label, task.seed): i for i, task in enumerate(episode_tasks(config, set()))}
-    records.sort(key=lambda r: position.get((r["policy"], int(r["seed"])), len(position)))
-
-    summary = summarise(records, config)
-    wanted = {(label, seed) for label in config.policies for seed in config.seeds}
-    finished = {(r["policy"], int(r["seed"])) for r in records} & wanted
-    timing = policy_ms_per_move(records, config)
-    write_outputs(summary, records, config, out, timing, plots, command)
-    return CompareResult(summary, records, finished == wanted, out, timing)
+    return log

@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from bearing_env.tasks import TASKS, TASKS_BY_ID, Task, task_named
+from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import COUNT, NON_NEGATIVE
 from bearing_env.train.common.errors import exit_on_output_errors, fail, missing_extra
 from bearing_env.train.compare.cli import (
@@ -194,19 +195,22 @@ def _logged(folder: Path) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="bearing-env suite",
-        description=(
-            "Run the baselines on every registered task (bearing-env compare once per "
-            "task, each in OUT/<task id>/, resuming what a previous run left) and write "
-            "the task cards and the task table."
-        ),
-        epilog=(
-            f"Tasks: {', '.join(TASKS_BY_ID)}. Policy specs as for bearing-env compare "
-            "(random, parallax, greedy, lookahead, pretrained:NAME, ...). Rerun the same "
-            "command after an interruption to finish."
-        ),
+    parser = command_parser(
+        "bearing-env suite",
+        "Run the baselines on every registered task (bearing-env compare once per "
+        "task, each in OUT/<task id>/, resuming what a previous run left) and write "
+        "the task cards and the task table.",
+        f"Tasks: {', '.join(TASKS_BY_ID)}. Policy specs as for bearing-env compare "
+        "(random, parallax, greedy, lookahead, pretrained:NAME, ...). Rerun the same "
+        "command after an interruption to finish.",
     )
+    _add_selection_arguments(parser)
+    _add_run_arguments(parser)
+    return parser
+
+
+def _add_selection_arguments(parser: argparse.ArgumentParser) -> None:
+    """What runs: the tasks, the policies, the episodes, and where the results go."""
     parser.add_argument(
         "--tasks",
         nargs="+",
@@ -244,6 +248,10 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"folder of the task cards and index.md (default {DEFAULT_DOCS}; with --quick "
         "OUT/docs, so a quick run leaves the published cards alone)",
     )
+
+
+def _add_run_arguments(parser: argparse.ArgumentParser) -> None:
+    """How it runs: quick or full, workers, resuming, the CIs, the progress bars."""
     parser.add_argument(
         "--quick",
         action="store_true",
@@ -274,8 +282,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=DEFAULT_BOOTSTRAP,
         help="bootstrap resamples for the CIs, >= 1 (default %(default)s)",
     )
-    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
-    return parser
+    add_no_progress(parser)
 
 
 def suite_configs(args: argparse.Namespace) -> list[tuple[Task, CompareConfig]]:

@@ -249,12 +249,6 @@ def task_card(
     with contextlib.closing(env):
         observation_space, action_space = env.observation_space, env.action_space
     seeds = config.seeds
-    policies = ", ".join(f"`{label}` = `{spec}`" for label, spec in config.policies.items())
-    overrides = (
-        f" with `{', '.join(f'{k}={v!r}' for k, v in config.env_kwargs.items())}`"
-        if config.env_kwargs
-        else ""
-    )
     parts = [
         f"# {task.id}",
         "",
@@ -287,6 +281,34 @@ def task_card(
         "",
         markdown_table(["setting", "value"], settings_rows(resolved, task)),
         "",
+        *baselines_section(task, config, summary),
+    ]
+    if plot:
+        parts += [f"![total area versus moves, {task.id}]({area_plot_name(task)})", ""]
+    if frame:
+        parts += [
+            f"![a rendered frame of {task.id}]({frame_name(task)})",
+            "",
+            f"The first evaluation episode (seed {seeds[0]}) after {FRAME_MOVES} moves of "
+            "`greedy`: the true landmarks (stars), their uncertainty regions and centroids, the "
+            "latest bearing cones (±ε), the robot and its path.",
+            "",
+        ]
+    if command:
+        parts += ["Regenerate with:", "", "```bash", command, "```", ""]
+    return "\n".join(parts)
+
+
+def baselines_section(task: Task, config: CompareConfig, summary: Mapping[str, Any]) -> list[str]:
+    """The card's lines on the baselines: how they ran, their area and outcome tables."""
+    seeds = config.seeds
+    policies = ", ".join(f"`{label}` = `{spec}`" for label, spec in config.policies.items())
+    overrides = (
+        f" with `{', '.join(f'{k}={v!r}' for k, v in config.env_kwargs.items())}`"
+        if config.env_kwargs
+        else ""
+    )
+    return [
         "## Baselines",
         "",
         f"{config.episodes} evaluation episodes per policy on `{task.id}`{overrides}, "
@@ -311,20 +333,6 @@ def task_card(
         markdown_table(*outcome_table_rows(summary, config)),
         "",
     ]
-    if plot:
-        parts += [f"![total area versus moves, {task.id}]({area_plot_name(task)})", ""]
-    if frame:
-        parts += [
-            f"![a rendered frame of {task.id}]({frame_name(task)})",
-            "",
-            f"The first evaluation episode (seed {seeds[0]}) after {FRAME_MOVES} moves of "
-            "`greedy`: the true landmarks (stars), their uncertainty regions and centroids, the "
-            "latest bearing cones (±ε), the robot and its path.",
-            "",
-        ]
-    if command:
-        parts += ["Regenerate with:", "", "```bash", command, "```", ""]
-    return "\n".join(parts)
 
 
 def write_task_card(
