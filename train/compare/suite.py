@@ -274,7 +274,8 @@ def _add_run_arguments(parser: argparse.ArgumentParser) -> None:
         type=NON_NEGATIVE,
         default=None,
         metavar="N",
-        help="run at most N new episodes in all, then write what is done (rerun to finish)",
+        help="run at most N new episodes in all, then write what is done (rerun to finish; "
+        "default: no limit)",
     )
     parser.add_argument(
         "--bootstrap",
