@@ -13,7 +13,7 @@ from the repository's folders. Checked:
   skipped the shipped models, and writes its report below the working directory, and
   ``bearing-env demo`` names the ``render`` extra and shows no traceback;
 - the sdist's tests (copied out of the unpacked sdist, away from its sources) collect
-  with only pytest and hypothesis added: every module but the five that import the
+  with only pytest and hypothesis added: every module but those that need the
   ``train`` extra (``tests/conftest.py`` leaves those out without it).
 
 The numba core compiles once per venv (its cache is keyed by the installed source path,
@@ -313,6 +313,7 @@ def test_the_sdist_tests_import_against_the_installed_package(
         for line in result.stdout.splitlines()
         if "::" in line
     }
-    repository_tests = {p.name for p in (ROOT / "tests").glob("test_*.py")}
+    tests = ROOT / "tests"
+    repository_tests = {p.relative_to(tests).as_posix() for p in tests.rglob("test_*.py")}
     assert collected == repository_tests - set(NEEDS_TRAIN_EXTRA) - set(NEEDS_RAY_EXTRA)
     assert len(result.stdout.splitlines()) > 400
