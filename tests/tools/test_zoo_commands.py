@@ -1,11 +1,11 @@
 """Every rl-zoo3 command the docs show runs, briefly, as written.
 
-The commands are read from the text: the README, the pages under ``docs/`` and the
-header comments of the shipped hyperparameter files (``train/sb3/hyperparams/*.yml``),
-so a command that changes there is the command tested here. Each runs in ``bash`` from
-a fresh folder, with ``bearing-env`` on the PATH (for its ``$(bearing-env hyperparams
-...)``), and with arguments appended that make it short: a few dozen timesteps, an
-evaluation every 16 steps of one episode, tiny buffers. ``enjoy`` runs on the output of
+The commands are read from the text: the README, the pages under ``docs/``, the header
+comments of the shipped hyperparameter files (``train/sb3/hyperparams/*.yml``) and the
+package's docstrings, so a command that changes there is the command tested here. Each
+runs in ``bash`` from a fresh folder, with ``bearing-env`` on the PATH (for its
+``$(bearing-env hyperparams ...)``), and with arguments appended that make it short: a
+few dozen timesteps, an evaluation every 16 steps of one episode, tiny buffers. ``enjoy`` runs on the output of
 the training command before it in the same document.
 
 What is checked, through :mod:`tests.tools.zoo_probe`, which records the settings of every
@@ -68,37 +68,47 @@ PROBED_PACKAGES = ("--gym-packages", "bearing_env", "tests.tools.zoo_probe")
 
 
 def documents() -> list[Path]:
-    """The files whose text shows rl-zoo3 commands, in a fixed order."""
+    """The files whose text shows rl-zoo3 commands, in a fixed order: the README, the
+    docs pages, the hyperparameter files and the docstrings of the package's modules."""
+    modules = [ROOT / folder for folder in ("bearing_env", "agents", "train", "benchmarks")]
     return [
         ROOT / "README.md",
         *sorted((ROOT / "docs").rglob("*.md")),
         *sorted((ROOT / "train" / "sb3" / "hyperparams").glob("*.yml")),
+        *sorted(
+            path
+            for folder in modules
+            for path in folder.rglob("*.py")
+            if "python -m rl_zoo3." in path.read_text(encoding="utf-8")
+        ),
     ]
 
 
-def zoo_commands(text: str, comments: bool = False) -> list[str]:
+def zoo_commands(text: str, kind: str = ".md") -> list[str]:
     """The rl-zoo3 commands of a text, in order: lines (``\\`` continuations joined,
-    shell comments dropped) that start with ``python -m rl_zoo3.``, and inline
-    ``python -m rl_zoo3.`` code.
-    With ``comments``, the text is a YAML file whose commands are in ``#`` comments."""
+    shell comments dropped) that start with ``python -m rl_zoo3.``, and in Markdown
+    inline ``python -m rl_zoo3.`` code. ``kind`` is the file's suffix: a ``.yml`` file
+    shows its commands in ``#`` comments, a ``.py`` file in docstrings (where the
+    continuation is an escaped ``\\\\``)."""
     commands: list[str] = []
     pending = ""
     for raw in text.splitlines():
         line = raw.strip()
-        if comments:
+        if kind == ".yml":
             if not line.startswith("#"):
                 pending = ""
                 continue
             line = line.lstrip("#").strip()
         pending = f"{pending} {line}".strip()
         if pending.endswith("\\"):
-            pending = pending[:-1].rstrip()
+            pending = pending.rstrip("\\").rstrip()
             continue
         command = re.sub(r"\s+#.*$", "", pending)  # a shell comment after the command
         if ZOO_COMMAND.match(command):
             commands.append(command)
         pending = ""
-    commands += re.findall(r"`(python -m rl_zoo3\.[^`]+)`", text)
+    if kind == ".md":
+        commands += re.findall(r"`(python -m rl_zoo3\.[^`]+)`", text)
     return commands
 
 
@@ -142,7 +152,7 @@ def documented_commands() -> list[DocumentedCommand]:
     for path in documents():
         source = str(path.relative_to(ROOT))
         earlier: list[DocumentedCommand] = []
-        for text in zoo_commands(path.read_text(encoding="utf-8"), path.suffix == ".yml"):
+        for text in zoo_commands(path.read_text(encoding="utf-8"), path.suffix):
             command = DocumentedCommand(text, source)
             if command.verb == "enjoy":
                 trainers = [
@@ -173,7 +183,9 @@ def test_the_docs_show_the_zoo_commands_this_test_must_run() -> None:
         "python -m rl_zoo3.enjoy --algo ppo --env E",
     ]
     yml = "#   python -m rl_zoo3.train --algo sac \\\n#       --env E\nkey: 1\n"
-    assert zoo_commands(yml, comments=True) == ["python -m rl_zoo3.train --algo sac --env E"]
+    assert zoo_commands(yml, ".yml") == ["python -m rl_zoo3.train --algo sac --env E"]
+    docstring = '"""Run::\n\n    python -m rl_zoo3.train --algo sac \\\\\n        --env E\n"""'
+    assert zoo_commands(docstring, ".py") == ["python -m rl_zoo3.train --algo sac --env E"]
 
 
 @dataclass(frozen=True)
