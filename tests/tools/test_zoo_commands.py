@@ -5,8 +5,8 @@ comments of the shipped hyperparameter files (``train/sb3/hyperparams/*.yml``) a
 package's docstrings, so a command that changes there is the command tested here. Each
 runs in ``bash`` from a fresh folder, with ``bearing-env`` on the PATH (for its
 ``$(bearing-env hyperparams ...)``), and with arguments appended that make it short: a
-few dozen timesteps, an evaluation every 16 steps of one episode, tiny buffers. ``enjoy`` runs on the output of
-the training command before it in the same document.
+few dozen timesteps, an evaluation every 16 steps of one episode, tiny buffers.
+``enjoy`` runs on the output of the training command before it in the same document.
 
 What is checked, through :mod:`tests.tools.zoo_probe`, which records the settings of every
 env rl-zoo3 builds: the training envs are the YAML entry's ``env_kwargs``, and the
