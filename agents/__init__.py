@@ -14,8 +14,10 @@ vector envs and on remote copies. All work on both registered ids:
   scored over worlds drawn inside the uncertainty regions;
 - :class:`LookaheadOracle`: the same search on the true map (privileged upper reference);
 - :class:`VectorPolicy`: one policy per sub-env of a vector env, with a batched ``act``;
-- :class:`SB3Policy`: a saved stable-baselines3 model; ``SB3Policy.pretrained(name, env)``
-  loads one shipped under ``agents/pretrained/`` (:func:`pretrained_names` lists them).
+- :class:`SB3Policy`: a saved stable-baselines3 model; ``SB3Policy.pretrained(name)``
+  loads one shipped under ``agents/pretrained/`` (:func:`pretrained_names` lists them),
+  whose ``make_env()`` makes the env it was trained on; given an env of another task it
+  raises :class:`TaskMismatchError` (see :mod:`bearing_env.agents.model_task`).
 
 :func:`make_policy` builds one from a spec string such as ``"greedy:n_turns=16"``.
 """
@@ -23,8 +25,9 @@ vector envs and on remote copies. All work on both registered ids:
 from .base import ActionCodec, Movement, Policy
 from .heuristics import GreedyOneStep, GreedyOracle, Parallax, RandomPolygonal
 from .lookahead import Lookahead, LookaheadOracle
+from .model_task import ModelTask, TaskMismatchError
 from .registry import POLICY_CLASSES, PolicySpec, make_policy, parse_policy_spec
-from .sb3 import ModelLoadError, SB3Policy, pretrained_names, pretrained_record
+from .sb3 import ModelLoadError, SB3Policy, pretrained_names, pretrained_record, pretrained_task
 from .vector import VectorPolicy
 
 __all__ = [
@@ -35,15 +38,18 @@ __all__ = [
     "Lookahead",
     "LookaheadOracle",
     "ModelLoadError",
+    "ModelTask",
     "Movement",
     "Parallax",
     "Policy",
     "PolicySpec",
     "RandomPolygonal",
     "SB3Policy",
+    "TaskMismatchError",
     "VectorPolicy",
     "make_policy",
     "parse_policy_spec",
     "pretrained_names",
     "pretrained_record",
+    "pretrained_task",
 ]

@@ -27,6 +27,7 @@ from bearing_env.extras import require
 from bearing_env.shipped import shipped_dir
 
 from .base import Action
+from .model_task import ModelTask, task_record_of
 
 #: File names tried, in order, when ``path`` is a directory.
 MODEL_FILE_NAMES = ("best_model.zip", "model.zip", "final_model.zip")
@@ -72,6 +73,18 @@ def pretrained_record(name: str) -> dict[str, Any]:
     if not record.is_file():
         raise FileNotFoundError(f"no training record for pretrained model {name!r}: {record}")
     return dict(json.loads(record.read_text()))
+
+
+def pretrained_task(name: str) -> ModelTask:
+    """The task a shipped model was trained on, from its record ``<name>.json``.
+
+    Raises:
+        ValueError: no shipped model has this name (the message lists them).
+    """
+    names = pretrained_names()
+    if name not in names:
+        raise ValueError(f"no pretrained model named {name!r}; available: {names}")
+    return ModelTask.from_record(pretrained_record(name), name, f"{name}.json")
 
 
 class ModelLoadError(ValueError):
@@ -225,14 +238,35 @@ def _spaces_match(model_space: spaces.Space[Any], env_space: spaces.Space[Any]) 
         return isinstance(model_space, spaces.Discrete) and model_space.n == env_space.n
     if isinstance(env_space, spaces.Box):
         return isinstance(model_space, spaces.Box) and model_space.shape == env_space.shape
+    if isinstance(env_space, spaces.Dict):
+        return (
+            isinstance(model_space, spaces.Dict)
+            and model_space.keys() == env_space.keys()
+            and all(_spaces_match(model_space[key], env_space[key]) for key in env_space)
+        )
     return type(model_space) is type(env_space)
+
+
+def space_summary(space: spaces.Space[Any]) -> str:
+    """A space in a few words, without its bounds: ``Box(61,)``, ``Discrete(24)``,
+    ``Dict(landmarks: Box(16, 8), robot: Box(9,))``."""
+    if isinstance(space, spaces.Box):
+        return f"Box{space.shape}"
+    if isinstance(space, spaces.Discrete):
+        return f"Discrete({space.n})"
+    if isinstance(space, spaces.Dict):
+        parts = ", ".join(f"{key}: {space_summary(value)}" for key, value in space.items())
+        return f"Dict({parts})"
+    return type(space).__name__
 
 
 class SB3Policy:
     """A saved stable-baselines3 model, acting greedily (``deterministic=True``) by default.
 
     Args:
-        env: the env it acts in; its observation and action spaces must match the model's.
+        env: the env it acts in: the model's task (see :mod:`bearing_env.agents.model_task`)
+            when the model has a record, and in any case spaces that match the model's.
+            None: no check; make one with :meth:`make_env`.
         path: the model ``.zip`` (the suffix may be left out), or a directory holding
             ``best_model.zip`` / ``model.zip`` / a single ``.zip``.
         vecnormalize: the ``VecNormalize`` statistics: ``"auto"`` (default) uses
@@ -244,60 +278,98 @@ class SB3Policy:
         deterministic: act with the mode of the policy rather than sampling.
         device: torch device.
         name: label in reports; default ``sb3_<algo>_<model stem>``.
+        task: what the model was trained on: ``"auto"`` (default) reads the record
+            ``<stem>.json`` beside the model (``bearing-env train --export`` writes it),
+            if there is one; None: unknown (only the spaces are checked).
 
     Raises:
         FileNotFoundError: the model, or an explicitly given VecNormalize file, is missing.
-        ModelLoadError (a ValueError): a file is corrupt, or does not fit the env.
+        TaskMismatchError (a ValueError): ``env`` is another task than the recorded one;
+            the one-line message names the settings that differ.
+        ModelLoadError (a ValueError): a file is corrupt, or its spaces do not fit the env.
     """
 
     privileged = False
 
     def __init__(
         self,
-        env: gym.Env,
+        env: gym.Env | None,
         path: str | Path,
         vecnormalize: str | Path | None = "auto",
         algo: str | None = None,
         deterministic: bool = True,
         device: str = "cpu",
         name: str | None = None,
+        task: ModelTask | str | None = "auto",
     ) -> None:
         self.model_path = resolve_model_path(path)
+        if isinstance(task, str) and task != "auto":
+            raise ValueError(f"task must be 'auto', a ModelTask or None, got {task!r}")
+        self.task = task_record_of(self.model_path) if isinstance(task, str) else task
         self.algo, _ = _algorithm_class(
             algo if algo is not None else infer_algorithm(self.model_path)
         )
         self.model = load_model(self.model_path, self.algo, device=device)
-        if not _spaces_match(self.model.observation_space, env.observation_space):
-            raise ModelLoadError(
-                f"model {self.model_path} expects observations {self.model.observation_space}, "
-                f"but the env gives {env.observation_space} (different max_landmarks?)"
-            )
-        if not _spaces_match(self.model.action_space, env.action_space):
-            raise ModelLoadError(
-                f"model {self.model_path} outputs actions {self.model.action_space}, but the "
-                f"env takes {env.action_space} (continuous vs discrete id?)"
-            )
+        if env is not None:
+            self.check_env(env)
         self.vecnormalize_path = self._resolve_vecnormalize(vecnormalize)
         self.obs_normalizer = (
             None if self.vecnormalize_path is None else load_vecnormalize(self.vecnormalize_path)
         )
         self.deterministic = bool(deterministic)
-        self.discrete = isinstance(env.action_space, spaces.Discrete)
+        self.discrete = isinstance(self.model.action_space, spaces.Discrete)
         self.name = name or f"sb3_{self.algo.lower()}_{self.model_path.stem}"
 
+    def check_env(self, env: gym.Env) -> None:
+        """Refuse an env the model cannot act in: another task than its recorded one
+        (:class:`TaskMismatchError`), or spaces that differ from its own
+        (:class:`ModelLoadError`)."""
+        if self.task is not None:
+            self.task.check(env)
+        if not _spaces_match(self.model.observation_space, env.observation_space):
+            raise ModelLoadError(
+                f"model {self.model_path.name} expects observations "
+                f"{space_summary(self.model.observation_space)}, but the env gives "
+                f"{space_summary(env.observation_space)} (other observation or max_landmarks?)"
+            )
+        if not _spaces_match(self.model.action_space, env.action_space):
+            raise ModelLoadError(
+                f"model {self.model_path.name} outputs actions "
+                f"{space_summary(self.model.action_space)}, but the env takes "
+                f"{space_summary(env.action_space)} (continuous vs discrete id?)"
+            )
+
+    def make_env(self, **overrides: Any) -> gym.Env:
+        """The env the model was trained on (its recorded env id and env kwargs), with
+        ``overrides`` on top (``render_mode="human"``, ``n_landmarks=12``, ...).
+
+        Raises:
+            ValueError: the model has no record of its task.
+            TaskMismatchError (a ValueError): an override changes the task.
+        """
+        if self.task is None:
+            raise ValueError(
+                f"model {self.model_path} has no record of its task "
+                f"({self.model_path.with_suffix('.json').name}); make its env with gym.make"
+            )
+        return self.task.make_env(**overrides)
+
     @classmethod
-    def pretrained(cls, name: str, env: gym.Env, **options: Any) -> SB3Policy:
+    def pretrained(cls, name: str, env: gym.Env | None = None, **options: Any) -> SB3Policy:
         """A model shipped with the package under ``agents/pretrained/``, by name.
 
         See :func:`pretrained_names` for what is available; ``options`` go to the
-        constructor (e.g. ``deterministic=False``).
+        constructor (e.g. ``deterministic=False``). Without ``env``, make the model's
+        own with :meth:`make_env`::
+
+            policy = SB3Policy.pretrained("ppo_generalist")
+            env = policy.make_env()
 
         Raises:
             ValueError: no shipped model has this name (the message lists them).
+            TaskMismatchError (a ValueError): ``env`` is another task than the model's.
         """
-        names = pretrained_names()
-        if name not in names:
-            raise ValueError(f"no pretrained model named {name!r}; available: {names}")
+        options.setdefault("task", pretrained_task(name))
         options.setdefault("name", name)
         return cls(env, PRETRAINED_DIR / f"{name}.zip", **options)
 

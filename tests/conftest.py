@@ -16,13 +16,17 @@ from bearing_env.extras import available, install_command
 settings.register_profile("deterministic", derandomize=True, database=None)
 settings.load_profile("deterministic")
 
-#: Test modules that import the ``train`` extra (torch, stable-baselines3) at the top.
+#: Test modules (paths below ``tests/``) that import the ``train`` extra (torch,
+#: stable-baselines3, rl-zoo3) at the top, or load the shipped models in every test.
 NEEDS_TRAIN_EXTRA = (
     "test_bench.py",
     "test_extractors.py",
     "test_lost_work.py",
     "test_train.py",
     "test_vec_env.py",
+    "agents/test_model_task.py",
+    "tools/test_compare_tasks.py",
+    "tools/test_zoo_commands.py",
 )
 TRAIN_EXTRA_INSTALLED = available("stable_baselines3", "torch")
 #: Test modules that import the ``ray`` extra at the top.

@@ -15,7 +15,7 @@ from the repository's folders. Checked:
   skipped the shipped models, and writes its report below the working directory, and
   ``bearing-env demo`` names the ``render`` extra and shows no traceback;
 - the sdist's tests (copied out of the unpacked sdist, away from its sources) collect
-  with only pytest and hypothesis added: every module but the five that import the
+  with only pytest and hypothesis added: every module but those that need the
   ``train`` extra (``tests/conftest.py`` leaves those out without it).
 
 The numba core compiles once per venv (its cache is keyed by the installed source path,

@@ -20,6 +20,8 @@ How each kind is checked, cheaply:
   long benchmark;
 - ``copy``: a ``cp`` of a comparison plot, whose destination folder is in the repository
   and whose source is written by a documented ``compare`` command;
+- ``zoo``: an rl-zoo3 command, which ``tests/tools/test_zoo_commands.py`` runs (briefly)
+  as it reads it from the docs;
 - ``pip``: a ``pip install`` of the package, whose extras are all in ``pyproject.toml``.
 
 CI's entry point, ``.ci/run``, runs exactly the README's test command
@@ -66,6 +68,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     ),
     "bearing-env play --env-kwargs n_landmarks=6 max_moves=30 --seed 3": ("parse", ()),
     "bearing-env suite --episodes 50 --workers 2": ("parse", ()),
+    "bearing-env compare --policies greedy pretrained:ppo_generalist": ("parse", ()),
     "bearing-env bench": ("parse", ()),
     "bearing-env bench --sections startup": ("parse", ()),
     "bearing-env bench --sections slam,planning --seconds 1": ("parse", ()),
@@ -112,9 +115,20 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "python -m bearing_env.train.studies.generalisation --model ppo_random --counts 3 4 6 8 10 "
     "--episodes 50": ("parse", ()),
     "python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 "
-    '--conf-file "$(bearing-env hyperparams ppo)"': ("parse", ()),
+    '--conf-file "$(bearing-env hyperparams ppo)" --eval-env-kwargs "scenario:\'khepera\'"': (
+        "zoo",
+        (),
+    ),
+    "python -m rl_zoo3.enjoy --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 -f logs": (
+        "zoo",
+        (),
+    ),
     "python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 "
-    '--conf-file "$(bearing-env hyperparams ppo_entities)"': ("parse", ()),
+    '--conf-file "$(bearing-env hyperparams ppo_entities)" --eval-env-kwargs '
+    '"scenario:\'random\'" "n_landmarks:[3, 12]" max_landmarks:16 "observation:\'entities\'"': (
+        "zoo",
+        (),
+    ),
     'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_entities)" '
     "--seed 0 --eval-freq 100000 --output runs/ppo_generalist": ("parse", ()),
     "bearing-env train --algo ppo --output runs/ppo_generalist --export "
@@ -206,20 +220,6 @@ def test_the_readme_gives_the_two_make_commands_and_ci_runs_its_test_command() -
 def _parse(argv: list[str]) -> None:
     """Parse a command's arguments with its own parser and settings step."""
     program, rest = argv[0], argv[1:]
-    if program == "python" and rest[:2] == ["-m", "rl_zoo3.train"]:
-        # rl-zoo3 builds its parser inside train(), so the run itself is in test_train
-        # (test_rl_zoo3_trains_with_the_shipped_yaml, with this substitution's path); here
-        # the module imports and the substituted path exists.
-        from bearing_env.train.sb3.zoo import rl_zoo3_module
-
-        assert callable(rl_zoo3_module("rl_zoo3.train").train)
-        conf = rest.index("--conf-file") + 1
-        shipped = re.fullmatch(r"\$\(bearing-env hyperparams (\w+)\)", rest[conf])
-        assert shipped is not None, rest[conf]
-        from bearing_env.train.sb3.conf_files import default_conf_file
-
-        assert default_conf_file(shipped.group(1)).is_file()
-        return
     if program == "python":
         assert rest[:2] == ["-m", "bearing_env.train.studies.generalisation"]
         result = subprocess.run(
@@ -296,6 +296,10 @@ def test_readme_command_runs_or_parses(command: str, tmp_path: Path) -> None:
         writers = ("bearing-env compare", "python -m bearing_env.train.studies.generalisation")
         producers = [c for c in CHECKS if c.startswith(writers) and out_option in c]
         assert producers, f"no documented command writes {source}"
+    elif kind == "zoo":
+        from tests.tools.test_zoo_commands import COMMANDS
+
+        assert command in {zoo.command for zoo in COMMANDS}
     elif kind == "parse":
         _parse(argv + list(extra))
     elif kind == "help":

@@ -2,13 +2,12 @@
 
 Runs are a few hundred steps with small networks and in-process envs (``DummyVecEnv``);
 one test runs the real command in a subprocess with ``SubprocVecEnv`` (spawn) and
-interrupts it with Ctrl-C. The rl-zoo3 command starts at the beginning of the module and
-runs in the background (it spends most of its time importing); its test checks it last.
+interrupts it with Ctrl-C. The documented ``python -m rl_zoo3`` commands run in
+``tests/tools/test_zoo_commands.py``.
 """
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import os
 import re
@@ -17,8 +16,7 @@ import subprocess
 import sys
 import time
 import zipfile
-from collections.abc import Iterator
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -26,7 +24,6 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
-import yaml
 from stable_baselines3 import PPO
 from stable_baselines3.common.utils import ConstantSchedule
 
@@ -589,64 +586,6 @@ def test_seed_ranges_are_disjoint_and_validation_episodes_repeat() -> None:
     np.testing.assert_array_equal(first[0], first[2])  # cycles
     assert not np.array_equal(first[0], first[1])
     env.close()
-
-
-@dataclass
-class BackgroundCommand:
-    """A command started early (it mostly waits on imports) and checked by a later test."""
-
-    process: subprocess.Popen[str]
-    folder: Path
-
-    def finish(self, timeout: float = 180) -> str:
-        output, _ = self.process.communicate(timeout=timeout)
-        return output
-
-
-@pytest.fixture(scope="module", autouse=True)
-def rl_zoo3_run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[BackgroundCommand | None]:
-    """``python -m rl_zoo3.train`` on the shipped PPO file, running while the other tests do."""
-    if importlib.util.find_spec("rl_zoo3") is None:
-        yield None
-        return
-    folder = tmp_path_factory.mktemp("rl_zoo3")
-    # As the README runs it: the path printed by `bearing-env hyperparams ppo`, from a
-    # folder that is not the checkout.
-    conf_file = subprocess.run(
-        [PYTHON, "-m", "bearing_env.train.cli", "hyperparams", "ppo"],
-        cwd=folder, capture_output=True, text=True, check=True,
-    ).stdout.strip()  # fmt: skip
-    command = [
-        PYTHON, "-m", "rl_zoo3.train", "--gym-packages", "bearing_env", "--algo", "ppo",
-        "--env", "BearingSLAM-v0", "--conf-file", conf_file, "-n", "300",
-        "-f", str(folder), "--device", "cpu", "--seed", "0",
-        "--hyperparams", "n_envs:2", "n_steps:64", f"policy_kwargs:'{TINY_NET}'",
-    ]  # fmt: skip
-    process = subprocess.Popen(
-        command, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
-    )
-    background = BackgroundCommand(process, folder)
-    yield background
-    if process.poll() is None:
-        process.kill()
-        process.communicate()
-
-
-def test_rl_zoo3_trains_with_the_shipped_yaml(rl_zoo3_run: BackgroundCommand | None) -> None:
-    if rl_zoo3_run is None:
-        pytest.skip("rl_zoo3 is not installed")
-    output = rl_zoo3_run.finish()
-    assert rl_zoo3_run.process.returncode == 0, output[-5000:]
-    run = rl_zoo3_run.folder / "ppo" / "BearingSLAM-v0_1"
-    assert (run / "BearingSLAM-v0.zip").is_file()
-    assert (run / "BearingSLAM-v0" / "vecnormalize.pkl").is_file()
-    # rl-zoo3 writes its config with Python tags (an OrderedDict of pairs).
-    saved_text = (run / "BearingSLAM-v0" / "config.yml").read_text()
-    saved = dict(yaml.load(saved_text, Loader=yaml.UnsafeLoader))
-    assert saved["env_kwargs"] == {"scenario": "khepera"}
-    assert saved["normalize"] is True
-    model = load_model(run / "BearingSLAM-v0.zip", "ppo")
-    assert model.num_timesteps >= 300
 
 
 def test_env_factory_raises_the_time_limit_with_max_moves() -> None:

@@ -16,6 +16,11 @@ seeds below ``TRAINING_SEED_LIMIT`` (``bearing_env.train.common.seeds``), so eva
 are never trained on. The policy's own randomness is seeded from the same episode seed
 through a separate stream (``bearing_env.agents.base.policy_rng``).
 
+A ``pretrained:NAME`` model runs on the task it was trained on (its record, see
+:mod:`bearing_env.agents.model_task`): without ``--env-kwargs`` the comparison runs on
+that task; env kwargs of another task (or models of different tasks) are refused in one
+line naming the settings that differ, with exit status 2.
+
 Outputs (in ``--out``):
 
 - ``config.json``: what was run (env id and kwargs, policy specs, seeds);
@@ -61,6 +66,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from bearing_env.agents.model_task import ModelTask, TaskMismatchError, setting_differences
 from bearing_env.extras import DISTRIBUTIONS, install_command
 from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import (
@@ -141,7 +147,8 @@ def _add_episode_options(group: argparse._ArgumentGroup) -> None:
         nargs="*",
         default=None,
         metavar="KEY=VALUE",
-        help="env kwargs (default: scenario=khepera)",
+        help="env kwargs (default: the task of the pretrained:NAME models in --policies, "
+        "else scenario=khepera)",
     )
     group.add_argument(
         "--episodes",
@@ -278,16 +285,48 @@ def installed_models(specs: list[str]) -> list[str]:
     return specs
 
 
+def models_task(specs: Sequence[str]) -> ModelTask | None:
+    """The task of the ``pretrained:NAME`` models among ``specs`` (the first one's), or
+    None when there are none.
+
+    Raises:
+        TaskMismatchError: two of them were trained on different tasks (the one-line
+            message names the settings that differ).
+    """
+    from bearing_env.agents.registry import parse_policy_spec
+    from bearing_env.agents.sb3 import pretrained_task
+
+    tasks = [
+        pretrained_task(str(parsed.options["name"]))
+        for parsed in map(parse_policy_spec, specs)
+        if parsed.kind == "pretrained"
+    ]
+    for other in tasks[1:]:
+        differences = setting_differences(tasks[0].settings(), other.settings(), other.model)
+        if differences:
+            raise TaskMismatchError(
+                f"models {tasks[0].model!r} and {other.model!r} were trained on different "
+                f"tasks: {', '.join(differences)}; compare them one at a time"
+            )
+    return tasks[0] if tasks else None
+
+
 def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
+    """The comparison the arguments describe, and its output folder. Without
+    ``--env-kwargs``, pretrained models run on their own task (:func:`models_task`)."""
     registered_env_id(args.env)
-    env_kwargs = dict(DEFAULT_ENV_KWARGS)
+    env_id, env_kwargs = args.env, dict(DEFAULT_ENV_KWARGS)
+    task = None if args.env_kwargs is not None else models_task(args.policies or [])
     if args.env_kwargs is not None:
         env_kwargs = parse_key_values(args.env_kwargs, "--env-kwargs")
+    elif task is not None:
+        env_kwargs = dict(task.env_kwargs)
+        env_id = task.env_id if args.env == DEFAULT_ENV_ID else args.env
     if args.quick:
         env_kwargs.setdefault("max_moves", QUICK_MAX_MOVES)
     policies = args.policies or [
         *(QUICK_POLICIES if args.quick else DEFAULT_POLICIES),
-        *shipped_policies(args.env, env_kwargs),
+        *shipped_policies(env_id, env_kwargs),
     ]
     episodes = args.episodes
     if episodes is None:
@@ -297,7 +336,7 @@ def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
     )
     config = CompareConfig(
         policies=policies_from_specs(policies),
-        env_id=args.env,
+        env_id=env_id,
         env_kwargs=env_kwargs,
         episodes=episodes,
         seed_start=args.seed_start,
@@ -358,6 +397,8 @@ def main(argv: Sequence[str] | None = None) -> None:
         with contextlib.closing(make_env(config.env_id, config.env_kwargs)) as env:
             for spec in config.policies.values():
                 make_policy(spec, env)
+    except TaskMismatchError as error:  # one line, with no usage: the arguments parse
+        fail(parser.prog, str(error))
     except (ValueError, TypeError, FileNotFoundError) as error:
         parser.error(str(error))
     except ImportError as error:  # an sb3: policy without stable-baselines3, ...

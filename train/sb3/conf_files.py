@@ -5,7 +5,10 @@ through :mod:`bearing_env.shipped`), so they exist in site-packages as well as i
 checkout. ``bearing-env hyperparams ppo`` prints the path of ``ppo.yml``, for rl-zoo3::
 
     python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 \\
-        --conf-file "$(bearing-env hyperparams ppo)"
+        --conf-file "$(bearing-env hyperparams ppo)" --eval-env-kwargs "scenario:'khepera'"
+
+(rl-zoo3 gives a file's ``env_kwargs`` to its training envs only: the evaluation env
+needs the same settings as ``--eval-env-kwargs``; each file's header shows its command.)
 
 ``bearing-env hyperparams`` without an algorithm lists the shipped files. Nothing here
 needs an optional extra.

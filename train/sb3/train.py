@@ -18,7 +18,7 @@ constructor arguments (``lin_<x>`` is a schedule decaying linearly from ``x`` to
 same files run under rl-zoo3::
 
     python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 \\
-        --conf-file "$(bearing-env hyperparams ppo)"
+        --conf-file "$(bearing-env hyperparams ppo)" --eval-env-kwargs "scenario:'khepera'"
 
 ``--env-kwargs k=v ...`` is merged over the entry's ``env_kwargs`` (rl-zoo3 replaces them
 instead), and ``--hyperparams k=v ...`` over the entry itself. Values are Python literals
