@@ -264,6 +264,17 @@ class BatchedPolygonSLAM:
         b2 = self._check_bearings(bearings_end, rows.size, "bearings_end")
         return self._update_checked(b1, b2, rows, robot)
 
+    def update_trusted(
+        self, bearings_start: FloatArray, bearings_end: FloatArray, robot: bool = True
+    ) -> BatchUpdateResult:
+        """:meth:`update` of every map, in order, without the input checks: for callers
+        that made the bearings themselves (a planner's simulated readings), as C-contiguous
+        float64 arrays (num_maps, n_landmarks) with no infinite value. Wrong input here is
+        not caught: it can corrupt the maps."""
+        return self._update_checked(
+            bearings_start, bearings_end, np.arange(self.num_maps), robot
+        )
+
     def _update_checked(
         self, b1: FloatArray, b2: FloatArray, rows: IntArray, robot: bool = True
     ) -> BatchUpdateResult:
