@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.slam import kernels
+from bearing_env.slam.compile_notice import announce_compile_once
 from bearing_env.slam.transfer import TRANSFERS
 from bearing_env.validation import epsilon_radians, int_at_least
 
@@ -190,6 +191,7 @@ class BatchedPolygonSLAM:
         self.n_dropped = np.zeros((n, m), dtype=np.int64)
         self.outliers = np.zeros((n, m), dtype=np.int64)
         self._state_ref: kernels.State | None = None
+        announce_compile_once()
         self.reset()
 
     def empty_like(self, num_maps: int) -> BatchedPolygonSLAM:
