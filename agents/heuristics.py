@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 
 from bearing_env.envs.core import WorldView
 from bearing_env.numerics import wrap, wrap_angle
-from bearing_env.slam import PolygonSLAM, world_to_fl
+from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM, world_to_fl
 
 from .base import Action, ActionCodec, Movement, policy_rng
 from .belief import (
@@ -319,6 +319,8 @@ class GreedyOneStep(BeliefPolicy):
         # The candidates as arrays: scoring makes no Python object per candidate.
         self._turns = np.array([c.turn for c in self.candidates], dtype=np.float64)
         self._lengths = np.array([c.length for c in self.candidates], dtype=np.float64)
+        #: Copies of the map to score candidates on, by count, refilled at each decision.
+        self._trials: dict[int, BatchedPolygonSLAM] = {}
         self.area_cap = float(bearing_env_of(env).area_cap)
         # Score moves with the potential the env rewards (reward="log_area" or "area").
         self.log_area = bearing_env_of(env).config.reward == "log_area"
@@ -338,7 +340,7 @@ class GreedyOneStep(BeliefPolicy):
         potentials = simulate_potentials(
             slam, pose.position, landmark_positions_fl(slam),
             pose.heading + self._turns[allowed], self._lengths[allowed] / pose.metres_per_unit,
-            self.area_cap, log_area=self.log_area,
+            self.area_cap, log_area=self.log_area, scratch=self._trials,
         )  # fmt: skip
         if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap, self.log_area):
             # No candidate is predicted to help (e.g. every landmark is uninitialised):
@@ -384,6 +386,7 @@ class GreedyOracle(GreedyOneStep):
             distances,
             self.area_cap,
             log_area=self.log_area,
+            scratch=self._trials,
         )
         if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap, self.log_area):
             return bootstrap_movement(self.codec, view)

@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 from bearing_env.envs.config import AREA_FLOOR
 from bearing_env.envs.kernels import potential_of
 from bearing_env.numerics import JIT_OPTIONS, wrap_angle
-from bearing_env.slam import PolygonSLAM
+from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
 
 
 def uncertainty_potential(
@@ -63,6 +63,7 @@ def simulate_potentials(
     area_cap: float,
     min_distance: float = 1e-9,
     log_area: bool = True,
+    scratch: dict[int, BatchedPolygonSLAM] | None = None,
 ) -> NDArray[np.float64]:
     """The uncertainty potential after each candidate move, simulated on a copy of ``slam``.
 
@@ -77,6 +78,8 @@ def simulate_potentials(
         area_cap: the cap (and the value of an uninitialised landmark) of the potential.
         min_distance: a move shorter than this (FL units) does not update the map.
         log_area: the env's ``reward`` is ``"log_area"`` (True) or ``"area"`` (False).
+        scratch: the caller's batches of copies by size, kept between calls and refilled
+            (see :meth:`PolygonSLAM.replicate`) instead of made anew for each decision.
 
     Every moving candidate is fused into its own copy of the map, all in one batched
     update; the bearings are computed here, so the update skips its input checks.
@@ -100,7 +103,11 @@ def simulate_potentials(
     )
     bearings_start = bearings_from(start, headings, targets)
     bearings_end = np.where(known, bearings_from(ends, headings, targets), bearings_start)
-    trials = slam.replicate(moving.size)
+    if scratch is None:
+        trials = slam.replicate(moving.size)
+    else:
+        trials = slam.replicate(moving.size, into=scratch.get(moving.size))
+        scratch[moving.size] = trials
     # Bearings made here are finite float arrays of the batch's shape: no checks needed.
     trials.update_trusted(bearings_start, bearings_end, robot=False)  # scores need areas only
     potentials[moving] = uncertainty_potential(trials.areas, area_cap, log_area)

@@ -328,6 +328,22 @@ class BatchedPolygonSLAM:
         """The vertices (CCW) of a map's robot region; empty before any frame change."""
         return self.robot_vertices[map_index, : self.robot_counts[map_index]].copy()
 
+    def same_settings(self, other: BatchedPolygonSLAM) -> bool:
+        """Whether ``other`` was made with this batch's settings (its map count aside)."""
+        return self._settings() == other._settings()
+
+    def _settings(self) -> tuple[object, ...]:
+        return (
+            self.n_landmarks, self.epsilon, self.transfer, self.edge_samples,
+            self.on_inconsistency, self.fusion, self.max_outliers, self.window,
+        )  # fmt: skip
+
+    def fill_from(self, source: BatchedPolygonSLAM, map_index: int) -> None:
+        """Make every map of this batch a copy of ``source``'s map ``map_index`` (same
+        settings), in place: a planner's scratch batch, refilled for each decision."""
+        for name in STATE_ARRAYS:
+            getattr(self, name)[:] = getattr(source, name)[map_index]
+
     def take(self, maps: ArrayLike) -> BatchedPolygonSLAM:
         """A new batch whose map ``i`` is a copy of map ``maps[i]`` (indices may repeat):
         for planning, many candidates from each of a few maps."""
