@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 
 from bearing_env.envs.core import WorldView
 from bearing_env.numerics import wrap, wrap_angle
-from bearing_env.slam import PolygonSLAM, world_to_fl
+from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM, world_to_fl
 
 from .base import Action, ActionCodec, Movement, policy_rng
 from .belief import (
@@ -26,7 +26,6 @@ from .belief import (
 )
 from .env_access import MapReader, bearing_env_of, world_of
 from .planning import (
-    SimulatedMove,
     landmark_positions_fl,
     simulate_potentials,
     uncertainty_potential,
@@ -317,6 +316,11 @@ class GreedyOneStep(BeliefPolicy):
         if int(n_turns) < 1:
             raise ValueError(f"n_turns must be >= 1, got {n_turns!r}")
         self.candidates = self.codec.candidates(int(n_turns), lengths)
+        # The candidates as arrays: scoring makes no Python object per candidate.
+        self._turns = np.array([c.turn for c in self.candidates], dtype=np.float64)
+        self._lengths = np.array([c.length for c in self.candidates], dtype=np.float64)
+        #: Copies of the map to score candidates on, by count, refilled at each decision.
+        self._trials: dict[int, BatchedPolygonSLAM] = {}
         self.area_cap = float(bearing_env_of(env).config.task.area_cap)
         # Score moves with the potential the env rewards (reward="log_area" or "area").
         self.log_area = bearing_env_of(env).config.task.reward == "log_area"
@@ -332,25 +336,17 @@ class GreedyOneStep(BeliefPolicy):
         pose = self.belief.pose(slam)
         if pose is None or pose.metres_per_unit is None:
             return bootstrap_movement(self.codec, view)
-        candidates = self._allowed(view)
-        moves = [
-            SimulatedMove(pose.heading + c.turn, c.length / pose.metres_per_unit)
-            for c in candidates
-        ]
+        allowed = np.flatnonzero(_allowed_turns(self._turns, view))
         potentials = simulate_potentials(
-            slam, pose.position, landmark_positions_fl(slam), moves, self.area_cap,
-            log_area=self.log_area,
+            slam, pose.position, landmark_positions_fl(slam),
+            pose.heading + self._turns[allowed], self._lengths[allowed] / pose.metres_per_unit,
+            self.area_cap, log_area=self.log_area, scratch=self._trials,
         )  # fmt: skip
         if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap, self.log_area):
             # No candidate is predicted to help (e.g. every landmark is uninitialised):
             # fall back on the move that keeps every landmark off the line of motion.
             return bootstrap_movement(self.codec, view)
-        return candidates[int(np.argmin(potentials))]
-
-    def _allowed(self, view: ObservationView) -> list[Movement]:
-        turns = np.array([c.turn for c in self.candidates])
-        keep = _allowed_turns(turns, view)
-        return [c for c, ok in zip(self.candidates, keep, strict=True) if ok]
+        return self.candidates[int(allowed[int(np.argmin(potentials))])]
 
 
 class GreedyOracle(GreedyOneStep):
@@ -375,20 +371,22 @@ class GreedyOracle(GreedyOneStep):
         heading_fl = world.heading - math.atan2(baseline.imag, baseline.real)
         truth = world_to_fl(world.landmarks, l1, l2)
         margin = world.arena.wall_margin
-        moves = []
-        for candidate in self.candidates:
+        distances = np.empty(len(self.candidates), dtype=np.float64)
+        for k, candidate in enumerate(self.candidates):
             free = world.arena.free_distance(world.position, world.heading + candidate.turn, margin)
             travelled = min(candidate.length, free)
             if travelled < world.min_baseline:
                 travelled = 0.0
-            moves.append(SimulatedMove(heading_fl + candidate.turn, travelled / metres_per_unit))
+            distances[k] = travelled / metres_per_unit
         potentials = simulate_potentials(
             slam,
             complex(position[0], position[1]),
             truth[:, 0] + 1j * truth[:, 1],
-            moves,
+            heading_fl + self._turns,
+            distances,
             self.area_cap,
             log_area=self.log_area,
+            scratch=self._trials,
         )
         if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap, self.log_area):
             return bootstrap_movement(self.codec, view)

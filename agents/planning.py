@@ -9,16 +9,15 @@ provided the move length is converted to FL units.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from bearing_env.envs.config import AREA_FLOOR
 from bearing_env.envs.kernels import potential_of
-from bearing_env.numerics import wrap_angle
-from bearing_env.slam import PolygonSLAM
+from bearing_env.numerics import JIT_OPTIONS, wrap_angle
+from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
 
 
 def uncertainty_potential(
@@ -30,10 +29,18 @@ def uncertainty_potential(
     areas, the default) and ``reward="area"`` (``log_area=False``: sum of capped areas)."""
     values = np.asarray(areas, dtype=np.float64)
     rows = np.ascontiguousarray(values.reshape(-1, values.shape[-1]))
-    potentials = np.array(
-        [potential_of(row, row.size, log_area, AREA_FLOOR, float(area_cap)) for row in rows]
-    )
+    potentials = np.empty(rows.shape[0], dtype=np.float64)
+    _potentials_of_rows(rows, bool(log_area), AREA_FLOOR, float(area_cap), potentials)
     return potentials.reshape(values.shape[:-1])
+
+
+@njit(**JIT_OPTIONS)
+def _potentials_of_rows(
+    rows: np.ndarray, log_area: bool, floor: float, cap: float, out: np.ndarray
+) -> None:
+    """``potential_of`` of every row, in one compiled call (no Python per map)."""
+    for i in range(rows.shape[0]):
+        out[i] = potential_of(rows[i], rows.shape[1], log_area, floor, cap)
 
 
 def bearings_from(
@@ -47,22 +54,16 @@ def bearings_from(
     return wrap_angle(angles)
 
 
-@dataclass(frozen=True)
-class SimulatedMove:
-    """A candidate in FL: the new heading and the distance actually travelled (FL units)."""
-
-    heading: float
-    distance: float
-
-
 def simulate_potentials(
     slam: PolygonSLAM,
     start: complex,
     landmarks: NDArray[np.complex128],
-    moves: Sequence[SimulatedMove],
+    headings: NDArray[np.float64],
+    distances: NDArray[np.float64],
     area_cap: float,
     min_distance: float = 1e-9,
     log_area: bool = True,
+    scratch: dict[int, BatchedPolygonSLAM] | None = None,
 ) -> NDArray[np.float64]:
     """The uncertainty potential after each candidate move, simulated on a copy of ``slam``.
 
@@ -72,23 +73,28 @@ def simulate_potentials(
         landmarks: all landmark positions in FL (n,), L1 = 0 and L2 = 1 first; NaN for a
             landmark whose position is unknown: it is given the same bearing at both
             ends (parallel cones, so no region), i.e. no predicted progress.
-        moves: the candidates.
+        headings: each candidate's new heading in FL (K,).
+        distances: the distance each candidate actually travels, in FL units (K,).
         area_cap: the cap (and the value of an uninitialised landmark) of the potential.
         min_distance: a move shorter than this (FL units) does not update the map.
         log_area: the env's ``reward`` is ``"log_area"`` (True) or ``"area"`` (False).
+        scratch: the caller's batches of copies by size, kept between calls and refilled
+            (see :meth:`PolygonSLAM.replicate`) instead of made anew for each decision.
 
-    Every candidate is fused into its own copy of the map, all in one batched update.
+    Every moving candidate is fused into its own copy of the map, all in one batched
+    update; the bearings are computed here, so the update skips its input checks.
     """
     current = uncertainty_potential(slam.areas, area_cap, log_area)
+    headings = np.asarray(headings, dtype=np.float64)
+    distances = np.asarray(distances, dtype=np.float64)
+    potentials = np.full(headings.size, current)
+    moving = np.flatnonzero(distances >= min_distance)
+    if moving.size == 0:
+        return potentials
+    headings, distances = headings[moving], distances[moving]
     known = np.isfinite(landmarks)
     targets = np.where(known, landmarks, 0.0)
-    potentials = np.full(len(moves), current)
-    moving = [index for index, move in enumerate(moves) if move.distance >= min_distance]
-    if not moving:
-        return potentials
-    headings = np.array([moves[index].heading for index in moving])
-    distances = np.array([moves[index].distance for index in moving])
-    # The same arithmetic as one candidate at a time, so decisions do not depend on batching.
+    # math.cos/sin, as one candidate at a time did, so decisions do not depend on batching.
     ends = np.array(
         [
             start + distance * complex(math.cos(heading), math.sin(heading))
@@ -97,8 +103,13 @@ def simulate_potentials(
     )
     bearings_start = bearings_from(start, headings, targets)
     bearings_end = np.where(known, bearings_from(ends, headings, targets), bearings_start)
-    trials = slam.replicate(len(moving))
-    trials.update(bearings_start, bearings_end, robot=False)  # scores need areas only
+    if scratch is None:
+        trials = slam.replicate(moving.size)
+    else:
+        trials = slam.replicate(moving.size, into=scratch.get(moving.size))
+        scratch[moving.size] = trials
+    # Bearings made here are finite float arrays of the batch's shape: no checks needed.
+    trials.update_trusted(bearings_start, bearings_end, robot=False)  # scores need areas only
     potentials[moving] = uncertainty_potential(trials.areas, area_cap, log_area)
     return potentials
 

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.slam import kernels
+from bearing_env.slam.compile_notice import announce_compile_once
 from bearing_env.slam.settings import (
     DEFAULT_MAX_OUTLIERS,
     DEFAULT_WINDOW,
@@ -169,6 +170,7 @@ class BatchedPolygonSLAM:
         self.n_dropped = np.zeros((n, m), dtype=np.int64)
         self.outliers = np.zeros((n, m), dtype=np.int64)
         self._state_ref: kernels.State | None = None
+        announce_compile_once()
         self.reset()
 
     @classmethod
@@ -242,6 +244,17 @@ class BatchedPolygonSLAM:
         b2 = self._check_bearings(bearings_end, rows.size, "bearings_end")
         return self._update_checked(b1, b2, rows, robot)
 
+    def update_trusted(
+        self, bearings_start: FloatArray, bearings_end: FloatArray, robot: bool = True
+    ) -> BatchUpdateResult:
+        """:meth:`update` of every map, in order, without the input checks: for callers
+        that made the bearings themselves (a planner's simulated readings), as C-contiguous
+        float64 arrays (num_maps, n_landmarks) with no infinite value. Wrong input here is
+        not caught: it can corrupt the maps."""
+        return self._update_checked(
+            bearings_start, bearings_end, np.arange(self.num_maps), robot
+        )
+
     def _update_checked(
         self, b1: FloatArray, b2: FloatArray, rows: IntArray, robot: bool = True
     ) -> BatchUpdateResult:
@@ -290,6 +303,22 @@ class BatchedPolygonSLAM:
     def robot_polygon(self, map_index: int) -> NDArray[np.complex128]:
         """The vertices (CCW) of a map's robot region; empty before any frame change."""
         return self.robot_vertices[map_index, : self.robot_counts[map_index]].copy()
+
+    def same_settings(self, other: BatchedPolygonSLAM) -> bool:
+        """Whether ``other`` was made with this batch's settings (its map count aside)."""
+        return self._settings() == other._settings()
+
+    def _settings(self) -> tuple[object, ...]:
+        return (
+            self.n_landmarks, self.epsilon, self.transfer, self.edge_samples,
+            self.on_inconsistency, self.fusion, self.max_outliers, self.window,
+        )  # fmt: skip
+
+    def fill_from(self, source: BatchedPolygonSLAM, map_index: int) -> None:
+        """Make every map of this batch a copy of ``source``'s map ``map_index`` (same
+        settings), in place: a planner's scratch batch, refilled for each decision."""
+        for name in STATE_ARRAYS:
+            getattr(self, name)[:] = getattr(source, name)[map_index]
 
     def take(self, maps: ArrayLike) -> BatchedPolygonSLAM:
         """A new batch whose map ``i`` is a copy of map ``maps[i]`` (indices may repeat):

@@ -244,13 +244,18 @@ class PolygonSLAM:
         """An independent copy (for planning: simulate moves without touching the map)."""
         return PolygonSLAM.view(self.replicate(1), 0)
 
-    def replicate(self, count: int) -> BatchedPolygonSLAM:
+    def replicate(self, count: int, into: BatchedPolygonSLAM | None = None) -> BatchedPolygonSLAM:
         """``count`` independent copies of this map, as one batch.
 
         For planning: score many candidate movements with one batched
-        :meth:`BatchedPolygonSLAM.update`, each candidate on its own copy.
+        :meth:`BatchedPolygonSLAM.update`, each candidate on its own copy. ``into``: a
+        batch from an earlier call to overwrite instead of making a new one, when it has
+        ``count`` maps and this map's settings (a planner's scratch; else a new batch).
         """
         count = int_at_least(count, 1, "replicate count")
+        if into is not None and into.num_maps == count and into.same_settings(self._batch):
+            into.fill_from(self._batch, self._index)
+            return into
         return self._batch.take(np.full(count, self._index, dtype=np.int64))
 
     @property

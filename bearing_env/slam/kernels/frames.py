@@ -37,6 +37,7 @@ from bearing_env.slam.kernels.polygons import (
     polygon_distance,
     simplify,
     small_convex_hull,
+    small_hull_indices,
 )
 
 ComplexArray = NDArray[np.complex128]
@@ -154,23 +155,36 @@ def sample_hypotheses(
     For one ``h1``, the images ``(z - h1) / (h2 - h1)`` of any point ``z`` over the
     samples ``h2`` are the points ``1 / (h2 - h1)`` times ``z - h1``: a rotation and
     scaling about 0. So only the ``h2`` whose ``1 / (h2 - h1)`` is a vertex of their
-    convex hull can give a vertex of a transferred region; the others are left out (a
-    third of them, typically), which changes no region.
+    convex hull can give a vertex of a transferred region. Symmetrically, for one ``h2``
+    the images are ``1 + (z - h2) / (h2 - h1)``: only the ``h1`` whose ``1 / (h2 - h1)``
+    is a vertex of the hull over the samples ``h1`` count. Pairs that fail either test
+    are left out (about half of them, typically), which changes no region.
     """
     s1 = np.empty(MAX_SAMPLES, dtype=np.complex128)
     s2 = np.empty(MAX_SAMPLES, dtype=np.complex128)
-    inverses = np.empty(MAX_SAMPLES, dtype=np.complex128)
-    extreme = np.empty(MAX_SAMPLES + 1, dtype=np.complex128)
     m1 = boundary_samples(a1, n1, per_edge, s1)
     m2 = boundary_samples(a2, n2, per_edge, s2)
-    k = 0
+    inverses = np.empty((m1, m2), dtype=np.complex128)
     for i in range(m1):
         for j in range(m2):
-            inverses[j] = 1.0 / (s2[j] - s1[i])
-        for v in range(small_convex_hull(inverses, m2, extreme, 0.0)):
-            h1[k] = s1[i]
-            inv_d[k] = extreme[v]
-            k += 1
+            inverses[i, j] = 1.0 / (s2[j] - s1[i])
+    column = np.empty(m1, dtype=np.complex128)
+    extreme = np.empty(MAX_SAMPLES + 1, dtype=np.int64)
+    # column_extreme[i, j]: h1 = s1[i] gives a hull vertex among the pairs with h2 = s2[j].
+    column_extreme = np.zeros((m1, m2), dtype=np.bool_)
+    for j in range(m2):
+        for i in range(m1):
+            column[i] = inverses[i, j]
+        for v in range(small_hull_indices(column, m1, extreme, 0.0)):
+            column_extreme[extreme[v], j] = True
+    k = 0
+    for i in range(m1):
+        for v in range(small_hull_indices(inverses[i], m2, extreme, 0.0)):
+            j = extreme[v]
+            if column_extreme[i, j]:
+                h1[k] = s1[i]
+                inv_d[k] = inverses[i, j]
+                k += 1
     return k
 
 

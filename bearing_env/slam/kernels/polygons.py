@@ -160,6 +160,17 @@ def small_convex_hull(points: np.ndarray, n_points: int, out: np.ndarray, tol: f
     is a simple polygon whatever the rounding, and with ``tol > 0`` each of its turns
     is a clear left turn.
     """
+    chosen = np.empty(n_points + 1, dtype=np.int64)
+    k = small_hull_indices(points, n_points, chosen, tol)
+    for v in range(k):
+        out[v] = points[chosen[v]]
+    return k
+
+
+@njit(**_JIT)
+def small_hull_indices(points: np.ndarray, n_points: int, out: np.ndarray, tol: float) -> int:
+    """:func:`small_convex_hull` as indices into ``points`` (``out`` holds ``n_points + 1``):
+    for callers that need to know which inputs are hull vertices."""
     if n_points == 0:
         return 0
     order = np.empty(n_points, dtype=np.int64)
@@ -176,19 +187,19 @@ def small_convex_hull(points: np.ndarray, n_points: int, out: np.ndarray, tol: f
     k = 0
     for j in range(n_points):  # lower chain
         p = points[order[j]]
-        while k >= 2 and _within_chord(out[k - 2], out[k - 1], p, tol):
+        while k >= 2 and _within_chord(points[out[k - 2]], points[out[k - 1]], p, tol):
             k -= 1
-        out[k] = p
+        out[k] = order[j]
         k += 1
     lower = k + 1
     for j in range(n_points - 2, -1, -1):  # upper chain
         p = points[order[j]]
-        while k >= lower and _within_chord(out[k - 2], out[k - 1], p, tol):
+        while k >= lower and _within_chord(points[out[k - 2]], points[out[k - 1]], p, tol):
             k -= 1
-        out[k] = p
+        out[k] = order[j]
         k += 1
     k -= 1  # the last point repeats the first
-    if k == 2 and out[0] == out[1]:
+    if k == 2 and points[out[0]] == points[out[1]]:
         return 1
     return max(k, 1)
 
@@ -197,7 +208,10 @@ def small_convex_hull(points: np.ndarray, n_points: int, out: np.ndarray, tol: f
 def _within_chord(a: complex, b: complex, c: complex, tol: float) -> bool:
     """Whether ``b`` fails to turn left by more than ``tol`` on the way from ``a`` to ``c``:
     it lies right of the chord ``a -> c``, or within ``tol`` of it."""
-    return cross(b - a, c - a) <= tol * abs(c - a)
+    turn = cross(b - a, c - a)
+    if tol == 0.0:  # skips a square root per test in the hulls of the hypotheses
+        return turn <= 0.0
+    return turn <= tol * abs(c - a)
 
 
 # --------------------------------------------------------------------------------------
