@@ -33,7 +33,9 @@ def test_the_check_finds_an_unseeded_sample() -> None:
     assert _functions_sampling_unseeded_spaces(unseeded + seeded) == ["f"]
 
 
-@pytest.mark.parametrize("path", sorted(TESTS.glob("*.py")), ids=lambda path: path.name)
+@pytest.mark.parametrize(
+    "path", sorted(TESTS.rglob("*.py")), ids=lambda path: path.relative_to(TESTS).as_posix()
+)
 def test_every_sampled_space_is_seeded(path: pathlib.Path) -> None:
     assert _functions_sampling_unseeded_spaces(path.read_text()) == []
 

@@ -1,3 +1,4 @@
+# ruff: noqa: E402  (the imports below need the extra; the module skips without it)
 """Ray: envs through the object store and in Ray tasks, ``compare --executor ray``, RLlib
 PPO (``bearing-env rllib``) and a Ray Tune sweep (``bearing-env sweep``).
 
@@ -21,6 +22,11 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import pytest
+
+from tests.extras import skip_module_without
+
+skip_module_without("ray")
+
 import ray
 
 from bearing_env.agents.registry import make_policy, spec_files, with_files
@@ -33,9 +39,9 @@ from bearing_env.train.compare.runner import executor_named
 from bearing_env.train.ray.ray_executor import materialise, read_bundle, run_on_ray
 from bearing_env.train.ray.rllib import PROGRESS_NAME, RLlibSettings, train_rllib
 from bearing_env.train.ray.sweep import SweepSettings, parse_grid, run_sweep
-from tests.test_extras import error_line, plain_cli
+from tests.tools.test_extras import error_line, plain_cli
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SMALL_ENV = {"scenario": "khepera", "max_moves": 5}
 #: 4 policies x 12 episodes; the shipped model's files reach the workers through the
 #: object store.

@@ -18,6 +18,7 @@ from bearing_env.envs import BearingSLAMDiscreteVectorEnv, BearingSLAMVectorEnv
 from bearing_env.registration import ENV_IDS
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import BatchedPolygonSLAM
+from tests.extras import needs
 
 VECTOR_CLASSES = {
     "BearingSLAM-v0": BearingSLAMVectorEnv,
@@ -270,6 +271,7 @@ def test_make_vec_in_a_spawned_process() -> None:
     assert np.array_equal(observations, expected)
 
 
+@needs("render")
 def test_rgb_array_render_gives_one_frame_per_env(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
     env = BearingSLAMVectorEnv(2, render_mode="rgb_array", scenario="khepera")

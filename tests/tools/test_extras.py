@@ -27,8 +27,9 @@ from bearing_env.extras import (
     require,
 )
 from bearing_env.train.common.errors import EXIT_ERROR, exit_on_missing_extra
+from tests.extras import import_or_skip, needs
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 RENDER = 'pip install "bearing_env[render]"'
 TRAIN = 'pip install "bearing_env[train]"'
 #: What a plain ``pip install bearing_env`` lacks: every extra's modules.
@@ -94,7 +95,10 @@ def test_train_without_the_train_extra_says_to_install_it(tmp_path: Path) -> Non
     assert not (tmp_path / "runs").exists()
 
 
-@pytest.mark.parametrize("missing", ["stable_baselines3", "yaml"])
+@pytest.mark.parametrize(
+    "missing",
+    ["stable_baselines3", pytest.param("yaml", marks=needs("train", "stable_baselines3"))],
+)
 def test_train_names_the_one_missing_package(tmp_path: Path, missing: str) -> None:
     result = plain_cli(["train", "--algo", "ppo"], tmp_path, blocked=(missing,))
     line = error_line(result, "bearing-env train")
@@ -127,7 +131,7 @@ def test_compare_quick_without_sb3_runs_the_heuristics_and_skips_the_shipped_mod
 
 def test_compare_quick_with_every_extra_includes_the_shipped_model(tmp_path: Path) -> None:
     """The counterpart of the test above: the skip happens only without SB3."""
-    pytest.importorskip("stable_baselines3")
+    import_or_skip("stable_baselines3")
     from bearing_env.train.compare.cli import shipped_policies
 
     assert shipped_policies("bearing_env:BearingSLAM-v0", {"scenario": "khepera"}) == [

@@ -39,7 +39,9 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+from tests.extras import needs
+
+ROOT = Path(__file__).resolve().parents[2]
 README = ROOT / "README.md"
 #: The README and the documentation pages (the generated task cards are left out: they
 #: quote the suite command that wrote them, checked in tests/tools/test_suite.py).
@@ -271,7 +273,24 @@ def _parse(argv: list[str]) -> None:
         pytest.fail(f"no parser check for bearing-env {command}")
 
 
-@pytest.mark.parametrize("command", sorted(CHECKS))
+def command_extra(command: str) -> str | None:
+    """The extra a README command needs to run or parse: training (and rl-zoo3's trainer)
+    needs ``train``, Ray's own command line ``ray``."""
+    if command.startswith(("bearing-env train", "python -m rl_zoo3")):
+        return "train"
+    if command.startswith("ray "):
+        return "ray"
+    return None
+
+
+#: Every checked command, each marked with the extra it needs.
+COMMAND_PARAMS = [
+    pytest.param(command, marks=needs(extra)) if (extra := command_extra(command)) else command
+    for command in sorted(CHECKS)
+]
+
+
+@pytest.mark.parametrize("command", COMMAND_PARAMS)
 def test_readme_command_runs_or_parses(command: str, tmp_path: Path) -> None:
     kind, extra = CHECKS[command]
     argv = shlex.split(command)

@@ -16,7 +16,7 @@ import pytest
 
 from bearing_env.train.compare.log import LOG_NAME
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
+REPO_ROOT = Path(__file__).resolve().parents[2]
 
 
 def live_members(pgid: int) -> list[str]:

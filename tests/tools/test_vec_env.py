@@ -1,3 +1,4 @@
+# ruff: noqa: E402  (the imports below need the extra; the module skips without it)
 """``bearing_env.train.sb3.vec_env``: the SB3 adapter for Gymnasium vector envs, and
 ``--vec-env batched``.
 
@@ -19,6 +20,11 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
+
+from tests.extras import skip_module_without
+
+skip_module_without("train")
+
 from stable_baselines3 import DQN, PPO
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, VecNormalize
 

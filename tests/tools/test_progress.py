@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from bearing_env.train.common import progress
 from bearing_env.train.common.progress import NoProgress, progress_bar
+from tests.extras import needs
 
 
 def test_a_disabled_bar_is_the_silent_stand_in(capsys):
@@ -14,6 +15,7 @@ def test_a_disabled_bar_is_the_silent_stand_in(capsys):
     assert capsys.readouterr().err == ""
 
 
+@needs("train", "tqdm")
 def test_an_enabled_bar_is_tqdm_counting_from_initial(monkeypatch):
     with progress_bar(10, desc="work", unit="it", enabled=True, initial=4) as bar:
         bar.update(2)

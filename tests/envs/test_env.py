@@ -32,6 +32,7 @@ from bearing_env.envs.bearing_slam import (
 from bearing_env.registration import register_envs
 from bearing_env.slam.batch import RELAXED_STATE_ARRAYS, STATE_ARRAYS
 from bearing_env.tasks import TASKS_BY_ID
+from tests.extras import needs
 
 #: The base ids, one per action kind (the task ids built on them: tests/envs/test_tasks.py).
 ENV_IDS = sorted(
@@ -127,6 +128,7 @@ def test_make_by_module_prefixed_id_without_importing_first() -> None:
 # --------------------------------------------------------------------------------------
 
 
+@needs("render")
 @pytest.mark.parametrize("observation", ["flat", "entities"])
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_gymnasium_check_env_without_warnings(env_id: str, observation: str) -> None:
@@ -137,6 +139,8 @@ def test_gymnasium_check_env_without_warnings(env_id: str, observation: str) -> 
     env.close()
 
 
+@needs("train", "stable_baselines3", "torch")
+@needs("render")
 @pytest.mark.parametrize("observation", ["flat", "entities"])
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_sb3_check_env_without_warnings(env_id: str, observation: str) -> None:
@@ -194,6 +198,7 @@ def test_same_seed_same_episode_bit_for_bit(env_id: str) -> None:
     assert not np.array_equal(first[0][0], other[0][0])
 
 
+@needs("render")
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_pickle_round_trip_continues_identically(env_id: str) -> None:
     env = gym.make(env_id, render_mode="rgb_array")
@@ -255,6 +260,7 @@ def test_make_vec_runs(env_id: str, mode: str) -> None:
         envs.close()
 
 
+@needs("train", "stable_baselines3", "torch")
 def test_sb3_subproc_vec_env_with_spawn() -> None:
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import SubprocVecEnv
@@ -630,6 +636,7 @@ def test_fuzz_observations_stay_finite(
 # --------------------------------------------------------------------------------------
 
 
+@needs("train", "stable_baselines3", "torch")
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_ppo_learns_a_few_hundred_steps(env_id: str) -> None:
     from stable_baselines3 import PPO

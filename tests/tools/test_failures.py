@@ -23,8 +23,9 @@ from bearing_env.train.compare import cli as compare
 from bearing_env.train.compare import log as compare_log
 from bearing_env.train.compare import report as compare_report
 from bearing_env.train.compare.log import LOG_NAME, CorruptLogError, EpisodeLog
+from tests.extras import import_or_skip
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 COMPARE_ARGS = [
     "--policies", "random", "--env-kwargs", "scenario=khepera", "max_moves=3",
@@ -253,7 +254,7 @@ TRAIN_ARGS = [
 
 
 def test_train_into_a_folder_below_a_file_fails_in_one_line(a_file: Path) -> None:
-    pytest.importorskip("stable_baselines3")
+    import_or_skip("stable_baselines3")
     run = a_file / "run"
     result = run_cli("train", *TRAIN_ARGS, "--output", str(run))
     assert result.returncode == EXIT_ERROR, result.stderr
@@ -264,7 +265,7 @@ def test_train_into_a_folder_below_a_file_fails_in_one_line(a_file: Path) -> Non
 def test_train_on_a_full_disk_names_the_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    pytest.importorskip("stable_baselines3")
+    import_or_skip("stable_baselines3")
     from bearing_env.train.sb3 import train_cli
 
     def disk_full(fd: int) -> None:  # the atomic writers fsync their temporary files
@@ -486,7 +487,11 @@ def test_a_bad_value_ends_in_one_line_naming_it_with_status_2(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     if "train" in argv:
-        pytest.importorskip("stable_baselines3")
+        import_or_skip("stable_baselines3")
+    if "ray" in argv:  # the executor's checks run after `import ray`
+        import_or_skip("ray")
+    if argv[0] == "figures" and "--only" in argv:  # it gets as far as plotting
+        import_or_skip("matplotlib")
     port = closed_port()
     fill = {"tmp": str(tmp_path), "a_file": str(a_file), "port": str(port)}
     argv = [arg.format(**fill) for arg in argv]
@@ -499,7 +504,7 @@ def test_a_bad_value_ends_in_one_line_naming_it_with_status_2(
 def test_train_on_a_missing_cuda_device_fails_in_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    torch = pytest.importorskip("torch")
+    torch = import_or_skip("torch")
     monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
     code, err = cli_exit([*_TRAIN, "--device", "cuda", "--output", str(tmp_path / "r")],
                          capsys, monkeypatch)
@@ -510,7 +515,7 @@ def test_train_on_a_missing_cuda_device_fails_in_one_line(
 
 
 def test_ppo_says_up_front_that_it_trains_whole_rollouts() -> None:
-    pytest.importorskip("stable_baselines3")
+    import_or_skip("stable_baselines3")
     from bearing_env.train.sb3.train import rollout_notice
 
     notice = rollout_notice({"n_steps": 256}, 16, 0, 100)
@@ -609,6 +614,8 @@ def test_figures_and_bench_on_a_bad_disk_name_the_file(
     disk; either way the message names the file."""
     from bearing_env.train.common import files
 
+    if command[0] == "figures":
+        import_or_skip("matplotlib")
     out = tmp_path / "out"
     where = ["--out", str(out)] if command[0] == "figures" else ["--json", str(out / "b.json")]
     name, replacement = patch

@@ -18,6 +18,7 @@ from hypothesis import strategies as st
 
 from bearing_env.slam import PolygonSLAM, UpdateResult
 from bearing_env.slam.geometry import relaxed_intersection
+from tests.extras import needs
 from tests.slam_sim import random_episode
 
 EPS = np.deg2rad(2.0)
@@ -249,6 +250,7 @@ def test_the_relaxed_state_survives_copies_and_pickles() -> None:
 # --------------------------------------------------------------------------------------
 
 
+@needs("render")
 def test_env_relaxed_passes_the_checkers_and_reports_outliers() -> None:
     import warnings
 

@@ -11,6 +11,7 @@ import pytest
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.agents import SB3Policy, pretrained_names, pretrained_record
+from tests.extras import needs
 
 SHIPPED = ("ppo_khepera", "ppo_random", "ppo_generalist")
 
@@ -19,6 +20,7 @@ def test_the_shipped_models_are_listed() -> None:
     assert set(SHIPPED) <= set(pretrained_names())
 
 
+@needs("train", "stable_baselines3", "torch")
 @pytest.mark.parametrize("name", SHIPPED)
 def test_a_shipped_model_acts_on_the_env_of_its_record(name: str) -> None:
     # A change to the observation or action layout would break the shipped models: the
@@ -38,6 +40,7 @@ def test_a_shipped_model_acts_on_the_env_of_its_record(name: str) -> None:
     env.close()
 
 
+@needs("train", "stable_baselines3", "torch")
 @pytest.mark.parametrize("name", SHIPPED)
 def test_a_shipped_model_acts_alike_on_the_vector_env(name: str) -> None:
     # Sub-env i of the batched vector env acts as the single env seeded seed + i does.
@@ -68,6 +71,7 @@ def test_a_shipped_model_acts_alike_on_the_vector_env(name: str) -> None:
     vector_env.close()
 
 
+@needs("train", "stable_baselines3", "torch")
 @pytest.mark.parametrize("count", [3, 16])
 def test_the_generalist_runs_on_counts_outside_its_training_range(count: int) -> None:
     # Trained on 3 to 12 landmarks; its deep set reads any count up to max_landmarks.
@@ -89,6 +93,7 @@ def test_the_generalist_runs_on_counts_outside_its_training_range(count: int) ->
     env.close()
 
 
+@needs("train", "stable_baselines3", "torch")
 def test_generalisation_table_covers_every_policy_and_count(tmp_path: Path) -> None:
     out = tmp_path / "generalisation"
     command = [sys.executable, "-m", "bearing_env.train.studies.generalisation",

@@ -22,6 +22,7 @@ from bearing_env.train.compare.log import LOG_NAME, EpisodeLog
 from bearing_env.train.compare.report import csv_text
 from bearing_env.train.compare.runner import EpisodeTask, episode_tasks, run_locally
 from bearing_env.train.compare.stats import bootstrap_mean_ci
+from tests.extras import needs
 
 SMALL_ENV = {"scenario": "khepera", "max_moves": 4}
 OUTPUT_FILES = (
@@ -69,6 +70,7 @@ def test_seeds_are_the_documented_evaluation_range() -> None:
     assert EVAL_SEED_START == 1_000_000
 
 
+@needs("train", "matplotlib")
 def test_a_run_writes_every_output(tmp_path: Path) -> None:
     result = run(small_config(), tmp_path, plots=True, command="bearing-env compare ...")
     assert result.complete
@@ -260,6 +262,7 @@ def test_the_report_quotes_the_command_that_reproduces_the_results() -> None:
     assert reproducing_command(argv) == "bearing-env compare --episodes 9 --out o"
 
 
+@needs("train", "matplotlib")
 def test_bearing_env_dispatches_compare(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -324,7 +327,7 @@ def test_ctrl_c_then_resume_reproduces_the_uninterrupted_run(tmp_path: Path) -> 
         "--episodes", "16", "--workers", "2", "--no-progress", "--no-plots",
         "--bootstrap", "100",
     ]  # fmt: skip
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
 
     def command(out: Path, *extra: str) -> list[str]:
         module = "bearing_env.train.compare.cli"

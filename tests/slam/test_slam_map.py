@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import shapely
 
+import bearing_env.slam
 from bearing_env.slam import (
     FRAME_L1_L2_OVERLAP,
     FRAME_L1_L2_TOO_CLOSE,
@@ -602,7 +603,9 @@ def test_fig11_area_after_ten_moves_grows_as_a_power_of_epsilon(transfer: str) -
 # Dependencies
 # --------------------------------------------------------------------------------------
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
+#: The package as imported: the checkout's, or an installed one (tests/tools/test_install.py).
+PACKAGE = Path(bearing_env.__file__).resolve().parent
 
 
 def _modules_after(code: str) -> set[str]:
@@ -645,7 +648,7 @@ def test_the_slam_subpackage_itself_imports_neither_gymnasium_nor_pygame():
         f"""
         import sys, types
         pkg = types.ModuleType("bearing_env")
-        pkg.__path__ = [{str(ROOT / "bearing_env")!r}]
+        pkg.__path__ = [{str(PACKAGE)!r}]
         sys.modules["bearing_env"] = pkg
         import bearing_env.slam
         s = bearing_env.slam.PolygonSLAM(3, 0.01)

@@ -19,6 +19,7 @@ from bearing_env.train.studies.figures import (
     random_polygonal_trace,
     shows_shrinking,
 )
+from tests.extras import needs
 
 KHEPERA_25 = {"scenario": "khepera", "move_length": 0.25, "transfer": "paper"}
 
@@ -59,6 +60,7 @@ def test_same_bearing_set_for_every_epsilon() -> None:
     assert not np.array_equal(scaled[0].bearings[1:], scaled[1].bearings[1:])
 
 
+@needs("train", "matplotlib")
 def test_figure7_shows_a_shrinking_run(tmp_path: Path) -> None:
     path, data = figure7(tmp_path)
     assert_png(path)
@@ -67,6 +69,7 @@ def test_figure7_shows_a_shrinking_run(tmp_path: Path) -> None:
     assert data["runs_skipped"] == data["seed"]
 
 
+@needs("train", "matplotlib")
 def test_figures_10_and_11(tmp_path: Path) -> None:
     seeds = list(range(1_000_000, 1_000_004))
     path10, data10 = figure10(tmp_path, seeds)
@@ -82,6 +85,7 @@ def test_figures_10_and_11(tmp_path: Path) -> None:
         figure11(tmp_path, seeds, noise_mode="loud")
 
 
+@needs("train", "matplotlib")
 def test_bearing_env_dispatches_figures(tmp_path: Path) -> None:
     cli.main(["figures", "--only", "11", "--seeds", "2", "--out", str(tmp_path)])
     assert_png(tmp_path / "fig11_epsilon.png")
@@ -89,6 +93,7 @@ def test_bearing_env_dispatches_figures(tmp_path: Path) -> None:
     assert set(summary) == {"fig11"} and "r_squared" in summary["fig11"]["linear_fit"]
 
 
+@needs("train", "matplotlib")
 def test_robustness_figure_compares_the_fusions_on_the_same_seeds(tmp_path: Path) -> None:
     from bearing_env.train.studies.figures import (
         ROBUST_FUSIONS,

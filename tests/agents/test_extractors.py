@@ -1,3 +1,4 @@
+# ruff: noqa: E402  (the imports below need the extra; the module skips without it)
 """The permutation-invariant landmark-set extractor and its training config."""
 
 from __future__ import annotations
@@ -7,6 +8,11 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
+
+from tests.extras import skip_module_without
+
+skip_module_without("train")
+
 import torch
 
 import bearing_env  # noqa: F401  (registers the ids)
@@ -15,9 +21,9 @@ from bearing_env.agents.extractors import LandmarkSetExtractor, LandmarkSetPolic
 from bearing_env.envs.observations import ENTITY_FEATURES
 from bearing_env.train.sb3.train import train
 from bearing_env.train.sb3.zoo import parse_hyperparameters, read_hyperparameters
-from tests.test_train import TINY_TIMESTEPS, tiny_settings
+from tests.tools.test_train import TINY_TIMESTEPS, tiny_settings
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
+REPO_ROOT = Path(__file__).resolve().parents[2]
 CONF_FILE = REPO_ROOT / "train" / "sb3" / "hyperparams" / "ppo_entities.yml"
 WIDTH = len(ENTITY_FEATURES)
 

@@ -1,3 +1,4 @@
+# ruff: noqa: E402  (the imports below need the extra; the module skips without it)
 """No lost work: a killed or stopped ``bearing-env train`` resumes with every counted step
 trained on, ``run.json`` keeps the killed segment, and a killed ``compare`` takes its
 workers with it.
@@ -20,6 +21,10 @@ from typing import Any
 
 import pytest
 
+from tests.extras import skip_module_without
+
+skip_module_without("train")
+
 import bearing_env.train.sb3.train as train_module
 from bearing_env.agents.sb3 import load_model
 from bearing_env.train.sb3 import train_cli
@@ -27,7 +32,7 @@ from bearing_env.train.sb3.callbacks import CheckpointStore, StopOnRequestCallba
 from bearing_env.train.sb3.run_record import segments_after_a_kill
 from bearing_env.train.sb3.train import TrainSettings, train
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
+REPO_ROOT = Path(__file__).resolve().parents[2]
 PYTHON = sys.executable
 ROLLOUT = 16  # n_steps * n_envs
 BUDGET = 1000  # not a multiple of ROLLOUT: learn() ends at the next boundary, 1008

@@ -31,6 +31,7 @@ from bearing_env.agents.env_access import MapReader
 from bearing_env.agents.lookahead import Lookahead, LookaheadOracle, sample_in_polygon
 from bearing_env.agents.vector import VectorPolicy
 from bearing_env.slam import world_to_fl
+from tests.extras import needs
 
 ENV_IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
 HEURISTICS = (RandomPolygonal, Parallax, GreedyOneStep, GreedyOracle, Lookahead, LookaheadOracle)
@@ -494,6 +495,7 @@ def tiny_dqn(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return folder / "dqn_model.zip"
 
 
+@needs("train")
 def test_sb3_policy_runs_episodes_with_its_vecnormalize(tiny_ppo: Path) -> None:
     env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=6, max_episode_steps=6)
     policy = SB3Policy(env, tiny_ppo)
@@ -515,6 +517,7 @@ def test_sb3_policy_runs_episodes_with_its_vecnormalize(tiny_ppo: Path) -> None:
     assert isinstance(make_policy(f"sb3:path={tiny_ppo}", env), SB3Policy)
 
 
+@needs("train")
 def test_sb3_policy_runs_a_dqn_on_the_discrete_id(tiny_dqn: Path) -> None:
     env = gym.make("BearingSLAMDiscrete-v0", scenario="khepera", max_moves=5, max_episode_steps=5)
     policy = SB3Policy(env, tiny_dqn.with_suffix(""))  # SB3-style path without .zip
@@ -523,6 +526,7 @@ def test_sb3_policy_runs_a_dqn_on_the_discrete_id(tiny_dqn: Path) -> None:
     assert moves == 5 and all(isinstance(a, int) for a in actions)
 
 
+@needs("train")
 def test_sb3_policy_load_errors(tiny_ppo: Path, tmp_path: Path) -> None:
     env = gym.make("BearingSLAM-v0", scenario="khepera")
     with pytest.raises(FileNotFoundError, match="not found"):

@@ -1,3 +1,4 @@
+# ruff: noqa: E402  (the imports below need the extra; the module skips without it)
 """Rendering: headless rgb_array frames, the human window, RecordVideo."""
 
 from __future__ import annotations
@@ -9,6 +10,10 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 import gymnasium as gym
 import numpy as np
 import pytest
+
+from tests.extras import skip_module_without
+
+skip_module_without("render")
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.envs import BearingSLAMEnv

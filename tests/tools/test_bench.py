@@ -15,6 +15,7 @@ from gymnasium.vector import AutoresetMode
 
 from bearing_env.benchmarks import bench_env, bench_report, bench_timing
 from bearing_env.train import cli
+from tests.extras import needs
 
 MACHINE_KEYS = {"platform", "cpu_count", "numpy", "python", "gymnasium"}
 FIGURE_KEYS = {
@@ -99,6 +100,7 @@ def test_quick_single_and_vector(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert [p.name for p in path.parent.iterdir()] == [path.name]  # no temp file left
 
 
+@needs("train", "stable_baselines3", "torch")
 def test_quick_ppo_in_process_kinds(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     results, _ = run_quick(tmp_path, "--sections", "ppo", "--ppo-kinds", "batched,dummy")
     check_common(results, {"ppo"})
@@ -116,6 +118,7 @@ def test_quick_ppo_in_process_kinds(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert "PPO" in capsys.readouterr().out
 
 
+@needs("train", "stable_baselines3", "torch")
 def test_quick_ppo_subproc(tmp_path: Path) -> None:
     results, _ = run_quick(
         tmp_path, "--sections", "ppo", "--ppo-kinds", "subproc", "--ppo-envs", "1"
@@ -214,6 +217,7 @@ def test_cli_reaches_the_world_model_bench(
     assert "update()" in out and "CartPole-v1" in out
 
 
+@needs("train", "stable_baselines3", "torch")
 def test_ppo_rounds_are_interleaved_and_the_median_counts(tmp_path: Path) -> None:
     results, _ = run_quick(
         tmp_path, "--sections", "ppo", "--ppo-kinds", "batched,dummy", "--ppo-rounds", "3"

@@ -1,3 +1,4 @@
+# ruff: noqa: E402  (the imports below need the extra; the module skips without it)
 """``bearing-env train``: tiny runs of each algorithm, save/load, resume, Ctrl-C, rl-zoo3.
 
 Runs are a few hundred steps with small networks and in-process envs (``DummyVecEnv``);
@@ -23,6 +24,11 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import pytest
+
+from tests.extras import skip_module_without
+
+skip_module_without("train")
+
 import torch
 from stable_baselines3 import PPO
 from stable_baselines3.common.utils import ConstantSchedule
@@ -55,7 +61,7 @@ from bearing_env.train.sb3.zoo import (
     rl_zoo3_module,
 )
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
+REPO_ROOT = Path(__file__).resolve().parents[2]
 ALGOS = ("ppo", "sac", "dqn")
 TINY_NET = "dict(net_arch=[32, 32])"
 #: Small versions of the shipped configs: same files, a few hundred steps.

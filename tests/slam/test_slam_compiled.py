@@ -12,7 +12,10 @@ import sys
 import textwrap
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+import bearing_env
+
+#: The package as imported: the checkout's, or an installed one (tests/tools/test_install.py).
+PACKAGE = Path(bearing_env.__file__).resolve().parent
 
 #: Runs one map update in a fresh process, with the package folder made unwritable for
 #: numba (root ignores file modes, so the test refuses writes where numba checks them).
@@ -65,7 +68,7 @@ def run_isolated(script: str, cache_home: Path, package_root: Path) -> dict:
 def copy_package(target: Path) -> Path:
     """A copy of the bearing_env package in its own folder, without any cached code."""
     shutil.copytree(
-        ROOT / "bearing_env",
+        PACKAGE,
         target / "bearing_env",
         ignore=shutil.ignore_patterns("__pycache__", "*.nbi", "*.nbc"),
     )
