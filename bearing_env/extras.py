@@ -29,6 +29,9 @@ MODULE_EXTRAS: dict[str, str] = {
     "yaml": "train",
     "rl_zoo3": "train",
     "ray": "ray",
+    "sphinx": "docs",
+    "myst_parser": "docs",
+    "furo": "docs",
 }
 #: The pip distribution of a module, where its name differs.
 DISTRIBUTIONS: dict[str, str] = {
@@ -36,6 +39,7 @@ DISTRIBUTIONS: dict[str, str] = {
     "yaml": "pyyaml",
     "PIL": "pillow",
     "sb3_contrib": "sb3-contrib",
+    "myst_parser": "myst-parser",
 }
 
 __all__ = [

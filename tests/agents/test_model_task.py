@@ -21,6 +21,9 @@ from bearing_env.agents.model_task import (
 )
 from bearing_env.agents.sb3 import PRETRAINED_DIR, pretrained_task
 from bearing_env.envs.config import SETTINGS, EnvConfig
+from tests.extras import skip_module_without
+
+skip_module_without("train")
 
 #: The longest message a refusal may print (it names settings, never dumps spaces).
 MAX_MESSAGE_LINES = 5

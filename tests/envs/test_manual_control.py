@@ -34,6 +34,9 @@ from bearing_env.envs.manual_control import (
     next_turn,
 )
 from bearing_env.numerics import wrap
+from tests.extras import skip_module_without
+
+skip_module_without("render")
 
 DOCS = os.path.join(os.path.dirname(__file__), "..", "..", "docs", "play.md")
 

@@ -19,6 +19,7 @@ from bearing_env.envs.bearing_slam_vector import BearingSLAMVectorEnv
 from bearing_env.envs.config import DEFAULT_MAX_MOVES, EnvConfig
 from bearing_env.registration import ENV_IDS, VECTOR_ENTRY_POINTS, register_envs
 from bearing_env.tasks import BASE_IDS, TASKS, TASKS_BY_ID, Task, task_named
+from tests.extras import needs
 
 TASK_IDS = [task.id for task in TASKS]
 NAME = re.compile(
@@ -93,6 +94,7 @@ def test_each_id_makes_resets_and_steps_with_its_settings(task_id: str) -> None:
     shorter.close()
 
 
+@needs("render")  # the checker renders
 @pytest.mark.parametrize("task_id", TASK_IDS)
 def test_gymnasium_check_env_without_warnings(task_id: str) -> None:
     env = gym.make(task_id)
@@ -102,6 +104,8 @@ def test_gymnasium_check_env_without_warnings(task_id: str) -> None:
     env.close()
 
 
+@needs("train", "stable_baselines3", "torch")
+@needs("render")
 @pytest.mark.parametrize("task_id", TASK_IDS)
 def test_sb3_check_env_without_warnings(task_id: str) -> None:
     from stable_baselines3.common.env_checker import check_env as sb3_check_env

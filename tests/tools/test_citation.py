@@ -9,8 +9,11 @@ from typing import Any
 import pytest
 
 import bearing_env
+from tests.extras import skip_module_without
 
-yaml = pytest.importorskip("yaml")
+skip_module_without("train", "yaml")
+import yaml  # noqa: E402  (pyyaml is the train extra's)
+
 tomllib = pytest.importorskip("tomllib")
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -12,6 +12,9 @@ import pytest
 from bearing_env.agents import pretrained_record
 from bearing_env.train.compare import cli as compare
 from bearing_env.train.compare.cli import QUICK_MAX_MOVES
+from tests.extras import skip_module_without
+
+skip_module_without("train")
 
 
 def run_compare(*arguments: str) -> subprocess.CompletedProcess[str]:

@@ -18,6 +18,10 @@ from urllib.parse import unquote, urlsplit
 
 import pytest
 
+from tests.extras import skip_module_without
+
+skip_module_without("docs")
+
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 README = ROOT / "README.md"

@@ -162,7 +162,7 @@ def test_the_generalisation_script_without_the_train_extra_says_to_install_it(
         [sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
         cwd=tmp_path, env=env,
     )
-    line = error_line(result, "generalisation.py")
+    line = error_line(result, "bearing-env generalisation")
     assert "'stable-baselines3'" in line and TRAIN in line
     assert not (tmp_path / "g").exists()
 

@@ -9,6 +9,9 @@ from typing import Any
 import pytest
 
 from bearing_env.train.studies import figures, generalisation
+from tests.extras import skip_module_without
+
+skip_module_without("train")
 
 SEEDS = [1_000_000, 1_000_001]
 

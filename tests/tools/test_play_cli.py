@@ -11,6 +11,7 @@ import sys
 import pytest
 
 from bearing_env.train.cli import main
+from tests.extras import needs
 
 
 def play(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
@@ -62,6 +63,7 @@ def test_without_pygame_it_names_the_render_extra_in_one_line(
     ]
 
 
+@needs("render")  # without pygame the command stops at the missing extra, before the settings
 def test_bad_settings_are_one_line_errors_naming_the_value(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

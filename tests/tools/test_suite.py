@@ -26,6 +26,7 @@ from bearing_env.train.compare.suite import (
     suite_configs,
     task_models,
 )
+from tests.extras import needs
 
 TWO_TASKS = ("BearingSLAM-Khepera-v0", "BearingSLAMDiscrete-Khepera-v0")
 
@@ -49,6 +50,8 @@ def results(out: Path, task_id: str) -> list[dict[str, Any]]:
     return sorted(records, key=lambda r: (r["policy"], r["seed"]))
 
 
+@needs("train", "matplotlib")  # the cards' area plots
+@needs("render")  # the cards' frames
 def test_quick_suite_on_two_tasks_writes_the_cards_and_the_index(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -141,6 +144,7 @@ def test_stop_after_leaves_the_rest_for_the_next_run(
     assert "--stop-after" not in card  # the cards quote the command that reproduces them
 
 
+@needs("train", "stable_baselines3", "torch")
 def test_shipped_models_run_on_the_task_they_were_trained_on() -> None:
     assert task_models(TASKS_BY_ID["BearingSLAM-Khepera-v0"]) == ["pretrained:ppo_khepera"]
     for task in TASKS:

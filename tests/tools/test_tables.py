@@ -1,6 +1,7 @@
 """Tables on an 80-column terminal: no number is split across lines (rich used to narrow
 the widest columns, so "0.192" printed as "0.19" over "2")."""
 
+# ruff: noqa: E402  (imports of the extra follow its skip)
 from __future__ import annotations
 
 import io
@@ -10,6 +11,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+
+from tests.extras import skip_module_without
+
+skip_module_without("train", "rich")
+
 from rich.console import Console
 
 from bearing_env.train.common.tables import boxed_chrome, fit_widths, print_table

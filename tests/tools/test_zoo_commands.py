@@ -19,6 +19,7 @@ The ``ppo`` and ``ppo_entities`` runs and ``enjoy`` are in the default run; the 
 algorithms' commands are ``slow``.
 """
 
+# ruff: noqa: E402  (imports of the extra follow its skip)
 from __future__ import annotations
 
 import json
@@ -32,6 +33,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+
+from tests.extras import skip_module_without
+
+skip_module_without("train")
+
 import yaml
 
 from bearing_env.envs.config import EnvConfig
