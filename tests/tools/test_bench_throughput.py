@@ -135,8 +135,9 @@ def test_presampled_steps_refuse_a_vector_env_without_autoreset() -> None:
         vectorization_mode="sync",
         vector_kwargs={"autoreset_mode": AutoresetMode.DISABLED},
     )
+    actions = bench_throughput.presampled_actions(venv, seed=0)
     with pytest.raises(ValueError, match="autoresetting"):
-        bench_throughput.step_presampled(venv, [venv.action_space.sample()], 0.0)
+        bench_throughput.step_presampled(venv, actions, 0.0)
     venv.close()
 
 
