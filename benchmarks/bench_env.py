@@ -4,6 +4,7 @@ BearingSLAM-v0 against CartPole-v1, in one run. The figures are measured by
 :mod:`~bearing_env.benchmarks.bench_report`.
 
     python benchmarks/bench_env.py [--seconds 2] [--sections single,vector,ppo] [--quick]
+    bearing-env bench --sections throughput      # EnvPool/gymnax-style table vs CartPole-v1
     bearing-env bench [...]                      # the same
     bearing-env bench --profile single           # cProfile of the single-env loop
     bearing-env bench --slam [--seconds 2]       # the world-model benchmark (bench_slam.py)
@@ -47,6 +48,12 @@ Sections:
   every kind once, in turn): a kind's rate is its median round and its ratio to
   SubprocVecEnv the median of the per-round ratios, so that a machine whose speed drifts
   during the run favours no kind.
+- ``throughput``: the table in EnvPool's and gymnax's format, rows = ``--counts`` sub-envs
+  (default 1, 64, 256, 1024), columns = CartPole-v1 steps/s, BearingSLAM-v0 steps/s (the
+  batched env) and their ratio, random actions sampled up front, each pair measured back
+  to back; then PPO on ``--ppo-envs`` batched envs against the same SB3 PPO (the same
+  hyperparameters) on CartPole-v1 in a DummyVecEnv, in ``--ppo-rounds`` interleaved rounds.
+  Details: :mod:`bearing_env.benchmarks.bench_throughput`.
 
 Targets (printed as met / not met and stored in the JSON):
 
@@ -57,7 +64,9 @@ c. 64 landmarks at >= 1/16 of the 4-landmark single-env rate;
 d. PPO on the batched env >= 2x the env steps/s of PPO on SubprocVecEnv, same n_envs;
 e. ``PolygonSLAM.update``, 4 landmarks, conservative: >= 20% of CartPole-v1's step rate;
 f. first env step in a fresh process with a warm numba cache: <= 1.5 s;
-g. ``GreedyOneStep`` plans a move in <= 0.2 ms (median).
+g. ``GreedyOneStep`` plans a move in <= 0.2 ms (median);
+h. PPO on the batched env >= 0.5x the env steps/s of the same PPO on CartPole-v1, same
+   n_envs (the throughput section).
 """
 
 from __future__ import annotations
@@ -77,6 +86,11 @@ from bearing_env.benchmarks.bench_report import (
     machine_info,
     print_table,
     write_json,
+)
+from bearing_env.benchmarks.bench_throughput import (
+    DEFAULT_THROUGHPUT_COUNTS,
+    QUICK_THROUGHPUT_COUNTS,
+    bench_throughput,
 )
 from bearing_env.benchmarks.bench_timing import (
     DEFAULT_NUM_ENVS,
@@ -154,7 +168,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_run_options(parser.add_argument_group("the run"))
     _add_env_options(parser.add_argument_group("single and vector env sections"))
-    _add_ppo_options(parser.add_argument_group("PPO section"))
+    _add_ppo_options(parser.add_argument_group("PPO section (and the throughput section's PPO)"))
+    _add_throughput_options(parser.add_argument_group("throughput section"))
     _add_profile_options(parser.add_argument_group("profiling"))
     return parser
 
@@ -180,7 +195,8 @@ def _add_run_options(group: argparse._ArgumentGroup) -> None:
     add(
         "--quick",
         action="store_true",
-        help="tiny settings for tests: 0.05 s, 1 and 4 envs, PPO on 2 envs, 8-step rollouts",
+        help="tiny settings for tests: 0.05 s, 1 and 4 envs (and sub-envs), PPO on 2 envs, "
+        "8-step rollouts",
     )
     add(
         "--slam",
@@ -249,6 +265,21 @@ def _add_ppo_options(group: argparse._ArgumentGroup) -> None:
     )
 
 
+def _add_throughput_options(group: argparse._ArgumentGroup) -> None:
+    """The sub-env counts of the throughput table (its PPO pair takes the PPO options)."""
+    group.add_argument(
+        "--counts",
+        nargs="+",
+        default=None,
+        metavar="N",
+        help="sub-env counts of the throughput table (default "
+        + ",".join(map(str, DEFAULT_THROUGHPUT_COUNTS))
+        + "; --quick "
+        + ",".join(map(str, QUICK_THROUGHPUT_COUNTS))
+        + ")",
+    )
+
+
 def _add_profile_options(group: argparse._ArgumentGroup) -> None:
     """``--profile``: a cProfile of one loop instead of the benchmark."""
     group.add_argument(
@@ -276,6 +307,7 @@ class Settings:
     ppo_overrides: dict[str, Any]
     quick: bool
     json_path: Path | None
+    counts: tuple[int, ...] = DEFAULT_THROUGHPUT_COUNTS
 
 
 def settings_from_args(args: argparse.Namespace, parser: argparse.ArgumentParser) -> Settings:
@@ -288,6 +320,7 @@ def settings_from_args(args: argparse.Namespace, parser: argparse.ArgumentParser
         parser.error(f"--ppo-kinds: choose from {','.join(PPO_KINDS)}")
     try:
         num_envs = _int_list(args.num_envs, "--num-envs") if args.num_envs else None
+        counts = _int_list(args.counts, "--counts") if args.counts else None
         landmarks = (
             _int_list(args.landmarks, "--landmarks", 3, MAX_N_LANDMARKS)
             if args.landmarks
@@ -326,6 +359,7 @@ def settings_from_args(args: argparse.Namespace, parser: argparse.ArgumentParser
         ppo_overrides=overrides,
         quick=quick,
         json_path=None if args.no_json else args.json,
+        counts=tuple(counts or (QUICK_THROUGHPUT_COUNTS if quick else DEFAULT_THROUGHPUT_COUNTS)),
     )
 
 
@@ -366,6 +400,20 @@ def run(settings: Settings) -> dict[str, Any]:
             settings.ppo_overrides,
             settings.ppo_rounds,
         )
+    if "throughput" in settings.sections:
+        log(
+            f"[throughput] random actions, {settings.counts} sub-envs vs CartPole-v1; PPO on "
+            f"{settings.ppo_envs} batched envs vs CartPole-v1"
+        )
+        results["throughput"] = bench_throughput(
+            bench,
+            settings.counts,
+            settings.env_kwargs,
+            settings.ppo_envs,
+            settings.ppo_steps,
+            settings.ppo_overrides,
+            settings.ppo_rounds,
+        )
     bench.measure_reference("end")
     return {
         "format": JSON_FORMAT,
@@ -385,6 +433,7 @@ def run(settings: Settings) -> dict[str, Any]:
             "ppo_kinds": list(settings.ppo_kinds),
             "ppo_overrides": json_safe(settings.ppo_overrides),
             "quick": settings.quick,
+            "counts": list(settings.counts),
         },
         "cartpole_references": [
             {"label": ref.label, "steps_per_s": ref.steps_per_s, "time_s": ref.time_s}

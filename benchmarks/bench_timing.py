@@ -26,7 +26,15 @@ from bearing_env.benchmarks.bench_slam import cartpole_steps_per_second
 from bearing_env.train.common.cli_values import json_safe
 
 ENV_ID = "BearingSLAM-v0"
-SECTIONS: tuple[str, ...] = ("single", "vector", "slam", "startup", "planning", "ppo")
+SECTIONS: tuple[str, ...] = (
+    "single",
+    "vector",
+    "slam",
+    "startup",
+    "planning",
+    "ppo",
+    "throughput",
+)
 PPO_KINDS: tuple[str, ...] = ("batched", "subproc", "dummy")
 DEFAULT_NUM_ENVS: tuple[int, ...] = (1, 4, 16, 64, 256)
 DEFAULT_SINGLE_LANDMARKS: tuple[int, ...] = (4, 16, 64)
@@ -423,6 +431,7 @@ class PPORun:
     make_kwargs: dict[str, Any]
     build_seconds: float
     rounds: list[dict[str, Any]] = field(default_factory=list)
+    env_id: str = ENV_ID
 
     def timed_round(self, bench: Bench) -> dict[str, Any]:
         before = int(self.model.num_timesteps)
@@ -447,6 +456,7 @@ class PPORun:
         rate = float(np.median(rates))
         return {
             "kind": self.kind,
+            "env_id": self.env_id,
             "n_envs": self.n_envs,
             "rollout_steps": int(self.algorithm_kwargs.get("n_steps", 2048)) * self.n_envs,
             "requested_steps": self.total_steps,
@@ -474,16 +484,22 @@ def build_ppo_run(
     total_steps: int,
     env_kwargs: dict[str, Any],
     overrides: dict[str, Any],
+    env_id: str = ENV_ID,
 ) -> PPORun:
-    """Build PPO on one vec env kind and warm it up (one rollout and one update)."""
+    """Build PPO on one vec env kind and warm it up (one rollout and one update).
+
+    ``env_id`` other than BearingSLAM-v0 (CartPole-v1 in the throughput section) trains
+    that env, with its default kwargs, on BearingSLAM-v0's hyperparameters."""
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
 
     from bearing_env.train.sb3.training_envs import make_training_env
 
     algorithm_kwargs, normalize, make_kwargs = ppo_settings(env_kwargs, overrides)
+    if env_id != ENV_ID:
+        make_kwargs = {}
     build_start = time.perf_counter()
-    venv = make_training_env(ENV_ID, make_kwargs, n_envs, kind, None)
+    venv = make_training_env(env_id, make_kwargs, n_envs, kind, None)
     try:
         if normalize is not None:
             venv = VecNormalize(venv, **normalize)
@@ -503,8 +519,9 @@ def build_ppo_run(
         normalize,
         make_kwargs,
         time.perf_counter() - build_start,
+        env_id=env_id,
     )
-    bench.measure_reference(f"ppo/{kind}")
+    bench.measure_reference(f"ppo/{kind}" if env_id == ENV_ID else f"ppo/{env_id} {kind}")
     return run
 
 
@@ -517,47 +534,53 @@ def bench_ppo(
     overrides: dict[str, Any],
     rounds: int = DEFAULT_PPO_ROUNDS,
 ) -> list[dict[str, Any]]:
-    """PPO throughput per vec env kind, in interleaved rounds.
-
-    Every kind is built and warmed up first; then each round times every kind once, in
-    turn, so that a drifting machine speed affects all kinds alike. A kind's rate is its
-    median round, and its ratio to SubprocVecEnv is the median of the per-round ratios.
-    """
+    """PPO throughput per vec env kind, in interleaved rounds (:func:`timed_ppo_rounds`);
+    each kind's ratio to SubprocVecEnv is the median of the per-round ratios."""
     runs: list[PPORun] = []
     try:
         with torch_threads(1):  # as bearing-env train (--torch-threads 1)
             for kind in kinds:
                 log(f"  ppo {kind}: building {n_envs} envs and warming up ...")
                 runs.append(build_ppo_run(bench, kind, n_envs, total_steps, env_kwargs, overrides))
-            for number in range(1, rounds + 1):
-                if number > 1:
-                    bench.measure_reference(f"ppo/round {number}")
-                for run in runs:
-                    figure = run.timed_round(bench)
-                    log(
-                        f"  ppo {run.kind:<8} round {number}/{rounds}: "
-                        f"{figure['steps_per_s']:10,.0f} env steps/s"
-                    )
-        rows = [run.row(bench) for run in runs]
+            rows = timed_ppo_rounds(bench, runs, rounds)
     finally:
         for run in runs:
             run.close()
     subproc = next((run for run in runs if run.kind == "subproc"), None)
     for run, row in zip(runs, rows, strict=True):
-        row["ratio_to_subproc"] = (
-            float(
-                np.median(
-                    [
-                        mine["steps_per_s"] / theirs["steps_per_s"]
-                        for mine, theirs in zip(run.rounds, subproc.rounds, strict=True)
-                    ]
-                )
-            )
-            if subproc is not None
-            else None
-        )
+        row["ratio_to_subproc"] = median_round_ratio(run, subproc) if subproc is not None else None
         log(f"  ppo {ppo_label(row):<24} {row['steps_per_s']:10,.0f} env steps/s (median)")
     return rows
+
+
+def timed_ppo_rounds(
+    bench: Bench, runs: Sequence[PPORun], rounds: int, section: str = "ppo"
+) -> list[dict[str, Any]]:
+    """Time built, warmed-up ``runs`` in ``rounds`` rounds, each timing every run once, in
+    turn, so that a drifting machine speed affects all runs alike; their rows (the median
+    round counts). The CartPole references between rounds are labelled ``section/round N``."""
+    for number in range(1, rounds + 1):
+        if number > 1:
+            bench.measure_reference(f"{section}/round {number}")
+        for run in runs:
+            figure = run.timed_round(bench)
+            log(
+                f"  ppo {run.kind:<8} {run.env_id} round {number}/{rounds}: "
+                f"{figure['steps_per_s']:10,.0f} env steps/s"
+            )
+    return [run.row(bench) for run in runs]
+
+
+def median_round_ratio(run: PPORun, reference: PPORun) -> float:
+    """The median over the interleaved rounds of ``run``'s rate / ``reference``'s."""
+    return float(
+        np.median(
+            [
+                mine["steps_per_s"] / theirs["steps_per_s"]
+                for mine, theirs in zip(run.rounds, reference.rounds, strict=True)
+            ]
+        )
+    )
 
 
 def ppo_label(row: dict[str, Any]) -> str:

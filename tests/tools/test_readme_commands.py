@@ -73,6 +73,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env compare --policies greedy pretrained:ppo_generalist": ("parse", ()),
     "bearing-env bench": ("parse", ()),
     "bearing-env bench --sections startup": ("parse", ()),
+    "bearing-env bench --sections throughput": ("parse", ()),
     "bearing-env bench --sections slam,planning --seconds 1": ("parse", ()),
     "bearing-env bench --profile vector": ("parse", ()),
     "bearing-env bench --sections single,vector,slam,startup,planning": ("parse", ()),
