@@ -24,6 +24,7 @@ from bearing_env.agents import (
 from bearing_env.agents.env_access import MapReader, RobotMapUnavailableError
 from bearing_env.envs import BearingSLAMEnv, BearingSLAMVectorEnv, robot_map
 from bearing_env.envs.config import EnvConfig
+from bearing_env.slam.batch import LANDMARK_AXES, VERTEX_COUNTS, BatchedPolygonSLAM
 from tests.extras import needs
 
 #: Short episodes, so that every autoreset mode resets sub-envs within a few steps.
@@ -155,6 +156,80 @@ def test_the_vector_infos_of_all_sub_envs_at_once_decode_to_their_maps() -> None
             assert (mine is None) == (theirs is None)
             if mine is not None:
                 np.testing.assert_array_equal(mine, theirs)
+
+
+def reference_encode(
+    batch: BatchedPolygonSLAM, rows: np.ndarray[Any, Any], slots: int
+) -> dict[str, Any]:
+    """The encoding as numpy operations, one array at a time (the env's encoding before
+    it was compiled): what the compiled one must reproduce, bit for bit."""
+    out: dict[str, Any] = {}
+    for name in batch.state_names:
+        values = getattr(batch, name)[rows]
+        if name in VERTEX_COUNTS:
+            used = getattr(batch, VERTEX_COUNTS[name])[rows]
+            values[np.arange(values.shape[-1]) >= used[..., None]] = 0
+        elif name in robot_map.UNKNOWN_AS_INF:
+            unknown = np.isnan(values)
+            values[unknown] = complex(np.inf, np.inf) if values.dtype.kind == "c" else np.inf
+        axis = LANDMARK_AXES.get(name)
+        if axis is not None and slots > values.shape[axis]:
+            shape = list(values.shape)
+            shape[axis] = slots
+            padded = np.full(shape, robot_map.PADDING.get(name, 0), dtype=values.dtype)
+            used_slots = [slice(None)] * values.ndim
+            used_slots[axis] = slice(0, values.shape[axis])
+            padded[tuple(used_slots)] = values
+            values = padded
+        if values.dtype.kind == "c":
+            values = values.view(np.float64).reshape(*values.shape, 2)
+        out[name] = values
+    return out
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [
+        {"scenario": "khepera"},
+        {"n_landmarks": 6, "max_landmarks": 6},
+        {"n_landmarks": (4, 7), "fusion": "relaxed", "max_outliers": 1},
+    ],
+)
+def test_the_compiled_encoding_is_the_numpy_one_and_decodes_to_the_map(
+    settings: dict[str, Any],
+) -> None:
+    venv = BearingSLAMVectorEnv(12, **settings, noise={"kind": "uniform", "outlier_rate": 0.2})
+    venv.reset(seed=51)
+    rng = np.random.default_rng(9)
+    for _ in range(12):
+        venv.step(rng.uniform(-1, 1, (12, 2)).astype(np.float32))
+    state, config = venv._state, venv.get_attr("config")[0]
+    slots = config.observations.max_landmarks - 2
+    checked = 0
+    for group_config, rows in venv._groups(np.arange(12)):
+        group = venv._maps.group(state, rows, group_config)
+        for some in (group.rows, group.rows[::-2]):  # every row, and some out of order
+            compiled = robot_map.encode(group.batch, some, slots)
+            reference = reference_encode(group.batch, some, slots)
+            assert list(compiled) == list(reference) == list(group.batch.state_names)
+            for name, values in reference.items():
+                assert compiled[name].dtype == values.dtype, name
+                np.testing.assert_array_equal(compiled[name], values, err_msg=name)
+            for i, row in enumerate(some.tolist()):
+                data = {name: values[i] for name, values in compiled.items()}
+                back = robot_map.decode(data, group.n, config.map_settings).batch
+                for name in group.batch.state_names:
+                    mine = getattr(group.batch, name)[row]
+                    theirs = getattr(back, name)[0]
+                    if name in VERTEX_COUNTS:  # unused vertex slots hold anything
+                        used = getattr(group.batch, VERTEX_COUNTS[name])[row]
+                        keep = np.arange(mine.shape[-1]) < used[..., None]
+                        mine, theirs = mine[keep], theirs[keep]
+                    np.testing.assert_array_equal(mine, theirs, err_msg=name)
+                checked += 1
+    groups = [rows for _, rows in venv._groups(np.arange(12))]
+    assert checked == sum(rows.size + rows[::-2].size for rows in groups)
+    assert ("window_vertices" in compiled) == (settings.get("fusion") == "relaxed")
 
 
 MAP_POLICIES = (Parallax, GreedyOneStep, GreedyOracle, Lookahead, LookaheadOracle)
