@@ -151,11 +151,13 @@ def test_batched_rows_in_same_step_mode_count_every_sub_step(
     """The vector rows count transitions by the env's autoreset mode."""
     monkeypatch.setattr(gym.spec(bench_timing.ENV_ID), "vector_entry_point", stand_in_vector_env)
     results, _ = run_quick(tmp_path, "--sections", "vector", "--num-envs", "2")
-    (batched, sync) = results["vector"]
+    (batched, batched_no_map, sync) = results["vector"]
     assert batched["kind"] == "batched" and batched["vectorization_mode"] == "vector_entry_point"
-    assert batched["autoreset_mode"] == "SameStep"
+    assert batched_no_map["kind"] == "batched_no_robot_map"
+    for row in (batched, batched_no_map):
+        assert row["autoreset_mode"] == "SameStep"
+        assert row["steps"] == 2 * row["step_calls"]  # SAME_STEP: every sub-step counts
     assert sync["autoreset_mode"] == "NextStep"
-    assert batched["steps"] == 2 * batched["step_calls"]  # SAME_STEP: every sub-step counts
 
 
 def fake_figure(rate: float, **extra: Any) -> dict[str, Any]:
