@@ -60,12 +60,32 @@ class MapReader:
         base = bearing_env_of(env)
         #: The world model's settings (epsilon, transfer, fusion, ...).
         self.map_settings: MapSettings = base.config.map_settings
+        #: Whether the env's infos carry the map (its ``robot_map_info`` setting).
+        self.available = base.config.observations.robot_map_info
+
+    def require(self, user: str) -> None:
+        """Raise :class:`RobotMapUnavailableError` naming ``user`` (a policy) when the
+        env's infos carry no map: a policy that reads the map calls this when it is built."""
+        if not self.available:
+            raise RobotMapUnavailableError(user)
 
     def read(self, info: Mapping[str, Any], n_landmarks: int) -> PolygonSLAM:
         """The map of an info (an independent copy: the policy may update it)."""
         if ROBOT_MAP_KEY not in info:
             raise KeyError(
                 f"the info has no {ROBOT_MAP_KEY!r} (keys: {sorted(info)}): pass the info "
-                "the env returned with this observation"
+                "the env returned with this observation, from an env made with "
+                "robot_map_info=True (the default)"
             )
         return robot_map.decode(info[ROBOT_MAP_KEY], n_landmarks, self.map_settings)
+
+
+class RobotMapUnavailableError(ValueError):
+    """A policy that reads ``info["robot_map"]`` was given an env whose infos do not
+    carry it (``robot_map_info=False``)."""
+
+    def __init__(self, user: str) -> None:
+        super().__init__(
+            f'{user} needs info["{ROBOT_MAP_KEY}"]; make the env with robot_map_info=True '
+            "(the default)"
+        )

@@ -53,12 +53,17 @@ class MovementPolicy:
     name = "movement_policy"
     #: True for policies that read ground truth (an upper reference, not a robot policy).
     privileged = False
+    #: True for policies that read the robot's map (``info["robot_map"]``): they refuse
+    #: an env made with ``robot_map_info=False`` when they are built.
+    reads_robot_map = False
 
     def __init__(self, env: gym.Env) -> None:
         self.env = env
         self.codec = ActionCodec(env)
         self.reader = ObservationReader(env)
         self.maps = MapReader(env)
+        if self.reads_robot_map:
+            self.maps.require(type(self).__name__)
         self.rng = policy_rng(None)
         #: Where a privileged policy reads the truth: the env's world (a vector env's
         #: row, under :class:`~bearing_env.agents.vector.VectorPolicy`). Robot policies
@@ -215,6 +220,7 @@ class Parallax(BeliefPolicy):
     """
 
     name = "parallax"
+    reads_robot_map = True  # its belief of the pose and its target come from the map
 
     def __init__(
         self, env: gym.Env, length: float | None = None, sign_rule: str = "inward"
@@ -308,6 +314,7 @@ class GreedyOneStep(BeliefPolicy):
     """
 
     name = "greedy_one_step"
+    reads_robot_map = True
 
     def __init__(
         self, env: gym.Env, n_turns: int = 8, lengths: int | tuple[float, ...] = 2

@@ -78,6 +78,13 @@ def int_at_most(value: int, maximum: int, name: str) -> int:
     return value
 
 
+def flag(value: Any, name: str) -> bool:
+    """A bool (numpy's included), as a Python bool; ints are not flags."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
 def choice(value: Any, choices: Sequence[str], name: str) -> str:
     if not isinstance(value, str):
         raise TypeError(f"{name} must be a str, one of {tuple(choices)}, got {value!r}")

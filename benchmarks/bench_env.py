@@ -22,12 +22,14 @@ Sections:
   seeded generator, ``reset()`` at the end of each episode (resets count in the time, not
   as steps). The Khepera scenario, and the random scenario with 4, 16 and 64 landmarks
   (``max_landmarks = n``). One more row steps the Khepera env through ``gym.make``'s
-  wrappers, as a user (or SB3's DummyVecEnv) does.
+  wrappers, as a user (or SB3's DummyVecEnv) does, and one the Khepera env made with
+  ``robot_map_info=False`` (no ``info["robot_map"]``).
 - ``vector``: ``gym.make_vec`` with ``vectorization_mode="vector_entry_point"`` (the
-  batched ``BearingSLAMVectorEnv``) and with ``"sync"`` (a SyncVectorEnv of single envs,
-  the baseline) for each ``--num-envs``. Rates are env transitions per second summed over
-  the sub-envs; in NEXT_STEP autoreset mode the reset-only sub-steps that follow an
-  episode's end count in the time but not as transitions.
+  batched ``BearingSLAMVectorEnv``; also with ``robot_map_info=False``) and with
+  ``"sync"`` (a SyncVectorEnv of single envs, the baseline) for each ``--num-envs``.
+  Rates are env transitions per second summed over the sub-envs; in NEXT_STEP autoreset
+  mode the reset-only sub-steps that follow an episode's end count in the time but not
+  as transitions.
 - ``slam``: ``PolygonSLAM.update`` alone (:mod:`bearing_env.benchmarks.bench_slam`'s readings), both
   transfers, 4 and 64 landmarks.
 - ``startup``: the compiled core's start-up, in fresh processes: compiling from an empty
@@ -322,9 +324,7 @@ def settings_from_args(args: argparse.Namespace, parser: argparse.ArgumentParser
         num_envs = _int_list(args.num_envs, "--num-envs") if args.num_envs else None
         counts = _int_list(args.counts, "--counts") if args.counts else None
         landmarks = (
-            _int_list(args.landmarks, "--landmarks", 3, MAX_N_LANDMARKS)
-            if args.landmarks
-            else None
+            _int_list(args.landmarks, "--landmarks", 3, MAX_N_LANDMARKS) if args.landmarks else None
         )
         env_kwargs = {"scenario": "khepera", **parse_key_values(args.env_kwargs, "--env-kwargs")}
         _check_env_kwargs(env_kwargs)

@@ -216,6 +216,8 @@ def table_rows(results: dict[str, Any]) -> list[tuple[str, ...]]:
             case = "khepera, 4 landmarks"
         elif row["name"] == "khepera_wrapped":
             case = "khepera, gym.make wrappers"
+        elif row["name"] == "khepera_no_robot_map":
+            case = "khepera, robot_map_info=False"
         else:
             case = f"random, {row['n_landmarks']} landmarks"
         add("single", case, row, _relative(row["ratio_to_4_landmarks"], "4-landmark rate"))

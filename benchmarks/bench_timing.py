@@ -117,6 +117,16 @@ def timed_figure(bench: Bench, run: Callable[[], tuple[int, float]]) -> dict[str
 # --------------------------------------------------------------------------------------
 
 
+#: The env setting of the rows that measure an env without ``info["robot_map"]``.
+NO_ROBOT_MAP: dict[str, Any] = {"robot_map_info": False}
+#: The vector section's kinds: (kind, vectorization mode, extra env kwargs).
+VECTOR_KINDS: tuple[tuple[str, str, dict[str, Any]], ...] = (
+    ("batched", "vector_entry_point", {}),
+    ("batched_no_robot_map", "vector_entry_point", NO_ROBOT_MAP),
+    ("sync", "sync", {}),
+)
+
+
 def single_env_cases(landmarks: Sequence[int]) -> list[tuple[str, dict[str, Any], bool]]:
     """(name, env kwargs, unwrapped) of the single-env rows."""
     cases: list[tuple[str, dict[str, Any], bool]] = [("khepera", {"scenario": "khepera"}, True)]
@@ -125,6 +135,7 @@ def single_env_cases(landmarks: Sequence[int]) -> list[tuple[str, dict[str, Any]
             (f"random_{n}", {"scenario": "random", "n_landmarks": n, "max_landmarks": n}, True)
         )
     cases.append(("khepera_wrapped", {"scenario": "khepera"}, False))
+    cases.append(("khepera_no_robot_map", {"scenario": "khepera", **NO_ROBOT_MAP}, True))
     return cases
 
 
@@ -348,10 +359,11 @@ def bench_vector(
 ) -> list[dict[str, Any]]:
     bench.measure_reference("vector")
     rows: list[dict[str, Any]] = []
-    for kind, mode in (("batched", "vector_entry_point"), ("sync", "sync")):
+    for kind, mode, extra_kwargs in VECTOR_KINDS:
         for num_envs in num_envs_list:
+            kind_kwargs = {**env_kwargs, **extra_kwargs}
             build_start = time.perf_counter()
-            venv = make_vector_env(num_envs, mode, env_kwargs)
+            venv = make_vector_env(num_envs, mode, kind_kwargs)
             build_seconds = time.perf_counter() - build_start
             calls = 0
 
@@ -366,7 +378,7 @@ def bench_vector(
                 "kind": kind,
                 "vectorization_mode": mode,
                 "num_envs": num_envs,
-                "env_kwargs": env_kwargs,
+                "env_kwargs": kind_kwargs,
                 "step_calls": calls,
                 "autoreset_mode": autoreset_mode(venv).value,
                 "build_seconds": build_seconds,
@@ -378,13 +390,14 @@ def bench_vector(
     sync_rates = {row["num_envs"]: row["steps_per_s"] for row in rows if row["kind"] == "sync"}
     for row in rows:
         row["ratio_to_sync"] = (
-            row["steps_per_s"] / sync_rates[row["num_envs"]] if row["kind"] == "batched" else None
+            row["steps_per_s"] / sync_rates[row["num_envs"]] if row["kind"] != "sync" else None
         )
     return rows
 
 
 def vector_label(row: dict[str, Any]) -> str:
-    return "sync (baseline)" if row["kind"] == "sync" else "batched"
+    labels = {"sync": "sync (baseline)", "batched_no_robot_map": "batched, no robot_map"}
+    return labels.get(row["kind"], row["kind"])
 
 
 # --------------------------------------------------------------------------------------
@@ -612,5 +625,3 @@ def profile(section: str, seconds: float, num_envs: int, env_kwargs: dict[str, A
     profiler.runcall(loop)
     env.close()
     pstats.Stats(profiler, stream=sys.stdout).sort_stats("tottime").print_stats(25)
-
-

@@ -234,8 +234,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     ## Info
 
-    `robot_map` is the robot's own map, as data (no ground truth; what policies may read:
-    see `bearing_env.agents.env_access.MapReader`): a dict of the state arrays its fusion
+    `robot_map` (unless `robot_map_info=False`) is the robot's own map, as data (no
+    ground truth; what policies may read: see `bearing_env.agents.env_access.MapReader`):
+    a dict of the state arrays its fusion
     uses (`BatchedPolygonSLAM.state_names`: `vertices` (M - 2, CAPACITY, 2), the FL
     region vertices as (x, y), of which the first `counts` are used, `areas`,
     `centroids` (M - 2, 2), the robot's
@@ -303,6 +304,10 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
       each other restarts from the newest one) or `"keep"` (it keeps its old region).
       With `"relaxed"`, this applies beyond `max_outliers`.
     - `observation`: `"flat"` (default, the Box above) or `"entities"` (the Dict above).
+    - `robot_map_info`: True (default) or False: whether infos carry `robot_map` (see
+      Info). The map-based planners (`Parallax`, `GreedyOneStep`, `Lookahead` and their
+      oracles) need it and refuse an env without it; training runs that never read it
+      can turn it off to save its cost (observations and rewards are the same either way).
     - `render_mode`: `None`, `"human"` or `"rgb_array"`.
     - `config`: an `EnvConfig` (`bearing_env.envs.config`) holding all the settings
       above but `render_mode`, instead of the keywords (`EnvConfig.create(...)` takes

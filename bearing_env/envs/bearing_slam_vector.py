@@ -538,7 +538,11 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
     def _merge_rows(
         self, infos: dict[str, Any], batched: dict[str, Any], rows: IntArray
     ) -> dict[str, Any]:
-        """What ``_add_info`` would build from each row's info, for many rows at once."""
+        """What ``_add_info`` would build from each row's info, for many rows at once.
+        Rows that are every sub-env, in order, into empty infos (one group stepped them
+        all: the common case) take the batched arrays themselves, with no copy."""
+        if not infos and rows.size == self.num_envs:  # rows are distinct and sorted
+            return _as_vector_infos(batched, self.num_envs)
         for key, value in batched.items():
             array: Any
             if isinstance(value, dict):
@@ -565,6 +569,16 @@ class BearingSLAMDiscreteVectorEnv(BearingSLAMVectorEnv):
 
 #: Sub-env attributes the vector env serves itself (see ``_row_attribute``).
 _ROW_ATTRIBUTES = frozenset({"n_landmarks", "slam", "world", "observation_space", "action_space"})
+
+
+def _as_vector_infos(batched: dict[str, Any], num_envs: int) -> dict[str, Any]:
+    """Batched infos of every sub-env as vector infos: the arrays themselves, each key
+    with an all-True ``_key`` mask (nested dicts included)."""
+    infos: dict[str, Any] = {}
+    for key, value in batched.items():
+        infos[key] = _as_vector_infos(value, num_envs) if isinstance(value, dict) else value
+        infos[f"_{key}"] = np.ones(num_envs, dtype=np.bool_)
+    return infos
 
 
 def _select_rows(batched: dict[str, Any], rows: IntArray) -> dict[str, Any]:

@@ -15,7 +15,7 @@ group           class                      fields
 ``mapping``     :class:`MappingSettings`   transfer, fusion, max_outliers, on_inconsistency
 ``task``        :class:`TaskSettings`      reward, target_area, max_moves, path_cost, ...
 ``actions``     :class:`ActionSettings`    move_length, n_turns, n_move_lengths
-``observations``:class:`ObservationSettings` max_landmarks, observation
+``observations``:class:`ObservationSettings` max_landmarks, observation, robot_map_info
 ==============  =========================  ===================================================
 
 **The groups' fields are the one home of the settings.** A field made by :func:`setting`
@@ -68,6 +68,7 @@ from bearing_env.slam.settings import DEFAULT_MAX_OUTLIERS, DEFAULT_WINDOW
 from bearing_env.validation import (
     EPSILON_RANGE,
     choice,
+    flag,
     int_at_least,
     int_at_most,
     is_real,
@@ -400,7 +401,9 @@ class ActionSettings(SettingsGroup):
 
 @dataclass(frozen=True)
 class ObservationSettings(SettingsGroup):
-    """The observation: its landmark slots and its kind (both fix the space)."""
+    """What the robot is given: the observation's landmark slots and kind (both fix the
+    space), and whether its infos carry its own map (``info["robot_map"]``, which the
+    map-based planners read; training runs that never read it can turn it off)."""
 
     max_landmarks: int = setting(
         DEFAULT_MAX_LANDMARKS,
@@ -409,6 +412,7 @@ class ObservationSettings(SettingsGroup):
         read_only=FIXES_THE_SPACES,
     )
     observation: str = setting("flat", attribute="observation_kind", read_only=FIXES_THE_SPACES)
+    robot_map_info: bool = setting(True)
 
     @classmethod
     def from_keywords(
@@ -418,7 +422,7 @@ class ObservationSettings(SettingsGroup):
         max_landmarks = keywords["max_landmarks"]
         if max_landmarks is None:
             max_landmarks = max(DEFAULT_MAX_LANDMARKS, layout.landmark_counts[1])
-        return cls(max_landmarks, keywords["observation"])
+        return cls(max_landmarks, keywords["observation"], keywords["robot_map_info"])
 
     def __post_init__(self) -> None:
         max_landmarks = int_at_least(self.max_landmarks, 3, "max_landmarks")
@@ -426,6 +430,7 @@ class ObservationSettings(SettingsGroup):
             self, "max_landmarks", int_at_most(max_landmarks, MAX_N_LANDMARKS, "max_landmarks")
         )
         choice(self.observation, OBSERVATIONS, "observation")
+        _normalise(self, "robot_map_info", flag(self.robot_map_info, "robot_map_info"))
 
 
 # ----------------------------------------------------------------------------------------

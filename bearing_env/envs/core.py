@@ -471,7 +471,8 @@ def observations(state: BatchState, group: Group) -> NDArray[np.float32]:
 
 
 def infos(state: BatchState, group: Group, outcome: StepOutcome) -> dict[str, Any]:
-    """The group's infos, batched along a first axis (see the env's Info section)."""
+    """The group's infos, batched along a first axis (see the env's Info section);
+    ``robot_map`` only with the ``robot_map_info`` setting on."""
     rows, batch = group.rows, group.batch
     size, n_mapped = rows.size, group.n - 2
     areas = np.empty((size, n_mapped))
@@ -480,7 +481,7 @@ def infos(state: BatchState, group: Group, outcome: StepOutcome) -> dict[str, An
     total_area = np.empty(size)
     robot_error = np.empty(size)
     kernels.write_infos(rows, group.inputs, areas, errors, contains, total_area, robot_error)
-    return {
+    infos: dict[str, Any] = {
         "landmark_area": areas,
         "landmark_error": errors,
         "landmark_contains_truth": contains,
@@ -490,23 +491,28 @@ def infos(state: BatchState, group: Group, outcome: StepOutcome) -> dict[str, An
         "inconsistent": outcome.inconsistent,
         "outliers": batch.outliers[rows],
         "path_length": outcome.travelled,
-        robot_map.KEY: robot_map.encode(batch, rows, group.config.observations.max_landmarks - 2),
         "rewards": {
             "uncertainty": outcome.uncertainty,
             "path_cost": outcome.path_cost,
             "move_cost": outcome.move_cost,
         },
     }
+    observations = group.config.observations
+    if observations.robot_map_info:
+        infos[robot_map.KEY] = robot_map.encode(batch, rows, observations.max_landmarks - 2)
+    return infos
 
 
 def row_info(batched: dict[str, Any], row: int) -> dict[str, Any]:
-    """One env's info dict (Python scalars, per-landmark arrays) from batched infos."""
+    """One env's info dict (Python scalars, per-landmark arrays) from batched infos.
+    The arrays are views of the batched ones: :func:`infos` makes them anew at every
+    call and keeps none, so a view is as private as a copy, and cheaper."""
     info: dict[str, Any] = {}
     for key, value in batched.items():
         if type(value) is dict:
             info[key] = row_info(value, row)
         elif value.ndim > 1:
-            info[key] = value[row].copy()
+            info[key] = value[row]
         else:
             info[key] = value[row].item()
     return info

@@ -23,14 +23,17 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
+from bearing_env.numerics import JIT_OPTIONS
 from bearing_env.slam import MapSettings, PolygonSLAM
-from bearing_env.slam.batch import LANDMARK_AXES, VERTEX_COUNTS, BatchedPolygonSLAM
+from bearing_env.slam.batch import LANDMARK_AXES, BatchedPolygonSLAM
 
 #: The info key of the robot's own map: the one key of an info robot policies read.
 KEY = "robot_map"
-#: Fill of the empty landmark slots (default 0: count 0 is an empty region).
+#: Fill of the empty landmark slots (default 0: count 0 is an empty region), as the
+#: compiled encoding (:func:`_encode_map`, :func:`_encode_window`) writes them.
 PADDING: dict[str, Any] = {"areas": np.inf, "centroids": complex(np.inf, np.inf)}
 #: The arrays whose unknown values (NaN in the map) are inf in an info.
 UNKNOWN_AS_INF: tuple[str, ...] = ("centroids", "robot_centroid", "robot_heading")
@@ -38,30 +41,127 @@ UNKNOWN_AS_INF: tuple[str, ...] = ("centroids", "robot_centroid", "robot_heading
 
 def encode(batch: BatchedPolygonSLAM, rows: NDArray[np.int64], slots: int) -> dict[str, Any]:
     """The map state of the batch's ``rows``, as an info's data (arrays with the rows
-    first), per-landmark arrays padded to ``slots`` landmark slots."""
-    mapped = batch.n_landmarks - 2
-    out: dict[str, Any] = {}
-    for name in batch.state_names:
-        values = getattr(batch, name)[rows]
-        if name in VERTEX_COUNTS:
-            used = getattr(batch, VERTEX_COUNTS[name])[rows]
-            values[np.arange(values.shape[-1]) >= used[..., None]] = 0
-        elif name in UNKNOWN_AS_INF:
-            unknown = np.isnan(values)
-            values[unknown] = complex(np.inf, np.inf) if values.dtype.kind == "c" else np.inf
-        axis = LANDMARK_AXES.get(name)
-        if axis is not None and slots > mapped:
-            shape = list(values.shape)
-            shape[axis] = slots
-            padded = np.full(shape, PADDING.get(name, 0), dtype=values.dtype)
-            used_slots = [slice(None)] * values.ndim
-            used_slots[axis] = slice(0, mapped)
-            padded[tuple(used_slots)] = values
-            values = padded
-        if values.dtype.kind == "c":
-            values = values.view(np.float64).reshape(*values.shape, 2)
-        out[name] = values
-    return out
+    first), per-landmark arrays padded to ``slots`` landmark slots.
+
+    One compiled call gathers every array at once, already in the canonical form, into
+    arrays it makes (:func:`_encode_map`, and :func:`_encode_window` for the relaxed
+    fusion's window and bases): a Python loop over the arrays costs several times more."""
+    state, slots = batch._kernel_state(), max(int(slots), batch.n_landmarks - 2)
+    arrays = _encode_map(state, rows, slots)
+    if batch.fusion == "relaxed":
+        arrays += _encode_window(state, rows, slots)
+    return {
+        name: values.view(np.float64).reshape(*values.shape, 2)
+        if values.dtype.kind == "c"
+        else values
+        for name, values in zip(batch.state_names, arrays, strict=True)
+    }
+
+
+@njit(**JIT_OPTIONS)
+def _known(value: complex) -> complex:  # pragma: no cover  (compiled)
+    """A complex point, inf + inf j if unknown (NaN in either part)."""
+    if np.isnan(value.real) or np.isnan(value.imag):
+        return complex(np.inf, np.inf)
+    return value
+
+
+@njit(**JIT_OPTIONS)
+def _encode_map(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
+    """The arrays every fusion uses (``STATE_ARRAYS`` up to ``n_inconsistent``), in
+    their order, for ``rows``: landmark slots padded to ``slots`` (see the module doc)."""
+    size, mapped, capacity = rows.size, state.counts.shape[1], state.vertices.shape[2]
+    vertices = np.zeros((size, slots, capacity), np.complex128)
+    counts = np.zeros((size, slots), np.int64)
+    areas = np.full((size, slots), np.inf)
+    centroids = np.full((size, slots), complex(np.inf, np.inf))
+    robot_vertices = np.zeros((size, capacity), np.complex128)
+    robot_counts = np.empty(size, np.int64)
+    robot_area = np.empty(size)
+    robot_centroid = np.empty(size, np.complex128)
+    robot_heading = np.empty(size)
+    n_updates = np.empty(size, np.int64)
+    n_frame_changes = np.empty(size, np.int64)
+    n_inconsistent = np.empty(size, np.int64)
+    for i in range(size):
+        row = rows[i]
+        for j in range(mapped):
+            count = state.counts[row, j]
+            counts[i, j] = count
+            vertices[i, j, :count] = state.vertices[row, j, :count]
+            areas[i, j] = state.areas[row, j]
+            centroids[i, j] = _known(state.centroids[row, j])
+        count = state.robot_counts[row]
+        robot_counts[i] = count
+        robot_vertices[i, :count] = state.robot_vertices[row, :count]
+        robot_area[i] = state.robot_area[row]
+        robot_centroid[i] = _known(state.robot_centroid[row])
+        heading = state.robot_heading[row]
+        robot_heading[i] = np.inf if np.isnan(heading) else heading
+        n_updates[i] = state.n_updates[row]
+        n_frame_changes[i] = state.n_frame_changes[row]
+        n_inconsistent[i] = state.n_inconsistent[row]
+    return (
+        vertices,
+        counts,
+        areas,
+        centroids,
+        robot_vertices,
+        robot_counts,
+        robot_area,
+        robot_centroid,
+        robot_heading,
+        n_updates,
+        n_frame_changes,
+        n_inconsistent,
+    )
+
+
+@njit(**JIT_OPTIONS)
+def _encode_window(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
+    """The relaxed fusion's arrays (``RELAXED_STATE_ARRAYS``), as :func:`_encode_map`."""
+    size, mapped = rows.size, state.counts.shape[1]
+    window, capacity = state.window_vertices.shape[1], state.window_vertices.shape[3]
+    base_capacity = state.base_vertices.shape[2]
+    window_vertices = np.zeros((size, window, slots, capacity), np.complex128)
+    window_counts = np.zeros((size, window, slots), np.int64)
+    window_inlier = np.zeros((size, window, slots), np.bool_)
+    window_rejected = np.empty((size, window), np.bool_)
+    window_length = np.empty(size, np.int64)
+    window_next = np.empty(size, np.int64)
+    base_vertices = np.zeros((size, slots, base_capacity), np.complex128)
+    base_counts = np.zeros((size, slots), np.int64)
+    n_dropped = np.zeros((size, slots), np.int64)
+    outliers = np.zeros((size, slots), np.int64)
+    for i in range(size):
+        row = rows[i]
+        for k in range(window):
+            window_rejected[i, k] = state.window_rejected[row, k]
+            for j in range(mapped):
+                count = state.window_counts[row, k, j]
+                window_counts[i, k, j] = count
+                window_vertices[i, k, j, :count] = state.window_vertices[row, k, j, :count]
+                window_inlier[i, k, j] = state.window_inlier[row, k, j]
+        window_length[i] = state.window_length[row]
+        window_next[i] = state.window_next[row]
+        for j in range(mapped):
+            count = state.base_counts[row, j]
+            base_counts[i, j] = count
+            base_vertices[i, j, :count] = state.base_vertices[row, j, :count]
+            n_dropped[i, j] = state.n_dropped[row, j]
+            outliers[i, j] = state.outliers[row, j]
+    return (
+        window_vertices,
+        window_counts,
+        window_inlier,
+        window_rejected,
+        window_length,
+        window_next,
+        base_vertices,
+        base_counts,
+        n_dropped,
+        outliers,
+    )
 
 
 def decode(data: Mapping[str, Any], n_landmarks: int, settings: MapSettings) -> PolygonSLAM:

@@ -70,7 +70,15 @@ def test_quick_single_and_vector(tmp_path: Path, capsys: pytest.CaptureFixture[s
     labels = {ref["label"] for ref in results["cartpole_references"]}
 
     single = {row["name"]: row for row in results["single"]}
-    assert set(single) == {"khepera", "random_4", "random_16", "random_64", "khepera_wrapped"}
+    assert set(single) == {
+        "khepera",
+        "random_4",
+        "random_16",
+        "random_64",
+        "khepera_wrapped",
+        "khepera_no_robot_map",
+    }
+    assert single["khepera_no_robot_map"]["env_kwargs"]["robot_map_info"] is False
     for row in single.values():
         check_figure(row, labels)
     assert single["random_4"]["ratio_to_4_landmarks"] == pytest.approx(1.0)
@@ -78,14 +86,16 @@ def test_quick_single_and_vector(tmp_path: Path, capsys: pytest.CaptureFixture[s
 
     vector = results["vector"]
     assert {(row["kind"], row["num_envs"]) for row in vector} == {
-        (kind, n) for kind in ("batched", "sync") for n in (1, 4)
+        (kind, n) for kind in ("batched", "batched_no_robot_map", "sync") for n in (1, 4)
     }
     for row in vector:
         check_figure(row, labels)
         assert row["step_calls"] >= 2
-        if row["kind"] == "batched":
+        if row["kind"] != "sync":
             assert positive_finite(row["ratio_to_sync"])
             assert row["vectorization_mode"] == "vector_entry_point"
+        has_map = row["kind"] != "batched_no_robot_map"
+        assert row["env_kwargs"].get("robot_map_info", True) == has_map
     targets = {target["id"]: target for target in results["targets"]}
     # The batched env always exists: no row or target says what it fell back to.
     for row in [*vector, *results["single"], *results["targets"]]:
@@ -141,11 +151,13 @@ def test_batched_rows_in_same_step_mode_count_every_sub_step(
     """The vector rows count transitions by the env's autoreset mode."""
     monkeypatch.setattr(gym.spec(bench_timing.ENV_ID), "vector_entry_point", stand_in_vector_env)
     results, _ = run_quick(tmp_path, "--sections", "vector", "--num-envs", "2")
-    (batched, sync) = results["vector"]
+    (batched, batched_no_map, sync) = results["vector"]
     assert batched["kind"] == "batched" and batched["vectorization_mode"] == "vector_entry_point"
-    assert batched["autoreset_mode"] == "SameStep"
+    assert batched_no_map["kind"] == "batched_no_robot_map"
+    for row in (batched, batched_no_map):
+        assert row["autoreset_mode"] == "SameStep"
+        assert row["steps"] == 2 * row["step_calls"]  # SAME_STEP: every sub-step counts
     assert sync["autoreset_mode"] == "NextStep"
-    assert batched["steps"] == 2 * batched["step_calls"]  # SAME_STEP: every sub-step counts
 
 
 def fake_figure(rate: float, **extra: Any) -> dict[str, Any]:
@@ -203,6 +215,7 @@ def test_cli_bench_runs_bench_env(
         "khepera",
         "random_4",
         "khepera_wrapped",
+        "khepera_no_robot_map",
     ]
     assert "Targets:" in capsys.readouterr().out
 
