@@ -76,6 +76,10 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env bench --sections throughput": ("parse", ()),
     "bearing-env bench --sections slam,planning --seconds 1": ("parse", ()),
     "bearing-env bench --profile vector": ("parse", ()),
+    "bearing-env bench --sections single,vector --seconds 1 --num-envs 64 256 --landmarks 4": (
+        "parse",
+        (),
+    ),
     "bearing-env bench --sections single,vector,slam,startup,planning": ("parse", ()),
     "bearing-env figures --out docs/figures": ("parse", ()),
     "bearing-env hyperparams ppo": ("run", ()),
