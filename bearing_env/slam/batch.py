@@ -30,6 +30,7 @@ from bearing_env.slam.settings import (
     DEFAULT_WINDOW,
     FUSIONS,
     INCONSISTENCY_POLICIES,
+    HasMapSettings,
     MapSettings,
 )
 from bearing_env.slam.transfer import TRANSFERS
@@ -98,7 +99,7 @@ class BatchUpdateResult:
     n_inconsistent: IntArray
 
 
-class BatchedPolygonSLAM:
+class BatchedPolygonSLAM(HasMapSettings):
     """``num_maps`` independent polygon-SLAM maps, updated together.
 
     Args mirror :class:`~bearing_env.slam.PolygonSLAM`, plus ``num_maps``; they are
@@ -127,8 +128,8 @@ class BatchedPolygonSLAM:
     ) -> None:
         self.num_maps = int_at_least(num_maps, 1, "num_maps")
         self.n_landmarks = int_at_least(n_landmarks, 3, "n_landmarks", "(L1, L2 and one more)")
-        #: The map's settings, validated (the attributes below are their values).
-        self.settings = settings = MapSettings(
+        #: The map's settings, validated (``self.epsilon`` and the others read them).
+        self.settings = MapSettings(
             epsilon,
             transfer=transfer,
             edge_samples=edge_samples,
@@ -137,13 +138,6 @@ class BatchedPolygonSLAM:
             max_outliers=max_outliers,
             window=window,
         )
-        self.epsilon = settings.epsilon
-        self.transfer = settings.transfer
-        self.edge_samples = settings.edge_samples
-        self.on_inconsistency = settings.on_inconsistency
-        self.fusion = settings.fusion
-        self.max_outliers = settings.max_outliers
-        self.window = settings.window
         n, m, cap = self.num_maps, self.n_landmarks - 2, kernels.CAPACITY
         self.vertices = np.zeros((n, m, cap), dtype=np.complex128)
         self.counts = np.zeros((n, m), dtype=np.int64)
@@ -306,13 +300,7 @@ class BatchedPolygonSLAM:
 
     def same_settings(self, other: BatchedPolygonSLAM) -> bool:
         """Whether ``other`` was made with this batch's settings (its map count aside)."""
-        return self._settings() == other._settings()
-
-    def _settings(self) -> tuple[object, ...]:
-        return (
-            self.n_landmarks, self.epsilon, self.transfer, self.edge_samples,
-            self.on_inconsistency, self.fusion, self.max_outliers, self.window,
-        )  # fmt: skip
+        return self.n_landmarks == other.n_landmarks and self.settings == other.settings
 
     def fill_from(self, source: BatchedPolygonSLAM, map_index: int) -> None:
         """Make every map of this batch a copy of ``source``'s map ``map_index`` (same

@@ -21,6 +21,7 @@ from bearing_env.slam.settings import (
     DEFAULT_WINDOW,
     FUSIONS,
     INCONSISTENCY_POLICIES,
+    HasMapSettings,
     MapSettings,
 )
 from bearing_env.validation import int_at_least
@@ -119,7 +120,7 @@ def _to_complex(points: ArrayLike) -> NDArray[np.complex128]:
     return arr[..., 0] + 1j * arr[..., 1]
 
 
-class PolygonSLAM:
+class PolygonSLAM(HasMapSettings):
     """Bearing-only SLAM with uncertainty polygons (Huang, Maire & Keeratipranon 2005).
 
     Feed it the two panoramic readings of each straight movement; it keeps, for every
@@ -190,15 +191,8 @@ class PolygonSLAM:
         self._index = index
         self._rows = np.array([index])
         self.n_landmarks = batch.n_landmarks
-        #: The map's settings (validated); the attributes below are their values.
-        self.settings: MapSettings = batch.settings
-        self.epsilon = batch.epsilon
-        self.transfer = batch.transfer
-        self.edge_samples = batch.edge_samples
-        self.on_inconsistency = batch.on_inconsistency
-        self.fusion = batch.fusion
-        self.max_outliers = batch.max_outliers
-        self.window = batch.window
+        #: The map's settings (validated; ``self.epsilon`` and the others read them).
+        self.settings = batch.settings
 
     @classmethod
     def from_settings(cls, n_landmarks: int, settings: MapSettings) -> PolygonSLAM:

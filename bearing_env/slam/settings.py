@@ -85,3 +85,38 @@ class MapSettings:
         if max_outliers >= window:
             raise ValueError(f"max_outliers must be < window ({window}), got {self.max_outliers!r}")
         normalise("max_outliers", max_outliers)
+
+
+class HasMapSettings:
+    """The map settings as read-only attributes (``slam.epsilon``, ``slam.fusion``, ...),
+    read from ``self.settings``, their one home, for the batch and its single-map views."""
+
+    settings: MapSettings
+
+    @property
+    def epsilon(self) -> float:
+        return self.settings.epsilon
+
+    @property
+    def transfer(self) -> str:
+        return self.settings.transfer
+
+    @property
+    def edge_samples(self) -> int:
+        return self.settings.edge_samples
+
+    @property
+    def on_inconsistency(self) -> str:
+        return self.settings.on_inconsistency
+
+    @property
+    def fusion(self) -> str:
+        return self.settings.fusion
+
+    @property
+    def max_outliers(self) -> int:
+        return self.settings.max_outliers
+
+    @property
+    def window(self) -> int:
+        return self.settings.window
