@@ -1,8 +1,9 @@
 """The ``bearing-env`` command line.
 
     bearing-env demo [...]        the random polygonal demo in the Khepera scenario (make demo)
-    bearing-env bench [...]       env, vector env and PPO steps/s against CartPole-v1, as a
-                                  table and JSON (benchmarks/bench_env.py, make bench)
+    bearing-env bench [...]       env, vector env, throughput and PPO steps/s against
+                                  CartPole-v1, as tables and JSON (benchmarks/bench_env.py,
+                                  make bench)
     bearing-env bench-slam [...]  world-model update() throughput against CartPole-v1
                                   (benchmarks/bench_slam.py; also ``bearing-env bench --slam``)
     bearing-env region-search [...]  a seeded search for regions that break the world
@@ -48,7 +49,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     ),
     "bench": (
         "bearing_env.benchmarks.bench_env",
-        "env, vector env and PPO steps/s vs CartPole-v1",
+        "env, vector env, throughput and PPO steps/s vs CartPole-v1",
     ),
     "bench-slam": (
         "bearing_env.benchmarks.bench_slam",
