@@ -101,10 +101,17 @@ def test_generalisation_table_covers_every_policy_and_count(tmp_path: Path) -> N
                "--out", str(out)]  # fmt: skip
     result = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
-    medians = json.loads((out / "generalisation.json").read_text())
-    assert set(medians) == {"3"}
-    assert set(medians["3"]) == {"random_polygonal", "parallax", "greedy_one_step", "ppo_random"}
-    assert all(np.isfinite(v) and v > 0 for v in medians["3"].values())
+    results = json.loads((out / "generalisation.json").read_text())
+    assert set(results) == {"ppo_random"} and set(results["ppo_random"]) == {"3"}
+    figures = results["ppo_random"]["3"]
+    assert set(figures) == {
+        "random_polygonal", "parallax", "greedy_one_step", "lookahead", "ppo_random"
+    }  # fmt: skip
+    for values in figures.values():
+        assert set(values) == {"median", "p90", "worst5_mean"}
+        # One episode: its area is the median, the 90th percentile and the worst 5%.
+        assert np.isfinite(values["median"]) and values["median"] > 0
+        assert values["median"] == values["p90"] == values["worst5_mean"]
     assert (out / "generalisation.png").stat().st_size > 10_000
 
 

@@ -11,6 +11,9 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
 
 from bearing_env.train import cli
 from bearing_env.train.common.cli_values import format_key_values, parse_key_values
@@ -19,9 +22,9 @@ from bearing_env.train.compare.cli import main
 from bearing_env.train.compare.comparison import RunMismatchError, run_comparison
 from bearing_env.train.compare.config import CompareConfig, policies_from_specs
 from bearing_env.train.compare.log import LOG_NAME, EpisodeLog
-from bearing_env.train.compare.report import csv_text
+from bearing_env.train.compare.report import area_tail_rows, csv_text
 from bearing_env.train.compare.runner import EpisodeTask, episode_tasks, run_locally
-from bearing_env.train.compare.stats import bootstrap_mean_ci
+from bearing_env.train.compare.stats import bootstrap_mean_ci, worst_share_mean
 from tests.extras import needs
 
 SMALL_ENV = {"scenario": "khepera", "max_moves": 4}
@@ -395,3 +398,46 @@ def test_compare_csv_files_round_trip_an_awkward_label(tmp_path: Path) -> None:
     assert [int(row[1]) for row in episodes[1:]] == config.seeds * 2
     logged = json.loads((tmp_path / "summary.json").read_text(encoding="utf-8"))
     assert float(summary[1][3]) == logged["policies"][AWKWARD_LABEL]["area_after"]["1"]["median"]
+
+
+def test_worst_share_mean_is_the_mean_of_the_largest_values() -> None:
+    values = np.arange(1.0, 41.0)  # 40 episodes: the worst 5% are the 2 largest
+    assert worst_share_mean(values) == pytest.approx((39.0 + 40.0) / 2)
+    assert worst_share_mean(np.array([3.0, 1.0, 2.0])) == 3.0  # at least one episode
+    assert worst_share_mean(values, share=0.5) == pytest.approx(np.arange(21.0, 41.0).mean())
+    assert np.isnan(worst_share_mean(np.array([])))
+
+
+@given(
+    arrays(
+        np.float64,
+        st.integers(1, 60),
+        elements=st.floats(0.0, 1e3, allow_nan=False, allow_infinity=False),
+    )
+)
+@settings(max_examples=60, deadline=None)
+def test_the_worst_case_figures_bound_the_median(values: np.ndarray) -> None:
+    assert np.median(values) <= np.percentile(values, 90) + 1e-9
+    assert np.percentile(values, 90) <= worst_share_mean(values) + 1e-9
+    assert worst_share_mean(values) <= values.max() + 1e-9
+
+
+def test_the_report_gives_the_worst_case_from_the_logged_episodes(tmp_path: Path) -> None:
+    config = small_config(episodes=6, env_kwargs={"scenario": "khepera", "max_moves": 10})
+    run(config, tmp_path)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    records = EpisodeLog(tmp_path / LOG_NAME).load()
+    for label, stats in summary["policies"].items():
+        # An episode that ended early keeps its last area (as the statistics carry it).
+        finals = np.array(
+            [r["area"][min(10, len(r["area"]) - 1)] for r in records if r["policy"] == label]
+        )
+        entry = stats["area_after"]["10"]
+        assert entry["p90"] == pytest.approx(np.percentile(finals, 90))
+        assert entry["worst5_mean"] == pytest.approx(finals.max())  # 6 episodes: the worst one
+    header, rows = area_tail_rows(summary, config)
+    assert header == ["policy", "median, 10", "90th pct, 10", "worst 5% mean, 10"]
+    assert [row[0] for row in rows] == list(summary["policies"])
+    report = (tmp_path / "report.md").read_text()
+    assert "mean of the worst 5%" in report and "90th pct, 10" in report
+    assert "area10_p90" in (tmp_path / "summary.csv").read_text().splitlines()[0]

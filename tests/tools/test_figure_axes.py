@@ -38,8 +38,11 @@ class Drawn:
         monkeypatch.setattr(figures, "save_and_close", recording)
 
     def unlabelled(self) -> list[str]:
-        return [f"{name} panel {i}" for i, (name, x, y, _) in enumerate(self.panels)
-                if not (x.strip() and y.strip())]
+        return [
+            f"{name} panel {i}"
+            for i, (name, x, y, _) in enumerate(self.panels)
+            if not (x.strip() and y.strip())
+        ]
 
 
 class CountingBar:
@@ -73,8 +76,21 @@ def test_every_panel_of_every_figure_labels_both_axes(
     figures.figure10(tmp_path, SEEDS, moves=4)
     figures.figure11(tmp_path, SEEDS, epsilons=(2.0, 4.0), moves=4)
     figures.figure_robustness(tmp_path, SEEDS, moves=4)
-    medians = {3: {"a": 1.0, "greedy_one_step": 0.5}, 5: {"a": 2.0, "greedy_one_step": 1.5}}
-    generalisation.plot_medians(medians, "a", (3, 4), tmp_path / "generalisation.png")
+
+    def figures_of(median: float) -> dict[str, float]:
+        return {"median": median, "p90": 2 * median, "worst5_mean": 3 * median}
+
+    results = {
+        "a": {
+            count: {
+                "a": figures_of(a),
+                "greedy_one_step": figures_of(g),
+                "lookahead": figures_of(h),
+            }
+            for count, (a, g, h) in {3: (1.0, 0.5, 0.4), 5: (2.0, 1.5, 1.2)}.items()
+        }
+    }
+    generalisation.plot_medians(results, {"a": (3, 4)}, tmp_path / "generalisation.png")
     names = {name for name, *_ in drawn.panels}
     assert names == {
         "fig7_polygons.png",

@@ -331,8 +331,10 @@ def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
     episodes = args.episodes
     if episodes is None:
         episodes = QUICK_EPISODES if args.quick else DEFAULT_EPISODES
-    out = args.out if args.out is not None else Path(
-        "outputs/compare_quick" if args.quick else "outputs/compare"
+    out = (
+        args.out
+        if args.out is not None
+        else Path("outputs/compare_quick" if args.quick else "outputs/compare")
     )
     config = CompareConfig(
         policies=policies_from_specs(policies),
@@ -382,8 +384,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         parser.error("--ray-address needs --executor ray")
     if args.executor == "ray" and args.workers != 1:
         parser.error(
-            "--workers is for --executor local; Ray runs as many episodes as the cluster "
-            "has CPUs"
+            "--workers is for --executor local; Ray runs as many episodes as the cluster has CPUs"
         )
     try:
         if args.executor == "ray":

@@ -98,6 +98,31 @@ def area_mean_rows(
     return header, rows
 
 
+def _tail_moves(moves: Sequence[int]) -> list[int]:
+    """The move counts the worst-case table reports: 10 and 20 where run, else the last."""
+    wanted = [k for k in (10, 20) if k in moves]
+    return wanted or list(moves[-1:])
+
+
+def area_tail_rows(
+    summary: Mapping[str, Any], config: CompareConfig
+) -> tuple[list[str], list[list[str]]]:
+    """The worst case beside the median: the 90th percentile of the total area and the
+    mean of the worst 5% of the episodes, after 10 and 20 moves (or the last count)."""
+    moves = _tail_moves(_reported_moves(summary))
+    header = ["policy"]
+    for k in moves:
+        header += [f"median, {k}", f"90th pct, {k}", f"worst 5% mean, {k}"]
+    rows = []
+    for label, stats in summary["policies"].items():
+        cells = [_display_label(label, config)]
+        for k in moves:
+            entry = stats["area_after"].get(str(k), {})
+            cells += [_fmt(entry.get(name)) for name in ("median", "p90", "worst5_mean")]
+        rows.append(cells)
+    return header, rows
+
+
 def outcome_table_rows(
     summary: Mapping[str, Any], config: CompareConfig, timing: Mapping[str, float] | None = None
 ) -> tuple[list[str], list[list[str]]]:
@@ -152,6 +177,7 @@ def print_tables(
             area_median_rows(summary, config),
         ),
         ("Mean total area [95% bootstrap CI]", area_mean_rows(summary, config)),
+        ("Worst case of the total area", area_tail_rows(summary, config)),
         ("Outcomes", outcome_table_rows(summary, config, timing)),
     )
     if not available("rich"):  # a plain install: the same tables as markdown
@@ -189,6 +215,11 @@ def report_markdown(
         "",
         markdown_table(*area_mean_rows(summary, config)),
         "",
+        "Worst case of the total area: the 90th percentile and the mean of the worst 5% of "
+        "the episodes, beside the median:",
+        "",
+        markdown_table(*area_tail_rows(summary, config)),
+        "",
         markdown_table(*outcome_table_rows(summary, config)),
         "",
     ]
@@ -204,11 +235,15 @@ def report_markdown(
     return "\n".join(parts)
 
 
+#: The total-area statistics the CSV gives per reported move count.
+AREA_CSV_STATS = ("median", "mean", "ci_low", "ci_high", "p90", "worst5_mean")
+
+
 def summary_csv(summary: Mapping[str, Any]) -> str:
     header = ["policy", "spec", "episodes"]
     moves = sorted({int(k) for p in summary["policies"].values() for k in p["area_after"]})
     for k in moves:
-        header += [f"area{k}_median", f"area{k}_mean", f"area{k}_ci_low", f"area{k}_ci_high"]
+        header += [f"area{k}_{name}" for name in AREA_CSV_STATS]
     header += [
         "success_rate",
         "moves_to_success_median",
@@ -225,7 +260,7 @@ def summary_csv(summary: Mapping[str, Any]) -> str:
         row: list[Any] = [label, stats["spec"], stats["episodes"]]
         for k in moves:
             entry = stats["area_after"].get(str(k), {})
-            row += [entry.get(name) for name in ("median", "mean", "ci_low", "ci_high")]
+            row += [entry.get(name) for name in AREA_CSV_STATS]
         row += [
             stats["success_rate"],
             stats["moves_to_success_median"],

@@ -1,5 +1,6 @@
 """The statistics of a comparison: per policy, the total area after each reported move
-count (median, mean with a seeded percentile-bootstrap 95% CI), success, landmark error,
+count (median, mean with a seeded percentile-bootstrap 95% CI, and the worst case: the
+90th percentile and the mean of the worst 5%), success, landmark error,
 containment, path length, and the policies' time per move.
 
 Deterministic given the records: each interval's resampling stream is keyed by the
@@ -60,12 +61,33 @@ def _nan_to_none(value: float) -> float | None:
     return None if value is None or not math.isfinite(value) else float(value)
 
 
+#: The share of the episodes whose mean is the "worst 5%" figure.
+WORST_SHARE = 0.05
+
+
+def worst_share_mean(values: NDArray[np.float64], share: float = WORST_SHARE) -> float:
+    """The mean of the largest ``ceil(share * n)`` values (at least one): the tail a
+    median hides, as in a conditional value at risk."""
+    if values.size == 0:
+        return math.nan
+    count = max(1, math.ceil(share * values.size - 1e-9))
+    return float(np.sort(values)[-count:].mean())
+
+
 def _distribution(
     values: NDArray[np.float64], rng: np.random.Generator, resamples: int
 ) -> dict[str, Any]:
     finite = values[np.isfinite(values)]
     if finite.size == 0:
-        return {"n": 0, "median": None, "mean": None, "ci_low": None, "ci_high": None}
+        return {
+            "n": 0,
+            "median": None,
+            "mean": None,
+            "ci_low": None,
+            "ci_high": None,
+            "p90": None,
+            "worst5_mean": None,
+        }
     low, high = bootstrap_mean_ci(finite, rng, resamples)
     return {
         "n": int(finite.size),
@@ -73,6 +95,8 @@ def _distribution(
         "mean": float(np.mean(finite)),
         "ci_low": _nan_to_none(low),
         "ci_high": _nan_to_none(high),
+        "p90": float(np.percentile(finite, 90.0)),
+        "worst5_mean": worst_share_mean(finite),
     }
 
 

@@ -1,13 +1,16 @@
 """How a policy trained on random layouts generalises across landmark counts.
 
 Runs ``bearing-env compare`` on random layouts (evaluation seeds, unseen in training) for
-each landmark count, including counts the policy never saw, prints one table of the
-median total area after 10 moves per policy and count, and writes it to
-``generalisation.json`` with a plot, ``generalisation.png`` (the medians against the count,
-and each policy's median over GreedyOneStep's but random polygonal's, with the model's
-training range shaded).
+each model and landmark count, including counts a model never saw, beside the baselines
+(random polygonal, Parallax, GreedyOneStep and Lookahead by default). It prints one table
+per model of the total area after 10 moves per policy and count (median and 90th
+percentile), and writes ``generalisation.json`` (model -> count -> policy -> median, 90th
+percentile and worst-5% mean) with a plot, ``generalisation.png``: the medians against the
+count, and each policy's median over GreedyOneStep's and over Lookahead's, with each
+model's training range shaded.
 
     bearing-env generalisation --model ppo_random --counts 3 4 6 8 10 --episodes 50
+    bearing-env generalisation --model ppo_generalist ppo_random --counts 3 8 10
     python -m bearing_env.train.studies.generalisation ...     # the same
 
 The total area is summed over the mapped landmarks (L3, L4, ...), so it grows with the
@@ -25,7 +28,9 @@ import subprocess
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
+
+import numpy as np
 
 from bearing_env.agents.sb3 import pretrained_names, pretrained_record
 from bearing_env.envs.config import EnvConfig
@@ -34,11 +39,19 @@ from bearing_env.train.common.cli_parser import command_parser, doc_summary
 from bearing_env.train.common.cli_values import COUNT, format_key_values
 from bearing_env.train.common.errors import MissingExtraError, fail
 from bearing_env.train.common.files import write_json_atomically
+from bearing_env.train.common.progress import progress_bar
 from bearing_env.train.common.tables import print_table
 
-DEFAULT_BASELINES = ("random", "parallax", "greedy")
-#: The label the ratio panel divides by (GreedyOneStep's report label).
-REFERENCE_LABEL = "greedy_one_step"
+DEFAULT_BASELINES = ("random", "parallax", "greedy", "lookahead")
+#: The labels the ratio panels divide by (GreedyOneStep's and Lookahead's report labels).
+REFERENCE_LABELS = ("greedy_one_step", "lookahead")
+#: The total-area figures kept per policy and count (see ``bearing-env compare``).
+FIGURES = ("median", "p90", "worst5_mean")
+#: The move count the study reports.
+MOVES = "10"
+
+#: model -> landmark count -> policy label -> figure -> total area after 10 moves.
+Results = dict[str, dict[int, dict[str, dict[str, float]]]]
 
 
 def env_kwargs_for_count(trained: dict[str, Any], count: int) -> dict[str, Any]:
@@ -46,79 +59,103 @@ def env_kwargs_for_count(trained: dict[str, Any], count: int) -> dict[str, Any]:
     return {**trained, "scenario": "random", "n_landmarks": count}
 
 
-def run_counts(
-    model: str,
-    counts: list[int],
-    episodes: int,
-    workers: int,
-    out: Path,
-    resume: bool,
-) -> dict[int, dict[str, float]]:
-    """Median total area after 10 moves, per landmark count and policy label."""
+class StudySettings(NamedTuple):
+    """What every comparison of the study shares."""
+
+    counts: list[int]
+    baselines: list[str]
+    episodes: int
+    workers: int
+    out: Path
+    resume: bool
+
+
+def compare_command(
+    model: str, env_kwargs: dict[str, Any], study: StudySettings, folder: Path
+) -> list[str]:
+    """The ``bearing-env compare`` run of one model and count."""
+    command = [
+        sys.executable,
+        "-m",
+        "bearing_env.train.compare.cli",
+        "--env-kwargs",
+        *format_key_values(env_kwargs),
+        "--policies",
+        *study.baselines,
+        f"pretrained:{model}",
+        "--episodes",
+        str(study.episodes),
+        "--workers",
+        str(study.workers),
+        "--out",
+        str(folder),
+        "--no-progress",
+    ]
+    if study.resume and (folder / "config.json").exists():
+        command.append("--resume")
+    return command
+
+
+def run_model(model: str, study: StudySettings) -> dict[int, dict[str, dict[str, float]]]:
+    """The total area after 10 moves (median, 90th percentile, worst 5% mean) per
+    landmark count and policy label, for one model and the baselines beside it. Each
+    count is its own comparison folder, so an interrupted study resumes count by count."""
     trained = dict(pretrained_record(model).get("env_kwargs", {}))
-    medians: dict[int, dict[str, float]] = {}
-    for count in counts:
-        folder = out / f"n{count}"
-        env_kwargs = env_kwargs_for_count(trained, count)
-        command = [
-            sys.executable,
-            "-m",
-            "bearing_env.train.compare.cli",
-            "--env-kwargs",
-            *format_key_values(env_kwargs),
-            "--policies",
-            *DEFAULT_BASELINES,
-            f"pretrained:{model}",
-            "--episodes",
-            str(episodes),
-            "--workers",
-            str(workers),
-            "--out",
-            str(folder),
-            "--no-progress",
-        ]
-        if resume and (folder / "config.json").exists():
-            command.append("--resume")
-        subprocess.run(command, check=True)
-        summary = json.loads((folder / "summary.json").read_text())
-        medians[count] = {
-            label: float(stats["area_after"]["10"]["median"])
-            for label, stats in summary["policies"].items()
-        }
-    return medians
+    results: dict[int, dict[str, dict[str, float]]] = {}
+    with progress_bar(len(study.counts), desc=model, unit="count", enabled=True) as bar:
+        for count in study.counts:
+            folder = study.out / model / f"n{count}"
+            command = compare_command(model, env_kwargs_for_count(trained, count), study, folder)
+            subprocess.run(command, check=True)
+            summary = json.loads((folder / "summary.json").read_text())
+            results[count] = {
+                label: {name: float(stats["area_after"][MOVES][name]) for name in FIGURES}
+                for label, stats in summary["policies"].items()
+            }
+            bar.update()
+    return results
 
 
-def plot_medians(
-    medians: dict[int, dict[str, float]], model: str, trained_counts: tuple[int, int], path: Path
-) -> Path:
-    """The medians against the landmark count (log scale) and over GreedyOneStep's."""
+def plot_medians(results: Results, training_counts: dict[str, tuple[int, int]], path: Path) -> Path:
+    """The medians against the landmark count (log scale), and each policy's median over
+    GreedyOneStep's and over Lookahead's, with each model's training range shaded."""
     from bearing_env.train.studies.figures import _plt, save_and_close
 
     plt = _plt()
-    counts = sorted(medians)
-    labels = list(medians[counts[0]])
-    figure, (areas, ratios) = plt.subplots(1, 2, figsize=(10, 4))
-    for axes in (areas, ratios):
-        axes.axvspan(*trained_counts, color="0.9", label=f"{model}'s training range")
+    first = next(iter(results.values()))
+    references = [label for label in REFERENCE_LABELS if label in next(iter(first.values()))]
+    figure, panels = plt.subplots(1, 1 + len(references), figsize=(5 * (1 + len(references)), 4))
+    panels = np.atleast_1d(panels)
     colours = plt.get_cmap("tab10").colors
-    for index, label in enumerate(labels):
-        values = [medians[count][label] for count in counts]
-        style = {"linewidth": 2.5 if label == model else 1.2, "color": colours[index % 10]}
-        areas.plot(counts, values, marker="o", label=label, **style)
-        # Random polygonal is several times above the rest: it would flatten that panel.
-        if REFERENCE_LABEL in medians[counts[0]] and label != "random_polygonal":
-            reference = [medians[count][REFERENCE_LABEL] for count in counts]
-            ratio = [value / ref for value, ref in zip(values, reference, strict=True)]
-            ratios.plot(counts, ratio, marker="o", label=label, **style)
-    areas.set_yscale("log")
-    areas.set_xlabel("landmarks")
-    areas.set_ylabel("median total area after 10 moves (FL units², log)")
-    areas.legend(fontsize=8)
-    ratios.axhline(1.0, color="0.4", linewidth=0.8, linestyle="--")
-    ratios.set_xlabel("landmarks")
-    ratios.set_ylabel(f"median ÷ {REFERENCE_LABEL}'s")
-    ratios.legend(fontsize=8)
-    figure.suptitle(f"{model} across landmark counts: random layouts, evaluation seeds")
+    # The baselines once (from the first model's runs), then each model.
+    lines = [(label, first, label) for label in next(iter(first.values())) if label not in results]
+    lines += [(model, results[model], model) for model in results]
+    for index, (label, by_count, name) in enumerate(lines):
+        counts = sorted(by_count)
+        colour = colours[index % 10]
+        values = np.array([by_count[count][label]["median"] for count in counts])
+        style = {"linewidth": 2.5 if name in results else 1.2, "color": colour, "marker": "o"}
+        if name in training_counts:
+            for axes in panels:
+                axes.axvspan(*training_counts[name], color=colour, alpha=0.12)
+        panels[0].plot(counts, values, label=name, **style)
+        for axes, reference in zip(panels[1:], references, strict=True):
+            # Random polygonal is several times above the rest: it would flatten the panel.
+            if label not in ("random_polygonal", reference):
+                ratio = values / np.array([by_count[c][reference]["median"] for c in counts])
+                axes.plot(counts, ratio, label=name, **style)
+    panels[0].set_yscale("log")
+    panels[0].set_ylabel(f"median total area after {MOVES} moves (FL units², log)")
+    for axes, reference in zip(panels[1:], references, strict=True):
+        axes.axhline(1.0, color="0.4", linewidth=0.8, linestyle="--")
+        axes.set_ylabel(f"median ÷ {reference}'s")
+    for axes in panels:
+        axes.set_xlabel("landmarks")
+        axes.legend(fontsize=8)
+    figure.suptitle(
+        "across landmark counts: random layouts, evaluation seeds "
+        "(shaded: each model's training range)"
+    )
     return save_and_close(figure, path, rect=(0, 0, 1, 0.94))
 
 
@@ -126,8 +163,17 @@ def build_parser() -> argparse.ArgumentParser:
     parser = command_parser("bearing-env generalisation", doc_summary(__doc__))
     parser.add_argument(
         "--model",
-        default="ppo_random",
-        help=f"shipped model name: {', '.join(pretrained_names())} (default %(default)s)",
+        nargs="+",
+        default=["ppo_random"],
+        metavar="NAME",
+        help=f"shipped models, one or more: {', '.join(pretrained_names())} (default ppo_random)",
+    )
+    parser.add_argument(
+        "--baselines",
+        nargs="+",
+        default=list(DEFAULT_BASELINES),
+        metavar="SPEC",
+        help="the policies run beside each model (greedy and lookahead give the ratio panels)",
     )
     parser.add_argument(
         "--counts",
@@ -140,9 +186,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--episodes", type=COUNT, default=50, help="evaluation episodes per count and policy"
     )
-    parser.add_argument(
-        "--workers", type=COUNT, default=2, help="processes per comparison, >= 1"
-    )
+    parser.add_argument("--workers", type=COUNT, default=2, help="processes per comparison, >= 1")
     parser.add_argument(
         "--out",
         type=Path,
@@ -153,44 +197,53 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def print_medians(medians: dict[int, dict[str, float]]) -> None:
-    """The medians as one table: a row per landmark count, a column per policy."""
-    labels = list(next(iter(medians.values())))
-    rows = [
-        [str(count), *(f"{row[label]:.3g}" for label in labels)]
-        for count, row in medians.items()
-    ]
-    print_table(
-        "median total area after 10 moves, random layouts (evaluation seeds)",
-        ["landmarks", *labels],
-        rows,
-    )
+def print_results(model: str, results: dict[int, dict[str, dict[str, float]]]) -> None:
+    """One model's tables, median then 90th percentile: a row per landmark count, a
+    column per policy."""
+    labels = list(next(iter(results.values())))
+    for figure, title in (("median", "median"), ("p90", "90th percentile")):
+        rows = [
+            [str(count), *(f"{row[label][figure]:.3g}" for label in labels)]
+            for count, row in results.items()
+        ]
+        print_table(
+            f"{model}: {title} total area after {MOVES} moves, random layouts (evaluation seeds)",
+            ["landmarks", *labels],
+            rows,
+        )
 
 
 def main(argv: Sequence[str] | None = None) -> None:
     parser = build_parser()
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
-    if args.model not in pretrained_names():
-        parser.error(f"unknown model {args.model!r}; shipped: {', '.join(pretrained_names())}")
-    # The env's own resolution of the training settings: their counts and observation slots.
-    trained = EnvConfig.create(**pretrained_record(args.model).get("env_kwargs", {}))
-    max_landmarks = trained.observations.max_landmarks
-    if min(args.counts) < 3 or max(args.counts) > max_landmarks:
-        parser.error(
-            f"--counts must lie in [3, {max_landmarks}]: {args.model} has "
-            f"max_landmarks={max_landmarks} observation slots"
-        )
+    training_counts: dict[str, tuple[int, int]] = {}
+    for model in args.model:
+        if model not in pretrained_names():
+            parser.error(f"unknown model {model!r}; shipped: {', '.join(pretrained_names())}")
+        # The env's own resolution of the training settings: counts and observation slots.
+        trained = EnvConfig.create(**pretrained_record(model).get("env_kwargs", {}))
+        max_landmarks = trained.observations.max_landmarks
+        if min(args.counts) < 3 or max(args.counts) > max_landmarks:
+            parser.error(
+                f"--counts must lie in [3, {max_landmarks}]: {model} has "
+                f"max_landmarks={max_landmarks} observation slots"
+            )
+        training_counts[model] = trained.layout.landmark_counts
     for module in ("stable_baselines3", "torch", "rich", "matplotlib"):
         if not available(module):
             fail(parser.prog, str(MissingExtraError(module, "this command")))
-    medians = run_counts(
-        args.model, args.counts, args.episodes, args.workers, args.out, args.resume
+    study = StudySettings(
+        args.counts, args.baselines, args.episodes, args.workers, args.out, args.resume
     )
-    print_medians(medians)
-    write_json_atomically(args.out / "generalisation.json", {str(k): v for k, v in medians.items()})
-    figure = plot_medians(
-        medians, args.model, trained.layout.landmark_counts, args.out / "generalisation.png"
+    results: Results = {}
+    for model in args.model:
+        results[model] = run_model(model, study)
+        print_results(model, results[model])
+    write_json_atomically(
+        args.out / "generalisation.json",
+        {model: {str(k): v for k, v in by_count.items()} for model, by_count in results.items()},
     )
+    figure = plot_medians(results, training_counts, args.out / "generalisation.png")
     print(f"wrote {args.out / 'generalisation.json'} and {figure}")
 
 
