@@ -1,5 +1,5 @@
 # ruff: noqa: E402  (the imports below need the extra; the module skips without it)
-"""The permutation-invariant landmark-set extractor and its training config."""
+"""The permutation-invariant extractors (deep set, attention) and their training configs."""
 
 from __future__ import annotations
 
@@ -17,15 +17,27 @@ import torch
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.agents import SB3Policy
-from bearing_env.agents.extractors import LandmarkSetExtractor, LandmarkSetPolicy
+from bearing_env.agents.extractors import (
+    LandmarkAttentionExtractor,
+    LandmarkAttentionPolicy,
+    LandmarkSetExtractor,
+    LandmarkSetPolicy,
+)
 from bearing_env.envs.observations import ENTITY_FEATURES
 from bearing_env.train.sb3.train import train
 from bearing_env.train.sb3.zoo import parse_hyperparameters, read_hyperparameters
 from tests.tools.test_train import TINY_TIMESTEPS, tiny_settings
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
-CONF_FILE = REPO_ROOT / "train" / "sb3" / "hyperparams" / "ppo_entities.yml"
+HYPERPARAMS = REPO_ROOT / "train" / "sb3" / "hyperparams"
+CONF_FILE = HYPERPARAMS / "ppo_entities.yml"
 WIDTH = len(ENTITY_FEATURES)
+EXTRACTORS = (LandmarkSetExtractor, LandmarkAttentionExtractor)
+#: Each extractor's policy and shipped hyperparameter file.
+CONFIGS = (
+    (LandmarkSetExtractor, LandmarkSetPolicy, HYPERPARAMS / "ppo_entities.yml"),
+    (LandmarkAttentionExtractor, LandmarkAttentionPolicy, HYPERPARAMS / "ppo_attention.yml"),
+)
 
 
 def entity_batch(max_landmarks: int, seeds: range) -> dict[str, torch.Tensor]:
@@ -43,10 +55,11 @@ def entity_batch(max_landmarks: int, seeds: range) -> dict[str, torch.Tensor]:
     return {"robot": torch.tensor(np.array(robots)), "landmarks": torch.tensor(np.array(tables))}
 
 
-def test_features_ignore_the_order_of_rows_and_the_padding() -> None:
+@pytest.mark.parametrize("extractor_class", EXTRACTORS)
+def test_features_ignore_the_order_of_rows_and_the_padding(extractor_class: type) -> None:
     space = gym.make("BearingSLAM-v0", max_landmarks=8, observation="entities").observation_space
     torch.manual_seed(0)
-    extractor = LandmarkSetExtractor(space, hidden=16, features_dim=8)
+    extractor = extractor_class(space, hidden=16, features_dim=8).eval()
     batch = entity_batch(8, range(4))
     features = extractor(batch)
     assert features.shape == (4, 8)
@@ -65,26 +78,53 @@ def test_features_ignore_the_order_of_rows_and_the_padding() -> None:
     assert not torch.allclose(changed, features)
 
 
-def test_extractor_refuses_the_flat_observation() -> None:
+@pytest.mark.parametrize("extractor_class", EXTRACTORS)
+def test_extractor_refuses_the_flat_observation(extractor_class: type) -> None:
     flat = gym.make("BearingSLAM-v0").observation_space
-    with pytest.raises(TypeError, match="observation='entities'"):
-        LandmarkSetExtractor(flat)  # type: ignore[arg-type]
+    with pytest.raises(
+        TypeError, match=f"{extractor_class.__name__} needs .*observation='entities'"
+    ):
+        extractor_class(flat)
 
 
-def test_the_entities_config_names_the_policy_class() -> None:
-    raw = read_hyperparameters("ppo", "BearingSLAM-v0", CONF_FILE)
+def test_attention_heads_must_divide_the_width() -> None:
+    space = gym.make("BearingSLAM-v0", observation="entities").observation_space
+    with pytest.raises(
+        ValueError, match=r"hidden \(10\) must be a positive multiple of heads \(4\)"
+    ):
+        LandmarkAttentionExtractor(space, hidden=10, heads=4)
+
+
+def test_attention_features_of_an_empty_table_are_finite() -> None:
+    space = gym.make("BearingSLAM-v0", max_landmarks=8, observation="entities").observation_space
+    torch.manual_seed(0)
+    extractor = LandmarkAttentionExtractor(space, hidden=16, features_dim=8).eval()
+    batch = entity_batch(8, range(2))
+    empty = torch.zeros_like(batch["landmarks"])  # no present row at all
+    features = extractor({"robot": batch["robot"], "landmarks": empty})
+    assert torch.isfinite(features).all()
+
+
+@pytest.mark.parametrize(("extractor_class", "policy_class", "conf_file"), CONFIGS)
+def test_the_entities_configs_name_their_policy_class(
+    extractor_class: type, policy_class: type, conf_file: Path
+) -> None:
+    raw = read_hyperparameters("ppo", "BearingSLAM-v0", conf_file)
     parsed = parse_hyperparameters(raw)
-    assert parsed.algorithm_kwargs["policy"] is LandmarkSetPolicy
+    assert parsed.algorithm_kwargs["policy"] is policy_class
     assert parsed.env_kwargs["observation"] == "entities"
     assert parsed.normalize is not None and parsed.normalize["norm_obs_keys"] == ["robot"]
 
 
-def test_a_tiny_run_trains_and_its_model_plays_other_landmark_counts(tmp_path: Path) -> None:
+@pytest.mark.parametrize(("extractor_class", "policy_class", "conf_file"), CONFIGS)
+def test_a_tiny_run_trains_and_its_model_plays_other_landmark_counts(
+    tmp_path: Path, extractor_class: type, policy_class: type, conf_file: Path
+) -> None:
     settings = tiny_settings(
         "ppo",
         tmp_path / "run",
         env_id="BearingSLAM-v0",
-        conf_file=CONF_FILE,
+        conf_file=conf_file,
         hyperparam_overrides={
             "n_steps": 64,
             "batch_size": 64,
@@ -94,7 +134,7 @@ def test_a_tiny_run_trains_and_its_model_plays_other_landmark_counts(tmp_path: P
     )
     result = train(settings)
     assert result.num_timesteps == TINY_TIMESTEPS
-    assert isinstance(result.model.policy.features_extractor, LandmarkSetExtractor)
+    assert type(result.model.policy.features_extractor) is extractor_class
     for count in (3, 16):
         env = gym.make(
             "BearingSLAM-v0",

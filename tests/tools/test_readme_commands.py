@@ -138,6 +138,8 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     ),
     'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_entities)" '
     "--seed 0 --eval-freq 100000 --output runs/ppo_generalist": ("parse", ()),
+    'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_attention)" '
+    "--seed 0 --eval-freq 100000 --output runs/ppo_attention": ("parse", ()),
     "bearing-env train --algo ppo --output runs/ppo_generalist --export "
     "agents/pretrained/ppo_generalist --export-only": ("parse", ()),
     "python -m bearing_env.train.studies.generalisation --model ppo_generalist --counts 3 8 12 16 "
