@@ -316,13 +316,21 @@ class BatchedPolygonSLAM(HasMapSettings):
         for name in STATE_ARRAYS:
             getattr(self, name)[:] = getattr(source, name)[map_index]
 
-    def take(self, maps: ArrayLike) -> BatchedPolygonSLAM:
-        """A new batch whose map ``i`` is a copy of map ``maps[i]`` (indices may repeat):
-        for planning, many candidates from each of a few maps."""
+    def take(self, maps: ArrayLike, into: BatchedPolygonSLAM | None = None) -> BatchedPolygonSLAM:
+        """A batch whose map ``i`` is a copy of map ``maps[i]`` (indices may repeat): for
+        planning, many candidates from each of a few maps. ``into``: a batch from an
+        earlier call to overwrite instead of making a new one, when it has ``len(maps)``
+        maps and this batch's settings (a planner's scratch; else a new batch). It must
+        not be this batch."""
         rows = self._check_maps(maps, distinct=False)
-        copies = self.empty_like(rows.size)
+        if into is self:
+            raise ValueError("take(into=...) must be another batch than the one copied from")
+        if into is not None and into.num_maps == rows.size and into.same_settings(self):
+            copies = into
+        else:
+            copies = self.empty_like(rows.size)
         for name in STATE_ARRAYS:
-            getattr(copies, name)[:] = getattr(self, name)[rows]
+            np.take(getattr(self, name), rows, axis=0, out=getattr(copies, name))
         return copies
 
     @property
