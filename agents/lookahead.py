@@ -37,7 +37,7 @@ import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
-from bearing_env.slam import PolygonSLAM, world_to_fl
+from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM, world_to_fl
 from bearing_env.validation import int_at_least
 
 from .base import Movement
@@ -61,9 +61,7 @@ class Worlds:
     positions: ComplexArray
 
 
-def sample_in_polygon(
-    vertices: ComplexArray, count: int, rng: np.random.Generator
-) -> ComplexArray:
+def sample_in_polygon(vertices: ComplexArray, count: int, rng: np.random.Generator) -> ComplexArray:
     """``count`` points drawn uniformly inside a convex polygon (its vertices, in order)."""
     if vertices.size < 3:
         return np.full(count, vertices.mean() if vertices.size else complex(np.nan, np.nan))
@@ -96,16 +94,23 @@ def beam_search(
     depth: int,
     width: int,
     area_cap: float,
+    scratch: dict[tuple[str, int], BatchedPolygonSLAM] | None = None,
 ) -> tuple[int, float]:
     """The index of the first candidate of the best plan, and that plan's mean score.
 
     Candidates are ``(turns[k], lengths[k])`` (turn relative to the heading, length in
-    metres); only the ``first_allowed`` ones may start a plan.
+    metres); only the ``first_allowed`` ones may start a plan. Each depth's expansions
+    are one batched update (:meth:`BatchedPolygonSLAM.update_trusted`: the bearings are
+    made here) on copies of the beam's maps; ``scratch``: the caller's batches of copies
+    by role and size, kept between calls and refilled in place
+    (:meth:`BatchedPolygonSLAM.take`) instead of made anew at each depth.
     """
+    batches: dict[tuple[str, int], BatchedPolygonSLAM] = {} if scratch is None else scratch
     n_worlds = worlds.positions.size
     known = np.isfinite(worlds.landmarks)  # (H, n)
     targets = np.where(known, worlds.landmarks, 0.0)
-    maps = slam.replicate(n_worlds)  # node 0, one map per world
+    maps = slam.replicate(n_worlds, into=batches.get(("root", n_worlds)))  # node 0, per world
+    batches["root", n_worlds] = maps
     positions = worlds.positions[None, :]  # (nodes, H)
     headings = np.array([heading])  # (nodes,)
     firsts = np.array([-1])
@@ -125,13 +130,14 @@ def beam_search(
         # A landmark without a region, or a move too short, gives no information.
         moving = (distances > 0.0)[..., None] & known[None, None, :, :]
         b2 = np.where(moving, b2, b1)
-        rows = (np.arange(n_nodes)[:, None, None] * n_worlds + np.arange(n_worlds)[None, None, :])
+        rows = np.arange(n_nodes)[:, None, None] * n_worlds + np.arange(n_worlds)[None, None, :]
         rows = np.broadcast_to(rows, step.shape).reshape(-1)
-        trials = maps.take(rows.astype(np.int64))
+        trials = maps.take(rows.astype(np.int64), into=batches.get(("trials", rows.size)))
+        batches["trials", rows.size] = trials
         n = slam.n_landmarks
-        trials.update(
-            np.ascontiguousarray(b1.reshape(-1, n)),
-            np.ascontiguousarray(b2.reshape(-1, n)),
+        trials.update_trusted(
+            np.ascontiguousarray(b1.reshape(-1, n), dtype=np.float64),
+            np.ascontiguousarray(b2.reshape(-1, n), dtype=np.float64),
             robot=False,
         )
         potentials = uncertainty_potential(trials.areas, area_cap).reshape(n_nodes, n_k, n_worlds)
@@ -145,7 +151,9 @@ def beam_search(
         keep = order[: min(width, order.size)]
         node_index, k_index = np.unravel_index(keep, scores.shape)
         chosen = (node_index * n_k + k_index)[:, None] * n_worlds + np.arange(n_worlds)[None, :]
-        maps = trials.take(chosen.reshape(-1).astype(np.int64))
+        chosen_rows = chosen.reshape(-1).astype(np.int64)
+        maps = trials.take(chosen_rows, into=batches.get(("beam", chosen_rows.size)))
+        batches["beam", chosen_rows.size] = maps
         positions = ends[node_index, k_index]
         headings = new_headings[node_index, k_index]
         firsts = node_firsts[node_index, k_index]
@@ -191,6 +199,8 @@ class Lookahead(GreedyOneStep):
         self.depth, self.width, self.hypotheses = depth, width, hypotheses
         self.min_baseline = float(bearing_env_of(env).config.layout.arena.min_baseline)
         self.planning_times: list[float] = []
+        #: The beam's copies of the map, by role and size, refilled at each decision.
+        self._beam: dict[tuple[str, int], BatchedPolygonSLAM] = {}
 
     def reset(self, seed: int | None = None) -> None:
         super().reset(seed)
@@ -225,8 +235,17 @@ class Lookahead(GreedyOneStep):
         lengths = np.array([c.length for c in self.candidates])
         allowed = _allowed_turns(turns, view)
         first, score = beam_search(
-            slam, worlds, heading, turns, lengths, allowed, mover, self.depth, self.width,
+            slam,
+            worlds,
+            heading,
+            turns,
+            lengths,
+            allowed,
+            mover,
+            self.depth,
+            self.width,
             self.area_cap,
+            scratch=self._beam,
         )
         if first < 0 or score >= uncertainty_potential(slam.areas, self.area_cap):
             return bootstrap_movement(self.codec, view)

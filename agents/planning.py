@@ -43,6 +43,17 @@ def _potentials_of_rows(
         out[i] = potential_of(rows[i], rows.shape[1], log_area, floor, cap)
 
 
+@njit(**JIT_OPTIONS)
+def _move_ends(
+    start: complex, headings: np.ndarray, distances: np.ndarray, out: np.ndarray
+) -> None:
+    """``out[k]``: where candidate ``k`` ends, in one compiled loop. math.cos and math.sin
+    (libm's, as Python's math module calls them), so the ends are the same bit for bit
+    as when they were computed one candidate at a time in Python."""
+    for k in range(headings.size):
+        out[k] = start + distances[k] * complex(math.cos(headings[k]), math.sin(headings[k]))
+
+
 def bearings_from(
     position: complex | NDArray[np.complex128],
     heading: float | NDArray[np.float64],
@@ -94,13 +105,8 @@ def simulate_potentials(
     headings, distances = headings[moving], distances[moving]
     known = np.isfinite(landmarks)
     targets = np.where(known, landmarks, 0.0)
-    # math.cos/sin, as one candidate at a time did, so decisions do not depend on batching.
-    ends = np.array(
-        [
-            start + distance * complex(math.cos(heading), math.sin(heading))
-            for heading, distance in zip(headings.tolist(), distances.tolist(), strict=True)
-        ]
-    )
+    ends = np.empty(headings.size, dtype=np.complex128)
+    _move_ends(complex(start), headings, distances, ends)
     bearings_start = bearings_from(start, headings, targets)
     bearings_end = np.where(known, bearings_from(ends, headings, targets), bearings_start)
     if scratch is None:

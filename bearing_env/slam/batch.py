@@ -17,6 +17,7 @@ environment reproduce the single environment bit for bit.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -245,30 +246,37 @@ class BatchedPolygonSLAM(HasMapSettings):
         that made the bearings themselves (a planner's simulated readings), as C-contiguous
         float64 arrays (num_maps, n_landmarks) with no infinite value. Wrong input here is
         not caught: it can corrupt the maps."""
-        return self._update_checked(
-            bearings_start, bearings_end, np.arange(self.num_maps), robot
-        )
+        return self._update_checked(bearings_start, bearings_end, np.arange(self.num_maps), robot)
 
     def _update_checked(
         self, b1: FloatArray, b2: FloatArray, rows: IntArray, robot: bool = True
     ) -> BatchUpdateResult:
         """:meth:`update` on checked input (float arrays (len(rows), n), distinct rows)."""
         n_rows, n_mapped = rows.size, self.n_landmarks - 2
+        # Fresh outputs: the result hands them out.
         out = kernels.Outputs(
             np.empty(n_rows, dtype=np.int8),
             np.empty((n_rows, n_mapped), dtype=np.int8),
             np.empty(n_rows, dtype=np.int64),
         )
-        params = self._kernel_params(bool(robot))
-        threads = kernels.threads() if n_rows >= PARALLEL_MIN_MAPS else 1
-        if threads > 1:
-            kernels.update_maps_parallel(
-                min(n_rows, threads), b1, b2, rows, params, self._kernel_state(), out
-            )
-        else:
-            kernels.update_maps(b1, b2, rows, params, self._kernel_state(), out)
+        self._run_update(b1, b2, rows, bool(robot), out)
         frame, landmark, bad = out
         return BatchUpdateResult(frame == FRAME_CODE["ok"], frame, landmark, bad)
+
+    def _run_update(
+        self, b1: FloatArray, b2: FloatArray, rows: IntArray, robot: bool, out: kernels.Outputs
+    ) -> None:
+        """The update kernel on checked input, writing what it did to ``out`` (arrays
+        over ``rows``): serial, or on all of numba's threads for a large batch."""
+        params = self._kernel_params(robot)
+        if rows.size >= PARALLEL_MIN_MAPS and (threads := kernels.threads()) > 1:
+            blocks = min(rows.size, threads)
+            _call(
+                kernels.update_maps_parallel,
+                (blocks, b1, b2, rows, params, self._kernel_state(), out),
+            )
+        else:
+            _call(kernels.update_maps, (b1, b2, rows, params, self._kernel_state(), out))
 
     def contains(self, points: ArrayLike, maps: ArrayLike | None = None) -> NDArray[np.bool_]:
         """Whether region ``i`` of each map contains FL point ``i`` (boundary counts).
@@ -308,13 +316,21 @@ class BatchedPolygonSLAM(HasMapSettings):
         for name in STATE_ARRAYS:
             getattr(self, name)[:] = getattr(source, name)[map_index]
 
-    def take(self, maps: ArrayLike) -> BatchedPolygonSLAM:
-        """A new batch whose map ``i`` is a copy of map ``maps[i]`` (indices may repeat):
-        for planning, many candidates from each of a few maps."""
+    def take(self, maps: ArrayLike, into: BatchedPolygonSLAM | None = None) -> BatchedPolygonSLAM:
+        """A batch whose map ``i`` is a copy of map ``maps[i]`` (indices may repeat): for
+        planning, many candidates from each of a few maps. ``into``: a batch from an
+        earlier call to overwrite instead of making a new one, when it has ``len(maps)``
+        maps and this batch's settings (a planner's scratch; else a new batch). It must
+        not be this batch."""
         rows = self._check_maps(maps, distinct=False)
-        copies = self.empty_like(rows.size)
+        if into is self:
+            raise ValueError("take(into=...) must be another batch than the one copied from")
+        if into is not None and into.num_maps == rows.size and into.same_settings(self):
+            copies = into
+        else:
+            copies = self.empty_like(rows.size)
         for name in STATE_ARRAYS:
-            getattr(copies, name)[:] = getattr(self, name)[rows]
+            np.take(getattr(self, name), rows, axis=0, out=getattr(copies, name))
         return copies
 
     @property
@@ -383,6 +399,20 @@ class BatchedPolygonSLAM(HasMapSettings):
                 state[key] = value.copy()
         state["_state_ref"] = None
         self.__dict__.update(state)
+
+
+#: Each update kernel's compiled function, resolved at its first call (see
+#: :func:`bearing_env.slam.kernels.entry_point`): every batch passes it arguments of the
+#: same types (checked float64 bearings, int64 rows, the kernels' own structures).
+_ENTRY_POINTS: dict[object, Callable[..., None]] = {}
+
+
+def _call(kernel: Callable[..., None], args: tuple[Any, ...]) -> None:
+    """``kernel(*args)`` through its compiled function, without numba's per-call typing."""
+    entry = _ENTRY_POINTS.get(kernel)
+    if entry is None:
+        entry = _ENTRY_POINTS[kernel] = kernels.entry_point(kernel, args)
+    entry(*args)
 
 
 #: The per-map state, every array with the map axis first: the fields of

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import shapely
@@ -191,6 +192,9 @@ class PolygonSLAM(HasMapSettings):
         self._index = index
         self._rows = np.array([index])
         self.n_landmarks = batch.n_landmarks
+        # What the kernel reports for this map's updates, made at the first and written
+        # in place by each one (PolygonSLAM.update hands out copies only).
+        self._outputs: kernels.Outputs | None = None
         #: The map's settings (validated; ``self.epsilon`` and the others read them).
         self.settings = batch.settings
 
@@ -289,16 +293,30 @@ class PolygonSLAM(HasMapSettings):
         b1 = self._check_bearings(bearings_start, "bearings_start")
         b2 = self._check_bearings(bearings_end, "bearings_end")
         # Checked above, for this map's shape; the batch need not check again.
-        result = self._batch._update_checked(b1[None], b2[None], self._rows)
+        out = self._outputs
+        if out is None:
+            out = self._outputs = kernels.Outputs(
+                np.empty(1, dtype=np.int8),
+                np.empty((1, self.n_landmarks - 2), dtype=np.int8),
+                np.empty(1, dtype=np.int64),
+            )
+        self._batch._run_update(b1[None], b2[None], self._rows, True, out)
+        frame = FRAME_STATUSES[out.frame_status[0]]
         return UpdateResult(
-            frame_changed=bool(result.frame_changed[0]),
-            frame_status=FRAME_STATUSES[result.frame_status[0]],
-            landmark_status=_LANDMARK_NAMES[result.landmark_status[0]],
-            n_inconsistent=int(result.n_inconsistent[0]),
+            frame_changed=frame == FRAME_OK,
+            frame_status=frame,
+            landmark_status=_LANDMARK_NAMES[out.landmark_status[0]],  # a new array
+            n_inconsistent=int(out.n_bad[0]),
         )
 
     def _check_bearings(self, bearings: ArrayLike, name: str) -> NDArray[np.float64]:
         return check_bearings(bearings, (self.n_landmarks,), name)
+
+    def __getstate__(self) -> dict[str, Any]:
+        # The outputs are made again (an out-of-band pickle would make them read-only).
+        state = self.__dict__.copy()
+        state["_outputs"] = None
+        return state
 
     # -- queries -----------------------------------------------------------------------------
 

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
-from bearing_env.slam import PolygonSLAM
+from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
 from bearing_env.slam.batch import STATE_ARRAYS
 
 
@@ -40,3 +41,33 @@ def test_replicate_into_a_batch_that_does_not_fit_makes_a_new_one() -> None:
     assert slam.replicate(3, into=wrong_count) is not wrong_count
     other_settings = PolygonSLAM(5, np.deg2rad(2.0), transfer="paper").replicate(3)
     assert slam.replicate(3, into=other_settings) is not other_settings
+
+
+def test_take_into_overwrites_the_scratch_with_the_same_copies() -> None:
+    source = _mapped(3).replicate(3)
+    source.update_trusted(*(np.ascontiguousarray(b) for b in _bearings_for(source, 4)))
+    rows = np.array([2, 0, 2, 1])
+    scratch = _mapped(4).replicate(4)
+    refilled = source.take(rows, into=scratch)
+    fresh = source.take(rows)
+    assert refilled is scratch
+    for name in STATE_ARRAYS:
+        np.testing.assert_array_equal(getattr(refilled, name), getattr(fresh, name), err_msg=name)
+
+
+def test_take_into_refuses_the_batch_it_copies_from() -> None:
+    batch = _mapped(5).replicate(2)
+    with pytest.raises(ValueError, match="another batch"):
+        batch.take(np.array([1, 0]), into=batch)
+
+
+def _bearings_for(batch: BatchedPolygonSLAM, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Noise-free bearings of a different seeded move for each map of ``batch``."""
+    rng = np.random.default_rng(seed)
+    landmarks = np.array([0.0, 1.0, 0.4 + 0.8j, 0.7 - 0.6j, -0.5 + 0.3j])
+    start = rng.uniform(-1.5, 1.5, batch.num_maps) + 1j * rng.uniform(-1.5, 1.5, batch.num_maps)
+    step = 0.5 * np.exp(1j * rng.uniform(-np.pi, np.pi, batch.num_maps))
+    heading = np.angle(step)[:, None]
+    b1 = np.angle(landmarks[None, :] - start[:, None]) - heading
+    b2 = np.angle(landmarks[None, :] - (start + step)[:, None]) - heading
+    return b1, b2

@@ -9,6 +9,8 @@ or in numba's user-wide cache directory when the package folder is read-only, or
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
+from typing import Any, cast
 
 import numba
 import numpy as np
@@ -73,6 +75,27 @@ _JIT: JitOptions = JIT_OPTIONS
 if "NUMBA_THREADING_LAYER" not in os.environ:
     # why: numba.config defines its settings at import through globals(), unseen by mypy
     numba.config.THREADING_LAYER = "workqueue"  # type: ignore[attr-defined]
+
+
+def entry_point(dispatcher: Any, args: tuple[Any, ...]) -> Callable[..., Any]:
+    """The compiled function ``dispatcher`` runs for the types of ``args`` (compiled, or
+    loaded from the cache, first if need be), to be called directly with arguments of
+    exactly those types.
+
+    A dispatcher types every argument in Python on each call: about 4 us each for a
+    structref or a namedtuple (measured), so about 15 us of a 4-landmark update's call
+    went to typing its state, settings and outputs. The compiled function only unboxes
+    them. It checks no type: callers pass arrays they made themselves, of the types they
+    were resolved with. Falls back on the dispatcher if numba's internals (``overloads``,
+    ``entry_point``) are not as expected.
+    """
+    try:
+        key = tuple(dispatcher.typeof_pyval(arg) for arg in args)
+        if key not in dispatcher.overloads:
+            dispatcher.compile(key)
+        return cast(Callable[..., Any], dispatcher.overloads[key].entry_point)
+    except (AttributeError, KeyError, TypeError):  # why: numba's dispatcher is not public API
+        return cast(Callable[..., Any], dispatcher)
 
 
 def threads() -> int:

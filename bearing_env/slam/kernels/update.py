@@ -101,7 +101,10 @@ def _transfer_robot(
 ) -> None:
     """Map ``row``'s robot region (the FR point R2 = 1 in FL) and heading."""
     fresh = scratch.fresh
-    n_robot = transfer_region(robot_point, 1, frame, scratch.cloud, scratch.hull, fresh)
+    # robot_point.size, not 1: a literal argument compiles one more specialisation.
+    n_robot = transfer_region(
+        robot_point, robot_point.size, frame, scratch.cloud, scratch.hull, fresh
+    )
     for v in range(n_robot):
         state.robot_vertices[row, v] = fresh[v]
     state.robot_counts[row] = n_robot
