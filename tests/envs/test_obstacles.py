@@ -17,6 +17,7 @@ from bearing_env.obstacles import random_obstacles
 from bearing_env.sensing import clearance
 from bearing_env.world import SCENARIOS
 from tests.envs.test_env_vector import assert_same, make_pair
+from tests.extras import needs
 
 BOX = [[0.4, 0.3], [0.6, 0.3], [0.6, 0.45], [0.4, 0.45]]
 
@@ -184,3 +185,34 @@ def test_the_vector_env_is_bit_exact_on_the_new_tasks(task_id: str) -> None:
         assert_same(batched.step(actions), reference.step(actions))
     batched.close()
     reference.close()
+
+
+@needs("render")
+def test_the_frame_shows_the_obstacles_the_field_of_view_and_the_missed_landmarks() -> None:
+    from bearing_env.rendering import MISSED, OBSTACLE, FieldLayout
+
+    env = gym.make("BearingSLAM-v0", scenario="furnished_room", field_of_view_deg=90,
+                   render_mode="rgb_array")  # fmt: skip
+    env.reset(seed=2)
+    env.action_space.seed(2)
+    world = env.unwrapped.world  # type: ignore[attr-defined]
+    for _ in range(20):  # until a reading has seen some landmarks and missed others
+        env.step(env.action_space.sample())
+        missed = np.isnan(env.unwrapped._state.latest_bearings[0, : world.n_landmarks])  # type: ignore[attr-defined]
+        if missed.any() and not missed.all():
+            break
+    assert missed.any() and not missed.all()
+    frame = env.render()
+    assert frame is not None
+    layout = FieldLayout.for_arena(env.unwrapped.config.arena)  # type: ignore[attr-defined]
+    x, y = layout.to_pixels(np.array([1.0, 0.7])).astype(int)  # the table's centre
+    assert tuple(frame[y, x]) == OBSTACLE
+    for landmark, is_missed in zip(world.landmarks, missed, strict=True):
+        px, py = layout.to_pixels(landmark).astype(int)
+        assert (tuple(frame[py, px]) == MISSED) == is_missed
+    panoramic = gym.make("BearingSLAM-v0", scenario="furnished_room", render_mode="rgb_array")
+    panoramic.reset(seed=2)
+    # The yellow wedge tints the field ahead of the camera only with a limited one.
+    assert not np.array_equal(frame, panoramic.render())
+    env.close()
+    panoramic.close()
