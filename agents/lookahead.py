@@ -43,8 +43,8 @@ from bearing_env.validation import int_at_least
 from .base import Movement
 from .belief import ObservationView
 from .env_access import bearing_env_of
-from .heuristics import GreedyOneStep, _allowed_turns, bootstrap_movement
-from .planning import bearings_from, uncertainty_potential
+from .heuristics import GreedyOneStep, _allowed_turns
+from .planning import Sensor, bearings_from, uncertainty_potential
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -96,11 +96,13 @@ def beam_search(
     depth: int,
     width: int,
     area_cap: float,
+    sensor: Sensor | None = None,
 ) -> tuple[int, float]:
     """The index of the first candidate of the best plan, and that plan's mean score.
 
     Candidates are ``(turns[k], lengths[k])`` (turn relative to the heading, length in
-    metres); only the ``first_allowed`` ones may start a plan.
+    metres); only the ``first_allowed`` ones may start a plan. ``sensor`` predicts the
+    readings' misses (its landmarks are the worlds'; None: every landmark seen).
     """
     n_worlds = worlds.positions.size
     known = np.isfinite(worlds.landmarks)  # (H, n)
@@ -125,6 +127,8 @@ def beam_search(
         # A landmark without a region, or a move too short, gives no information.
         moving = (distances > 0.0)[..., None] & known[None, None, :, :]
         b2 = np.where(moving, b2, b1)
+        if sensor is not None:
+            b1, b2 = sensor(b1, starts, heading_grid), sensor(b2, ends, heading_grid)
         rows = (np.arange(n_nodes)[:, None, None] * n_worlds + np.arange(n_worlds)[None, None, :])
         rows = np.broadcast_to(rows, step.shape).reshape(-1)
         trials = maps.take(rows.astype(np.int64))
@@ -199,7 +203,7 @@ class Lookahead(GreedyOneStep):
     def _choose(self, view: ObservationView, slam: PolygonSLAM) -> Movement:
         pose = self.belief.pose(slam)
         if pose is None or pose.metres_per_unit is None:
-            return bootstrap_movement(self.codec, view)
+            return self._bootstrap(view)
         scale = pose.metres_per_unit
         started = time.perf_counter()
         worlds = self._worlds(slam, pose.position)
@@ -209,7 +213,8 @@ class Lookahead(GreedyOneStep):
             shape = (positions.shape[0], lengths.size, positions.shape[1])
             return np.broadcast_to((metres / scale)[None, :, None], shape)
 
-        movement = self._search(view, slam, worlds, pose.heading, mover)
+        sensor = self._sensor(view, pose, worlds.landmarks)
+        movement = self._search(view, slam, worlds, pose.heading, mover, sensor)
         self.planning_times.append(time.perf_counter() - started)
         return movement
 
@@ -220,16 +225,17 @@ class Lookahead(GreedyOneStep):
         worlds: Worlds,
         heading: float,
         mover: Mover,
+        sensor: Sensor | None = None,
     ) -> Movement:
         turns = np.array([c.turn for c in self.candidates])
         lengths = np.array([c.length for c in self.candidates])
         allowed = _allowed_turns(turns, view)
         first, score = beam_search(
             slam, worlds, heading, turns, lengths, allowed, mover, self.depth, self.width,
-            self.area_cap,
+            self.area_cap, sensor,
         )
         if first < 0 or score >= uncertainty_potential(slam.areas, self.area_cap):
-            return bootstrap_movement(self.codec, view)
+            return self._bootstrap(view)
         return self.candidates[first]
 
     def _worlds(self, slam: PolygonSLAM, position: complex) -> Worlds:
