@@ -221,9 +221,20 @@ class RobotBelief:
             if not view.blocked:
                 self._legs.append((self._turn_since_fix, movement.length))
 
-    def commanded(self, movement: Movement, view: ObservationView) -> None:
-        """Remember the movement about to be sent, with the reading it started from."""
-        self._pending = (movement, view.readings)
+    def commanded(
+        self,
+        movement: Movement,
+        view: ObservationView,
+        remembered: NDArray[np.float64] | None = None,
+    ) -> None:
+        """Remember the movement about to be sent, with the reading it started from; a
+        landmark that reading missed takes its ``remembered`` bearing when given (a
+        forward camera's :class:`~bearing_env.agents.visibility.BearingMemory`: stale by
+        the moves since it was seen, so a rougher scale sample than none)."""
+        readings = view.readings
+        if remembered is not None and remembered.size == readings.size:
+            readings = np.where(view.seen, readings, remembered)
+        self._pending = (movement, readings)
 
     def metres_per_unit(self) -> float | None:
         samples = self._scale_samples or self._blocked_samples

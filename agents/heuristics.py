@@ -240,7 +240,8 @@ class BeliefPolicy(MovementPolicy):
         self.memory.observe(view.bearings, view.seen, view.progress == 0.0)
 
     def _commanded(self, movement: Movement, view: ObservationView) -> None:
-        self.belief.commanded(movement, view)
+        remembered = self.memory.bearings if self.half_fov < math.pi else None
+        self.belief.commanded(movement, view, remembered)
         self.memory.commanded(movement.turn)
 
     def _bootstrap(self, view: ObservationView) -> Movement:
