@@ -56,25 +56,34 @@ def test_a_landmark_inside_an_obstacle_is_refused() -> None:
         EnvConfig.create(scenario="khepera", obstacles=[around_l1])
 
 
-def test_obstacle_files_json_and_yaml(tmp_path: Path) -> None:
-    pytest.importorskip("yaml")
-    data = {"obstacles": [BOX, {"name": "crate", "vertices": [[0.8, 0.5], [0.9, 0.5], [0.85, 0.6]]}]}  # noqa: E501
+CRATE = [[0.8, 0.5], [0.9, 0.5], [0.85, 0.6]]
+
+
+def test_obstacle_files_json(tmp_path: Path) -> None:
+    data = {"obstacles": [BOX, {"name": "crate", "vertices": CRATE}]}
     (tmp_path / "room.json").write_text(json.dumps(data))
-    (tmp_path / "room.yaml").write_text(
-        "obstacles:\n  - [[0.4, 0.3], [0.6, 0.3], [0.6, 0.45], [0.4, 0.45]]\n"
-        "  - name: crate\n    vertices: [[0.8, 0.5], [0.9, 0.5], [0.85, 0.6]]\n"
-    )
     from_json = EnvConfig.create(scenario="khepera", obstacles=str(tmp_path / "room.json"))
-    from_yaml = EnvConfig.create(scenario="khepera", obstacles=tmp_path / "room.yaml")
-    crate = [[0.8, 0.5], [0.9, 0.5], [0.85, 0.6]]
-    inline = EnvConfig.create(scenario="khepera", obstacles=[BOX, crate])
-    assert from_json == from_yaml == inline and len(inline.obstacles) == 2
+    inline = EnvConfig.create(scenario="khepera", obstacles=[BOX, CRATE])
+    assert from_json == inline and len(inline.obstacles) == 2
     (tmp_path / "bad.json").write_text(json.dumps({"walls": []}))
     with pytest.raises(ValueError, match="'obstacles' list"):
         EnvConfig.create(scenario="khepera", obstacles=tmp_path / "bad.json")
     (tmp_path / "broken.json").write_text("{")
     with pytest.raises(ValueError, match="not valid JSON"):
         EnvConfig.create(scenario="khepera", obstacles=tmp_path / "broken.json")
+
+
+@needs("train", "yaml")
+def test_obstacle_files_yaml(tmp_path: Path) -> None:
+    (tmp_path / "room.yaml").write_text(
+        "obstacles:\n  - [[0.4, 0.3], [0.6, 0.3], [0.6, 0.45], [0.4, 0.45]]\n"
+        "  - name: crate\n    vertices: [[0.8, 0.5], [0.9, 0.5], [0.85, 0.6]]\n"
+    )
+    from_yaml = EnvConfig.create(scenario="khepera", obstacles=tmp_path / "room.yaml")
+    assert from_yaml == EnvConfig.create(scenario="khepera", obstacles=[BOX, CRATE])
+    (tmp_path / "broken.yml").write_text("obstacles: [[[0, 0]")
+    with pytest.raises(ValueError, match="not valid YAML"):
+        EnvConfig.create(scenario="khepera", obstacles=tmp_path / "broken.yml")
 
 
 def test_random_obstacles_are_seeded_and_apart() -> None:
