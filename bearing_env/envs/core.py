@@ -36,6 +36,7 @@ from bearing_env.envs.kernels import Settings
 from bearing_env.envs.observations import FL_COORD_LIMIT, observation_size
 from bearing_env.envs.state import BatchState
 from bearing_env.numerics import wrap_angle
+from bearing_env.sensing import visible_rows
 from bearing_env.slam import MapSettings, PolygonSLAM
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
@@ -140,7 +141,8 @@ class Group(NamedTuple):
 
 def kernel_settings(n_landmarks: int, config: EnvConfig) -> Settings:
     """The kernels' settings of a group of ``config`` with ``n_landmarks`` landmarks."""
-    arena, task = config.layout.arena, config.task
+    arena, task, sensor = config.layout.arena, config.task, config.sensor
+    vertices, starts = config.layout.packed_obstacles
     return Settings(
         n=int(n_landmarks),
         n_slots=int(config.observations.max_landmarks),
@@ -157,6 +159,10 @@ def kernel_settings(n_landmarks: int, config: EnvConfig) -> Settings:
         move_cost=float(task.move_cost),
         coordinate_limit=FL_COORD_LIMIT,
         tolerance=CONTAINMENT_TOLERANCE,
+        half_fov=sensor.half_fov,
+        max_range=sensor.max_range,
+        obstacle_vertices=vertices,
+        obstacle_starts=starts,
     )
 
 
@@ -291,13 +297,17 @@ def reset_rows(
     layout, noise = config.layout, config.sensor.noise
     lo, hi = layout.landmark_counts
     fixed = layout.fixed_landmarks
+    obstacles = layout.packed_obstacles if layout.obstacles else None
     state.landmarks[rows] = 0.0
     state.landmarks_fl[rows] = 0.0
     for row, rng in zip(rows.tolist(), rngs, strict=True):
         # Rejection sampling makes the draws per row: a layout's draw count varies.
         count = int(rng.integers(lo, hi + 1)) if hi > lo else hi
-        landmarks = fixed if fixed is not None else random_layout(rng, layout.arena, count)
-        position, heading = random_start(rng, layout.arena, landmarks)
+        if fixed is not None:
+            landmarks = fixed
+        else:
+            landmarks = random_layout(rng, layout.arena, count, obstacles=obstacles)
+        position, heading = random_start(rng, layout.arena, landmarks, obstacles=obstacles)
         state.n_landmarks[row] = count
         state.landmarks[row, :count] = landmarks
         state.positions[row] = position
@@ -324,11 +334,24 @@ def reset_rows(
         )
         group_rngs = [rng_of[i] for i in group.tolist()]
         readings = noise.corrupt_rows(group_rngs, truth, config.epsilon)
+        readings[~sees(state, group, n, config)] = np.nan
         state.latest_bearings[group] = 0.0
         state.latest_bearings[group, :n] = readings
         rows_group = maps.group(state, group, config)
         rows_group.batch.reset(group)
         state.potentials[group] = potentials(state, rows_group)
+
+
+def sees(state: BatchState, rows: IntArray, n: int, config: EnvConfig) -> BoolArray:
+    """Which of their ``n`` landmarks the rows' sensors see from their poses (len(rows), n)."""
+    out = np.empty((rows.size, n), dtype=bool)
+    vertices, starts = config.layout.packed_obstacles
+    sensor = config.sensor
+    visible_rows(
+        state.landmarks[rows, :n], state.positions[rows], state.headings[rows],
+        sensor.half_fov, sensor.max_range, vertices, starts, out,
+    )
+    return out
 
 
 def group_rows(state: BatchState, rows: IntArray) -> list[tuple[int, IntArray]]:
@@ -500,6 +523,9 @@ def infos(state: BatchState, group: Group, outcome: StepOutcome) -> dict[str, An
     observations = group.config.observations
     if observations.robot_map_info:
         infos[robot_map.KEY] = robot_map.encode(batch, rows, observations.max_landmarks - 2)
+    if observations.sensor_info:
+        infos["seen"] = ~np.isnan(state.latest_bearings[rows, : group.n])
+        infos["blocked"] = state.blocked[rows].copy()
     return infos
 
 

@@ -27,9 +27,10 @@ from numpy.typing import NDArray
 from bearing_env.envs.observations import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
 from bearing_env.numerics import JIT_OPTIONS as _JIT
 from bearing_env.numerics import wrap
+from bearing_env.sensing import visible
 from bearing_env.slam.kernels import State as MapState
 from bearing_env.slam.kernels import contains_point
-from bearing_env.world import bearing, straight_move
+from bearing_env.world import bearing, obstructed_move
 
 if TYPE_CHECKING:  # only for annotations: that module imports this one
     from bearing_env.envs.state import BatchState
@@ -63,6 +64,10 @@ class Settings(NamedTuple):
     move_cost: float  #: per move
     coordinate_limit: float  #: FL coordinates are clipped to +-this in the observation
     tolerance: float  #: relative tolerance of the info's containment test
+    half_fov: float  #: half the sensor's field of view, radians (pi: panoramic)
+    max_range: float  #: the sensor's range, metres (inf: no limit)
+    obstacle_vertices: FloatArray  #: the obstacles, packed (see bearing_env.sensing)
+    obstacle_starts: NDArray[np.int64]
 
 
 class Inputs(NamedTuple):
@@ -112,6 +117,20 @@ def _noisy(true_bearing: float, offset: float, is_outlier: bool, replacement: fl
 
 
 @njit(**_JIT)
+def _read(
+    settings: Settings, x: float, y: float, heading: float, lx: float, ly: float, reading: float
+) -> float:
+    """The reading of the landmark at (lx, ly) from a pose: NaN (missed) unless the
+    sensor sees it (field of view, range, line of sight)."""
+    if visible(
+        x, y, heading, lx, ly, settings.half_fov, settings.max_range,
+        settings.obstacle_vertices, settings.obstacle_starts,
+    ):
+        return reading
+    return math.nan
+
+
+@njit(**_JIT)
 def move_and_read(
     rows: np.ndarray,
     turns: np.ndarray,
@@ -123,10 +142,12 @@ def move_and_read(
     reading_start: np.ndarray,
     reading_end: np.ndarray,
 ) -> None:
-    """Turn, read, move straight until the wall margin, read again; for each row.
+    """Turn, read, move straight until the wall margin or an obstacle's, read again; for
+    each row.
 
     The readings are the true bearings plus the rows' pre-drawn noise (``first``,
-    ``second``; see :meth:`~bearing_env.world.NoiseModel.draw_rows`), wrapped; out in
+    ``second``; see :meth:`~bearing_env.world.NoiseModel.draw_rows`), wrapped, or NaN
+    for a landmark the sensor does not see (:func:`_read`); out in
     ``reading_start`` and ``reading_end`` (len(rows), n) and ``travelled``. In place:
     the rows' pose, start position, readings, move count and blocked flag. A robot that
     could not move at least ``min_baseline`` does not move (see
@@ -139,15 +160,14 @@ def move_and_read(
         row = rows[i]
         heading = wrap(state.headings[row] + turns[i])
         x, y = state.positions[row, 0], state.positions[row, 1]
-        new_x, new_y, distance, stopped = straight_move(
+        new_x, new_y, distance, stopped = obstructed_move(
             x,
             y,
             heading,
             lengths[i],
-            settings.width,
-            settings.height,
-            settings.margin,
-            settings.min_baseline,
+            (settings.width, settings.height, settings.margin, settings.min_baseline),
+            settings.obstacle_vertices,
+            settings.obstacle_starts,
         )
         for j in range(settings.n):
             lx, ly = state.landmarks[row, j, 0], state.landmarks[row, j, 1]
@@ -157,6 +177,7 @@ def move_and_read(
                 outlier_start[i, j],
                 replacement_start[i, j],
             )
+            reading = _read(settings, x, y, heading, lx, ly, reading)
             reading_start[i, j] = state.start_bearings[row, j] = reading
             reading = _noisy(
                 bearing(lx, ly, new_x, new_y, heading),
@@ -164,6 +185,7 @@ def move_and_read(
                 outlier_end[i, j],
                 replacement_end[i, j],
             )
+            reading = _read(settings, new_x, new_y, heading, lx, ly, reading)
             reading_end[i, j] = state.latest_bearings[row, j] = reading
         state.start_positions[row, 0], state.start_positions[row, 1] = x, y
         state.positions[row, 0], state.positions[row, 1] = new_x, new_y
