@@ -175,8 +175,10 @@ def _encode_levels(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cove
     level_vertices = np.zeros((size, slots, levels, capacity), np.complex128)
     level_counts = np.zeros((size, slots, levels), np.int64)
     n_regions = np.zeros((size, slots), np.int64)
+    robot_fixed_at = np.empty(size, np.int64)
     for i in range(size):
         row = rows[i]
+        robot_fixed_at[i] = state.robot_fixed_at[row]
         for j in range(mapped):
             outliers[i, j] = state.outliers[row, j]
             n_regions[i, j] = state.n_regions[row, j]
@@ -184,7 +186,7 @@ def _encode_levels(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cove
                 count = state.level_counts[row, j, k]
                 level_counts[i, j, k] = count
                 level_vertices[i, j, k, :count] = state.level_vertices[row, j, k, :count]
-    return outliers, level_vertices, level_counts, n_regions
+    return outliers, level_vertices, level_counts, n_regions, robot_fixed_at
 
 
 def decode(data: Mapping[str, Any], n_landmarks: int, settings: MapSettings) -> PolygonSLAM:

@@ -173,6 +173,7 @@ class BatchedPolygonSLAM(HasMapSettings):
         self.level_vertices = np.zeros((n, m, levels, cap), dtype=np.complex128)
         self.level_counts = np.zeros((n, m, levels), dtype=np.int64)
         self.n_regions = np.zeros((n, m), dtype=np.int64)
+        self.robot_fixed_at = np.zeros(n, dtype=np.int64)
         self._state_ref: kernels.State | None = None
         announce_compile_once()
         self.reset()
@@ -221,6 +222,7 @@ class BatchedPolygonSLAM(HasMapSettings):
         self.outliers[rows] = 0
         self.level_counts[rows] = 0
         self.n_regions[rows] = 0
+        self.robot_fixed_at[rows] = 0
 
     def update(
         self,

@@ -21,6 +21,7 @@ from tests.slam.test_slam_relaxed import (
     assert_same_result,
     convex_polygon,
     polygon_angles,
+    run_with_outlier,
     shapely_polygon,
 )
 from tests.slam_sim import random_episode
@@ -139,6 +140,21 @@ def test_the_guaranteed_set_holds_the_truth_more_often_than_the_likely_set() -> 
     assert total == total_likely > 0
     assert guaranteed > likely
     assert guaranteed >= 0.9 * total
+
+
+def test_a_misread_frame_landmark_is_caught_by_the_robot_region() -> None:
+    robust, statuses, truth = run_with_outlier("robust", 1, 0.6)
+    assert statuses[6] == "rejected"  # its start misses where the last move ended
+    assert statuses.count("rejected") == 1
+    assert robust.contains(truth).all()
+    assert robust.outliers.tolist() == [0, 0, 0, 0]  # nothing of it was fused
+
+
+def test_a_misread_landmark_is_left_out_for_that_landmark_only() -> None:
+    robust, statuses, truth = run_with_outlier("robust", 3, 0.3)
+    assert "rejected" not in statuses
+    assert robust.contains(truth).all()
+    assert robust.outliers.tolist() == [0, 1, 0, 0]
 
 
 def test_the_robust_state_survives_copies_and_pickles() -> None:

@@ -29,9 +29,11 @@ intersection bit for bit.
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from bearing_env.slam.kernels.common import _JIT
+from bearing_env.slam.kernels.frames import FrameChange, transfer_region
 from bearing_env.slam.kernels.fusion import _copy_polygon, _merge_hull
 from bearing_env.slam.kernels.polygons import area_centroid, clip_convex
 from bearing_env.slam.kernels.state import Params, Scratch, State
@@ -145,3 +147,26 @@ def robust_landmark(
     state.counts[row, j] = n
     state.areas[row, j], state.centroids[row, j] = area_centroid(state.vertices[row, j], n)
     return consistent
+
+
+@njit(**_JIT)
+def frame_contradicts_robot(
+    state: State, row: int, frame: FrameChange, scratch: Scratch
+) -> bool:
+    """Whether the movement's start R1 (the FR origin), seen through its change of
+    frames, misses the map's robot region, which is where the previous movement ended:
+    the robot did not jump, so one of the two frames is wrong, and since a wrong frame
+    (a misread L1 or L2) would have been caught at the previous movement, it is this
+    one. False when the robot's region is unknown or older than the previous movement
+    (whose frame could not be changed, or which was simulated without the robot)."""
+    n_robot = state.robot_counts[row]
+    if n_robot == 0 or state.robot_fixed_at[row] != state.n_updates[row] - 1:
+        return False
+    origin = np.zeros(1, dtype=np.complex128)
+    n_start = transfer_region(origin, 1, frame, scratch.cloud, scratch.hull, scratch.fresh)
+    if n_start < 3:
+        return False
+    n = clip_convex(
+        state.robot_vertices[row], n_robot, scratch.fresh, n_start, scratch.fused, scratch.work
+    )
+    return n == 0

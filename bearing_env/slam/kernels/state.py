@@ -73,6 +73,7 @@ class State(NamedTuple):
     level_vertices: ComplexArray  #: (maps, m, levels, CAPACITY) the robust fusion's levels
     level_counts: IntArray  #: (maps, m, levels) (levels: 0 unless ``"robust"``)
     n_regions: IntArray  #: (maps, m) regions fused into the robust levels
+    robot_fixed_at: IntArray  #: (maps,) the movement (``n_updates``) that set the robot region
 
 
 @structref.register

@@ -44,7 +44,11 @@ from bearing_env.slam.kernels.polygons import (
     area_centroid,
     contains_point,
 )
-from bearing_env.slam.kernels.robust import contamination, robust_landmark
+from bearing_env.slam.kernels.robust import (
+    contamination,
+    frame_contradicts_robot,
+    robust_landmark,
+)
 from bearing_env.slam.kernels.state import (
     FUSION_RELAXED,
     FUSION_ROBUST,
@@ -191,7 +195,11 @@ def _update_rows(
         if relaxed:
             newest = _open_window_slot(state, row, scratch)
         rate = contamination(state, row) if robust else 0.0
-        for j in range(2, n_landmarks):
+        last = n_landmarks
+        if robust and params.with_robot and frame_contradicts_robot(state, row, frame, scratch):
+            frame_status[i] = FRAME_REJECTED  # a misread L1 or L2: no landmark is fused
+            last = 2
+        for j in range(2, last):
             slot = j - 2
             fresh_counts[slot] = 0
             if fr_status[j] == FR_MISSING:
@@ -237,6 +245,7 @@ def _update_rows(
             state.robot_heading[row] = np.nan
             continue
         _transfer_robot(state, row, frame, scratch, robot_point)
+        state.robot_fixed_at[row] = state.n_updates[row]
 
 
 @njit(**_JIT)
