@@ -11,7 +11,7 @@ import pickle
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from bearing_env.slam import MapSettings, PolygonSLAM, kernels
@@ -27,16 +27,22 @@ from tests.slam.test_slam_relaxed import (
 from tests.slam_sim import random_episode
 
 
-def exact_relaxed_set(polygons: list[np.ndarray], left_out: int) -> shapely.Geometry:
-    """The points in all of ``polygons`` but at most ``left_out``, by shapely."""
+def exact_relaxed_set(polygons: list[np.ndarray], left_out: int) -> shapely.Geometry | None:
+    """The points in all of ``polygons`` but at most ``left_out``, by shapely: the
+    pieces with area (the kernels call an intersection with no area empty); None when
+    GEOS cannot union them (pieces within rounding of each other's edges)."""
     shapes = [shapely_polygon(p) for p in polygons]
     pieces = []
     for kept in itertools.combinations(range(len(shapes)), len(shapes) - left_out):
         piece = shapes[kept[0]]
         for i in kept[1:]:
             piece = piece.intersection(shapes[i])
-        pieces.append(piece)
-    return shapely.union_all(pieces)
+        if piece.area > 1e-9:
+            pieces.append(piece)
+    try:
+        return shapely.union_all(pieces) if pieces else shapely.Polygon()
+    except shapely.errors.GEOSException:
+        return None
 
 
 @settings(max_examples=40, deadline=None, derandomize=True)
@@ -56,13 +62,16 @@ def test_levels_are_nested_supersets_of_the_relaxed_sets(
     previous = None
     for k, level in enumerate(levels):
         exact = exact_relaxed_set(polygons, k)
+        assume(exact is not None)
+        assert exact is not None
         if level.size == 0:
             assert exact.area < 1e-9
             continue
-        hull = shapely_polygon(level).buffer(1e-9)
-        assert hull.contains(exact)
+        hull = shapely_polygon(level).buffer(1e-8)
+        assert exact.is_empty or hull.contains(exact)  # shapely: nothing contains empty
         if k == 0:  # the strict intersection itself
-            assert hull.area == pytest.approx(exact.area, rel=1e-6, abs=1e-9)
+            area = shapely_polygon(level).area
+            assert area == pytest.approx(exact.area, rel=1e-6, abs=1e-8)
         if previous is not None:
             assert hull.contains(previous)
         previous = shapely_polygon(level)
