@@ -50,6 +50,8 @@ def encode(batch: BatchedPolygonSLAM, rows: NDArray[np.int64], slots: int) -> di
     arrays = _encode_map(state, rows, slots)
     if batch.fusion == "relaxed":
         arrays += _encode_window(state, rows, slots)
+    elif batch.fusion == "robust":
+        arrays += _encode_levels(state, rows, slots)
     return {
         name: values.view(np.float64).reshape(*values.shape, 2)
         if values.dtype.kind == "c"
@@ -162,6 +164,29 @@ def _encode_window(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cove
         n_dropped,
         outliers,
     )
+
+
+@njit(**JIT_OPTIONS)
+def _encode_levels(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
+    """The robust fusion's arrays (``ROBUST_STATE_ARRAYS``), as :func:`_encode_map`."""
+    size, mapped = rows.size, state.counts.shape[1]
+    levels, capacity = state.level_vertices.shape[2], state.level_vertices.shape[3]
+    outliers = np.zeros((size, slots), np.int64)
+    level_vertices = np.zeros((size, slots, levels, capacity), np.complex128)
+    level_counts = np.zeros((size, slots, levels), np.int64)
+    n_regions = np.zeros((size, slots), np.int64)
+    robot_fixed_at = np.empty(size, np.int64)
+    for i in range(size):
+        row = rows[i]
+        robot_fixed_at[i] = state.robot_fixed_at[row]
+        for j in range(mapped):
+            outliers[i, j] = state.outliers[row, j]
+            n_regions[i, j] = state.n_regions[row, j]
+            for k in range(levels):
+                count = state.level_counts[row, j, k]
+                level_counts[i, j, k] = count
+                level_vertices[i, j, k, :count] = state.level_vertices[row, j, k, :count]
+    return outliers, level_vertices, level_counts, n_regions, robot_fixed_at
 
 
 def decode(data: Mapping[str, Any], n_landmarks: int, settings: MapSettings) -> PolygonSLAM:
