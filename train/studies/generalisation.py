@@ -128,22 +128,22 @@ def plot_medians(results: Results, training_counts: dict[str, tuple[int, int]], 
     panels = np.atleast_1d(panels)
     colours = plt.get_cmap("tab10").colors
     # The baselines once (from the first model's runs), then each model.
-    lines = [(label, first, label) for label in next(iter(first.values())) if label not in results]
-    lines += [(model, results[model], model) for model in results]
-    for index, (label, by_count, name) in enumerate(lines):
+    lines = [(label, first) for label in next(iter(first.values())) if label not in results]
+    lines += [(model, results[model]) for model in results]
+    for index, (label, by_count) in enumerate(lines):
         counts = sorted(by_count)
         colour = colours[index % 10]
         values = np.array([by_count[count][label]["median"] for count in counts])
-        style = {"linewidth": 2.5 if name in results else 1.2, "color": colour, "marker": "o"}
-        if name in training_counts:
+        style = {"linewidth": 2.5 if label in results else 1.2, "color": colour, "marker": "o"}
+        if label in training_counts:
             for axes in panels:
-                axes.axvspan(*training_counts[name], color=colour, alpha=0.12)
-        panels[0].plot(counts, values, label=name, **style)
+                axes.axvspan(*training_counts[label], color=colour, alpha=0.12)
+        panels[0].plot(counts, values, label=label, **style)
         for axes, reference in zip(panels[1:], references, strict=True):
             # Random polygonal is several times above the rest: it would flatten the panel.
             if label not in ("random_polygonal", reference):
                 ratio = values / np.array([by_count[c][reference]["median"] for c in counts])
-                axes.plot(counts, ratio, label=name, **style)
+                axes.plot(counts, ratio, label=label, **style)
     panels[0].set_yscale("log")
     panels[0].set_ylabel(f"median total area after {MOVES} moves (FL units², log)")
     for axes, reference in zip(panels[1:], references, strict=True):
