@@ -19,7 +19,9 @@ or action spaces, or what the observation and an action mean:
 
 Not part of the task, so a model runs with them changed: the landmark count and layout
 (``n_landmarks``, ``landmarks``: running a model on counts it never saw, up to its
-``max_landmarks``, is what ``python -m bearing_env.train.studies.generalisation`` does),
+``max_landmarks``, is what ``python -m bearing_env.train.studies.generalisation`` does;
+a model of a set policy, :data:`SLOT_FREE_POLICIES`, also runs with more
+``max_landmarks`` slots than it was trained with, so on any count),
 ``max_moves`` (the episode length: ``bearing-env compare --quick`` plays 10 moves; the
 observation's ``progress`` feature then runs twice as fast as in 20-move training), the
 sensor and map settings (``epsilon_deg``, ``noise``, ``transfer``, ``fusion``,
@@ -54,6 +56,15 @@ TASK_SETTINGS: tuple[str, ...] = (
     "arena",
     "move_length",
     *GRID_SETTINGS,
+)
+
+#: The policies whose features do not depend on how many landmark slots the entity
+#: observation has (the set extractors of :mod:`bearing_env.agents.extractors`, whose
+#: invariance to padding is tested there): their models run with more ``max_landmarks``
+#: slots than they were trained with. Named by the dotted path their records give.
+SLOT_FREE_POLICIES: tuple[str, ...] = (
+    "bearing_env.agents.extractors.LandmarkSetPolicy",
+    "bearing_env.agents.extractors.LandmarkAttentionPolicy",
 )
 
 #: The pseudo-setting naming the action kind in a mismatch: "continuous" or "discrete".
@@ -104,6 +115,9 @@ class ModelTask:
     model: str = "model"
     #: Where the task was read (named in messages), e.g. ``ppo_generalist.json``.
     source: str = ""
+    #: The model's policy is one of :data:`SLOT_FREE_POLICIES`: an env with more
+    #: ``max_landmarks`` slots than the recorded ones is still its task.
+    slot_free: bool = False
 
     @classmethod
     def from_record(cls, record: Mapping[str, Any], model: str, source: str) -> ModelTask:
@@ -117,7 +131,15 @@ class ModelTask:
             raise ValueError(f"{source} names no env_id, so the model's task is unknown")
         if not isinstance(env_kwargs, Mapping):
             raise ValueError(f"{source}: env_kwargs must be a mapping, got {env_kwargs!r}")
-        return cls(env_id=env_id, env_kwargs=dict(env_kwargs), model=model, source=source)
+        hyperparams = record.get("hyperparams", {})
+        policy = hyperparams.get("policy") if isinstance(hyperparams, Mapping) else None
+        return cls(
+            env_id=env_id,
+            env_kwargs=dict(env_kwargs),
+            model=model,
+            source=source,
+            slot_free=policy in SLOT_FREE_POLICIES,
+        )
 
     @property
     def discrete(self) -> bool:
@@ -160,7 +182,10 @@ class ModelTask:
         except TypeError:
             return []  # a foreign env: only its spaces can be checked
         actual = task_settings(base.config, isinstance(base, BearingSLAMDiscreteEnv))
-        return setting_differences(self.settings(), actual, "env")
+        expected = self.settings()
+        if self.slot_free and actual["max_landmarks"] >= expected["max_landmarks"]:
+            expected["max_landmarks"] = actual["max_landmarks"]  # more slots: still its task
+        return setting_differences(expected, actual, "env")
 
     def mismatch_message(self, differences: list[str], where: str = "this env") -> str:
         """One line: what differs, and the model's own task."""

@@ -23,6 +23,7 @@ import numpy as np
 from gymnasium import spaces
 from numpy.typing import NDArray
 
+from bearing_env.envs.observations import ENTITY_FEATURES
 from bearing_env.extras import require
 from bearing_env.shipped import shipped_dir
 
@@ -247,6 +248,25 @@ def _spaces_match(model_space: spaces.Space[Any], env_space: spaces.Space[Any]) 
     return type(model_space) is type(env_space)
 
 
+def _longer_table(model_space: spaces.Space[Any], env_space: spaces.Space[Any]) -> bool:
+    """Whether ``env_space`` is the entity observation ``model_space`` with more landmark
+    rows (the same robot block, a ``"landmarks"`` table of more rows of the same width)."""
+    if not (isinstance(model_space, spaces.Dict) and isinstance(env_space, spaces.Dict)):
+        return False
+    if model_space.keys() != env_space.keys() or set(env_space.keys()) != {"robot", "landmarks"}:
+        return False
+    width = len(ENTITY_FEATURES)
+    model_table, env_table = model_space["landmarks"], env_space["landmarks"]
+    return (
+        _spaces_match(model_space["robot"], env_space["robot"])
+        and isinstance(model_table, spaces.Box)
+        and isinstance(env_table, spaces.Box)
+        and len(model_table.shape) == len(env_table.shape) == 1
+        and env_table.shape[0] % width == 0
+        and env_table.shape[0] > model_table.shape[0]
+    )
+
+
 def space_summary(space: spaces.Space[Any]) -> str:
     """A space in a few words, without its bounds: ``Box(61,)``, ``Discrete(24)``,
     ``Dict(landmarks: Box(16, 8), robot: Box(9,))``."""
@@ -326,6 +346,13 @@ class SB3Policy:
         (:class:`ModelLoadError`)."""
         if self.task is not None:
             self.task.check(env)
+        if self.task is not None and self.task.slot_free and _longer_table(
+            self.model.observation_space, env.observation_space
+        ):
+            # A set policy's features do not depend on the table's length: it reads
+            # the env's longer table as it is (the task check allowed the extra slots).
+            self.model.observation_space = env.observation_space
+            self.model.policy.observation_space = env.observation_space
         if not _spaces_match(self.model.observation_space, env.observation_space):
             raise ModelLoadError(
                 f"model {self.model_path.name} expects observations "
@@ -352,7 +379,9 @@ class SB3Policy:
                 f"model {self.model_path} has no record of its task "
                 f"({self.model_path.with_suffix('.json').name}); make its env with gym.make"
             )
-        return self.task.make_env(**overrides)
+        env = self.task.make_env(**overrides)
+        self.check_env(env)  # a set policy takes on the env's longer landmark table
+        return env
 
     @classmethod
     def pretrained(cls, name: str, env: gym.Env | None = None, **options: Any) -> SB3Policy:

@@ -120,6 +120,31 @@ def test_settings_outside_the_task_are_accepted(overrides: dict[str, Any]) -> No
     env.close()
 
 
+@pytest.mark.parametrize("count", [16, 24, 32])
+def test_a_set_policy_acts_with_more_landmark_slots_than_it_was_trained_with(count: int) -> None:
+    """The generalist's deep set reads a longer landmark table as it is: more slots than
+    its 16 are still its task, and it acts on counts it has no training slots for."""
+    policy = SB3Policy.pretrained("ppo_generalist")
+    assert policy.task is not None and policy.task.slot_free
+    env = policy.make_env(n_landmarks=count, max_landmarks=32)
+    observation, info = env.reset(seed=11)
+    assert observation["landmarks"].shape == (32 * 8,)
+    for _ in range(3):
+        action = policy.act(observation, info)
+        assert env.action_space.contains(action)
+        observation, _, _, _, info = env.step(action)
+    SB3Policy.pretrained("ppo_generalist", env)  # given the env, the same check passes
+    env.close()
+
+
+def test_a_set_policy_still_refuses_fewer_slots_and_a_flat_policy_more() -> None:
+    with pytest.raises(TaskMismatchError, match=r"max_landmarks 16 \(env: 12\)"):
+        SB3Policy.pretrained("ppo_generalist").make_env(max_landmarks=12)
+    assert not SB3Policy.pretrained("ppo_random").task.slot_free  # type: ignore[union-attr]
+    with pytest.raises(TaskMismatchError, match=r"max_landmarks 10 \(env: 12\)"):
+        SB3Policy.pretrained("ppo_random").make_env(max_landmarks=12)
+
+
 def test_make_env_refuses_overrides_that_change_the_task() -> None:
     policy = SB3Policy.pretrained("ppo_random")
     with pytest.raises(TaskMismatchError, match=r"max_landmarks 10 \(env: 12\)") as refused:

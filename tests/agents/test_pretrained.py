@@ -118,7 +118,8 @@ def test_generalisation_table_covers_every_policy_and_count(tmp_path: Path) -> N
 @pytest.mark.parametrize(
     ("model", "slots"),
     # ppo_khepera's record names no count or slots: the env's defaults (4, 8 slots) apply.
-    [("ppo_random", 10), ("ppo_khepera", 8), ("ppo_generalist", 16)],
+    # ppo_generalist is a set policy: it runs on any count (below).
+    [("ppo_random", 10), ("ppo_khepera", 8)],
 )
 def test_generalisation_rejects_counts_beyond_the_observation_slots(model: str, slots: int) -> None:
     result = subprocess.run(
@@ -130,3 +131,14 @@ def test_generalisation_rejects_counts_beyond_the_observation_slots(model: str, 
     )  # fmt: skip
     assert result.returncode == 2
     assert f"--counts must lie in [3, {slots}]" in result.stderr
+
+
+def test_generalisation_gives_a_set_policy_the_slots_a_count_needs() -> None:
+    from bearing_env.train.studies.generalisation import env_kwargs_for_count
+
+    trained = {"scenario": "random", "n_landmarks": [3, 12], "max_landmarks": 16}
+    assert env_kwargs_for_count(trained, 8, 16) == {**trained, "n_landmarks": 8}
+    assert env_kwargs_for_count(trained, 24, 16) == {
+        **trained, "n_landmarks": 24, "max_landmarks": 24,
+    }  # fmt: skip
+    assert env_kwargs_for_count(trained, 24) == {**trained, "n_landmarks": 24}

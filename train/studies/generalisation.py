@@ -16,7 +16,9 @@ model's training range shaded.
 The total area is summed over the mapped landmarks (L3, L4, ...), so it grows with the
 count; compare policies within a column. Every count runs with the env kwargs the model
 was trained with (its observation kind and ``max_landmarks`` slots), the landmark count
-and the random scenario aside. It needs the ``train`` extra (the shipped model runs on
+and the random scenario aside; a model of a set policy (the entity observation's deep set
+or attention extractor) also runs on counts beyond its slots, with as many slots as the
+count needs. It needs the ``train`` extra (the shipped model runs on
 stable-baselines3); without it, it says so in one line and exits with status 2.
 """
 
@@ -32,7 +34,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from bearing_env.agents.sb3 import pretrained_names, pretrained_record
+from bearing_env.agents.sb3 import pretrained_names, pretrained_record, pretrained_task
 from bearing_env.envs.config import EnvConfig
 from bearing_env.extras import available
 from bearing_env.train.common.cli_parser import command_parser, doc_summary
@@ -54,9 +56,16 @@ MOVES = "10"
 Results = dict[str, dict[int, dict[str, dict[str, float]]]]
 
 
-def env_kwargs_for_count(trained: dict[str, Any], count: int) -> dict[str, Any]:
-    """The model's training env kwargs on a random layout of ``count`` landmarks."""
-    return {**trained, "scenario": "random", "n_landmarks": count}
+def env_kwargs_for_count(
+    trained: dict[str, Any], count: int, max_landmarks: int | None = None
+) -> dict[str, Any]:
+    """The model's training env kwargs on a random layout of ``count`` landmarks; with
+    ``max_landmarks`` (the model's slots), more slots when ``count`` needs them (only a
+    set policy's model runs with more slots than it was trained with)."""
+    kwargs = {**trained, "scenario": "random", "n_landmarks": count}
+    if max_landmarks is not None and count > max_landmarks:
+        kwargs["max_landmarks"] = count
+    return kwargs
 
 
 class StudySettings(NamedTuple):
@@ -101,11 +110,13 @@ def run_model(model: str, study: StudySettings) -> dict[int, dict[str, dict[str,
     landmark count and policy label, for one model and the baselines beside it. Each
     count is its own comparison folder, so an interrupted study resumes count by count."""
     trained = dict(pretrained_record(model).get("env_kwargs", {}))
+    slots = EnvConfig.create(**trained).observations.max_landmarks
     results: dict[int, dict[str, dict[str, float]]] = {}
     with progress_bar(len(study.counts), desc=model, unit="count", enabled=True) as bar:
         for count in study.counts:
             folder = study.out / model / f"n{count}"
-            command = compare_command(model, env_kwargs_for_count(trained, count), study, folder)
+            kwargs = env_kwargs_for_count(trained, count, slots)
+            command = compare_command(model, kwargs, study, folder)
             subprocess.run(command, check=True)
             summary = json.loads((folder / "summary.json").read_text())
             results[count] = {
@@ -223,6 +234,8 @@ def main(argv: Sequence[str] | None = None) -> None:
         # The env's own resolution of the training settings: counts and observation slots.
         trained = EnvConfig.create(**pretrained_record(model).get("env_kwargs", {}))
         max_landmarks = trained.observations.max_landmarks
+        if pretrained_task(model).slot_free:
+            max_landmarks = max(args.counts)  # a set policy: any count, with more slots
         if min(args.counts) < 3 or max(args.counts) > max_landmarks:
             parser.error(
                 f"--counts must lie in [3, {max_landmarks}]: {model} has "
