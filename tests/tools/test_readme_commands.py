@@ -155,6 +155,8 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "agents/pretrained/ppo_generalist --export-only": ("parse", ()),
     "python -m bearing_env.train.studies.generalisation --model ppo_generalist --counts 3 8 12 16 "
     "--episodes 200 --out outputs/generalisation_generalist": ("parse", ()),
+    "python -m bearing_env.train.studies.generalisation --model ppo_generalist --counts 24 32 "
+    "--baselines random greedy --episodes 200 --out outputs/generalisation_24_32": ("parse", ()),
     "cp outputs/generalisation_generalist/generalisation.png "
     "docs/compare/generalisation_generalist.png": ("copy", ()),
     "bearing-env compare --policies greedy oracle lookahead lookahead_oracle --episodes 200 "
