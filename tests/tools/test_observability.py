@@ -121,3 +121,13 @@ def test_a_bad_field_of_view_is_named(capsys: pytest.CaptureFixture[str]) -> Non
         observability.main(["--fov", "0", "--per-side", "4", "--headings", "4", "--no-progress"])
     assert raised.value.code == 2
     assert "field_of_view_deg" in capsys.readouterr().err
+
+
+def test_the_omniscient_planner_maps_with_a_panoramic_camera_and_not_with_90_degrees() -> None:
+    wide = observability.omniscient_final_areas(KHEPERA, {"max_moves": 4}, episodes=1)
+    narrow = observability.omniscient_final_areas(
+        KHEPERA, {"max_moves": 4, "field_of_view_deg": 90.0}, episodes=1
+    )
+    assert len(wide) == len(narrow) == 1
+    assert 0.0 < wide[0] < 1.0  # both landmarks mapped well within 4 moves
+    assert narrow[0] == 20.0  # both still at the cap of 10

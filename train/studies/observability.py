@@ -36,10 +36,10 @@ from numpy.typing import NDArray
 
 from bearing_env.envs.config import EnvConfig
 from bearing_env.sensing import clearance, visible_rows
-from bearing_env.slam import BatchedPolygonSLAM
+from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
 from bearing_env.slam.batch import LANDMARK_CODE
 from bearing_env.train.common.cli_parser import add_no_progress, command_parser, doc_summary
-from bearing_env.train.common.cli_values import COUNT
+from bearing_env.train.common.cli_values import COUNT, NON_NEGATIVE
 from bearing_env.train.common.files import write_json_atomically
 from bearing_env.train.common.progress import progress_bar
 from bearing_env.train.common.seeds import EVAL_SEED_START
@@ -50,6 +50,8 @@ FloatArray = NDArray[np.float64]
 
 #: Movements fused per world-model call (bounds the memory of the batch of maps).
 CHUNK = 4096
+#: The omniscient planner's headings (evenly over the circle), each with 3 lengths.
+ORACLE_HEADINGS = 24
 
 
 @dataclass(frozen=True)
@@ -136,19 +138,26 @@ def _readings(layout: Layout, positions: FloatArray, headings: FloatArray) -> Fl
     return np.where(seen, bearings, np.nan)
 
 
-def movement_outcomes(layout: Layout, movements: Movements) -> Outcomes:
-    """Move and read as the env does, then fuse each movement into an empty map."""
+def _moved(
+    layout: Layout, begin: FloatArray, headings: FloatArray, lengths: FloatArray
+) -> FloatArray:
+    """Where the env's moves from ``begin`` (N, 2) end: walls and obstacles stop them."""
     arena = layout.config.layout.arena
     settings = (arena.width, arena.height, arena.wall_margin, arena.min_baseline)
     vertices, starts = layout.config.layout.packed_obstacles
-    begin = movements.starts[movements.start_index]
     end = np.empty_like(begin)
     for i, (x, y) in enumerate(begin):
         moved = obstructed_move(
-            float(x), float(y), float(movements.headings[i]), float(movements.lengths[i]),
-            settings, vertices, starts,
-        )  # fmt: skip
+            float(x), float(y), float(headings[i]), float(lengths[i]), settings, vertices, starts
+        )
         end[i] = moved[0], moved[1]
+    return end
+
+
+def movement_outcomes(layout: Layout, movements: Movements) -> Outcomes:
+    """Move and read as the env does, then fuse each movement into an empty map."""
+    begin = movements.starts[movements.start_index]
+    end = _moved(layout, begin, movements.headings, movements.lengths)
     first = _readings(layout, begin, movements.headings)
     second = _readings(layout, end, movements.headings)
     n = len(layout.landmarks)
@@ -199,6 +208,96 @@ def study(
             results[float(fov)] = {**summary, "layout": layout, "grid_starts": movements.starts}
             bar.update()
     return results
+
+
+@dataclass(frozen=True)
+class MoveGrid:
+    """The omniscient planner's candidate moves: absolute headings and lengths (K,)."""
+
+    headings: FloatArray
+    lengths: FloatArray
+
+
+def _potentials(maps: BatchedPolygonSLAM, config: EnvConfig) -> FloatArray:
+    """The env's uncertainty potential of each map of a batch."""
+    from bearing_env.agents.planning import uncertainty_potential
+
+    task = config.task
+    return uncertainty_potential(maps.areas, task.area_cap, task.reward == "log_area")
+
+
+def _omniscient_choice(
+    layout: Layout, slam: PolygonSLAM, position: FloatArray, grid: MoveGrid, last: bool
+) -> int:
+    """The index of the move whose best follow-up (none on the ``last`` move) leaves the
+    lowest potential, simulated from the true ``position`` with noise-free readings."""
+    count = grid.headings.size
+    start = np.repeat(position[None], count, axis=0)
+    ends = _moved(layout, start, grid.headings, grid.lengths)
+    first = slam.replicate(count)
+    first.update(
+        _readings(layout, start, grid.headings), _readings(layout, ends, grid.headings), robot=False
+    )
+    scores = _potentials(first, layout.config)
+    if not last:
+        pairs = np.repeat(np.arange(count), count)
+        headings, lengths = np.tile(grid.headings, count), np.tile(grid.lengths, count)
+        after = _moved(layout, ends[pairs], headings, lengths)
+        second = first.take(pairs)
+        second.update(
+            _readings(layout, ends[pairs], headings),
+            _readings(layout, after, headings),
+            robot=False,
+        )
+        best_next = _potentials(second, layout.config).reshape(count, count).min(axis=1)
+        scores = best_next + 1e-3 * scores  # ties: the better first move
+    return int(np.argmin(scores))
+
+
+def omniscient_final_areas(
+    env_id: str, env_kwargs: dict[str, Any], episodes: int, progress: bool = False
+) -> list[float]:
+    """The final total area (each landmark capped at ``area_cap``) of each of
+    ``episodes`` evaluation episodes played by an omniscient two-move planner: it knows
+    the true pose and landmarks, simulates the env's moves and sensor with noise-free
+    readings, scores every pair of moves (:data:`ORACLE_HEADINGS` headings x 3 lengths
+    over the env's range, twice) on copies of the robot's own map with the env's
+    potential, and makes the first move of the best pair. It reads ground truth: an upper
+    reference of what a policy could reach, not a robot policy."""
+    import gymnasium as gym
+
+    from bearing_env.agents.base import ActionCodec
+    from bearing_env.agents.env_access import MapReader, bearing_env_of, world_of
+
+    env = gym.make(env_id, **{**env_kwargs, "target_area": 1e-12})  # play every move
+    codec, maps = ActionCodec(env), MapReader(env)
+    headings, lengths = np.meshgrid(
+        2 * math.pi * np.arange(ORACLE_HEADINGS) / ORACLE_HEADINGS,
+        np.linspace(*codec.length_range, 3),
+        indexing="ij",
+    )
+    grid = MoveGrid(headings.ravel(), lengths.ravel())
+    finals = []
+    with progress_bar(episodes, desc="omniscient", unit="episode", enabled=progress) as bar:
+        for episode in range(episodes):
+            _, info = env.reset(seed=EVAL_SEED_START + episode)
+            world, config = world_of(env), bearing_env_of(env).config
+            layout = Layout(config, np.array(world.landmarks))
+            for move in range(config.task.max_moves):
+                slam = maps.read(info, len(layout.landmarks))
+                last = move + 1 == config.task.max_moves
+                k = _omniscient_choice(layout, slam, np.array(world.position), grid, last)
+                turn = math.remainder(grid.headings[k] - world.heading, 2 * math.pi)
+                action = codec.movement(turn, float(grid.lengths[k])).action
+                _, _, terminated, truncated, info = env.step(action)
+                if terminated or truncated:
+                    break
+            cap = config.task.area_cap
+            areas = np.minimum(np.nan_to_num(info["landmark_area"], posinf=cap), cap)
+            finals.append(float(areas.sum()))
+            bar.update()
+    env.close()
+    return finals
 
 
 def as_json(results: dict[float, dict[str, Any]]) -> dict[str, dict[str, Any]]:
@@ -291,6 +390,14 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--lengths", type=COUNT, default=3, help="move lengths per heading")
     parser.add_argument("--plot", type=Path, default=None, help="also draw the arenas here (PNG)")
     parser.add_argument("--json", type=Path, default=None, help="also write the figures here")
+    parser.add_argument(
+        "--oracle-episodes",
+        type=NON_NEGATIVE,
+        default=0,
+        help="also play this many evaluation episodes per field of view with the omniscient "
+        "two-move planner (ground truth; slow: about a second per move) and report its final "
+        "total areas",
+    )
     add_no_progress(parser)
     return parser
 
@@ -307,6 +414,18 @@ def main(argv: Sequence[str] | None = None) -> None:
     except (ValueError, TypeError, gym.error.Error) as error:  # a bad id or field of view
         parser.error(str(error))
     print_results(args.env, results)
+    if args.oracle_episodes:
+        for fov, row in results.items():
+            finals = omniscient_final_areas(
+                env_id, {"field_of_view_deg": fov}, args.oracle_episodes, not args.no_progress
+            )
+            row["omniscient_final_areas"] = finals
+            low, median, high = np.percentile(finals, [10, 50, 90])
+            print(
+                f"field of view {fov:g} deg: the omniscient planner's final total area over "
+                f"{len(finals)} episodes: median {median:.3g} (10th-90th percentile "
+                f"{low:.3g}-{high:.3g})"
+            )
     if args.json is not None:
         write_json_atomically(args.json, {"env": args.env, "fovs": as_json(results)})
         print(f"wrote {args.json}")
