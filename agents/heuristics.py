@@ -31,7 +31,7 @@ from .planning import (
     simulate_potentials,
     uncertainty_potential,
 )
-from .visibility import TOO_CLOSE, BearingMemory, VisibilityPredictor, keep_in_view
+from .visibility import TOO_CLOSE, BearingMemory, TrueSensor, VisibilityPredictor, keep_in_view
 
 #: Turns tried by the bootstrap move on the continuous id (every 5 degrees).
 BOOTSTRAP_TURNS = 72
@@ -480,9 +480,11 @@ class GreedyOracle(GreedyOneStep):
 
     Same candidates and the same scoring (simulated updates of the robot's current map),
     but the bearings are simulated from the true landmark positions and the true robot
-    pose, the FL scale is the true ``|L1 - L2|``, and each candidate's length is cut where
-    the true arena wall would stop it. It reads ground truth, so it is not a robot
-    policy: it bounds what one-step planning could do.
+    pose, the FL scale is the true ``|L1 - L2|``, each candidate's length is cut where the
+    true arena wall or an obstacle would stop it, and a bearing the real sensor would miss
+    (field of view, range, line of sight) is missed
+    (:class:`~bearing_env.agents.visibility.TrueSensor`). It reads ground truth, so it is
+    not a robot policy: it bounds what one-step planning could do.
     """
 
     name = "greedy_oracle"
@@ -496,13 +498,11 @@ class GreedyOracle(GreedyOneStep):
         position = world_to_fl(world.position, l1, l2)
         heading_fl = world.heading - math.atan2(baseline.imag, baseline.real)
         truth = world_to_fl(world.landmarks, l1, l2)
-        margin = world.arena.wall_margin
+        sensor = TrueSensor(world)  # the real field of view, range and obstacles
         distances = np.empty(len(self.candidates), dtype=np.float64)
         for k, candidate in enumerate(self.candidates):
-            free = world.arena.free_distance(world.position, world.heading + candidate.turn, margin)
-            travelled = min(candidate.length, free)
-            if travelled < world.min_baseline:
-                travelled = 0.0
+            heading = world.heading + candidate.turn
+            travelled = sensor.travel(world.position, heading, candidate.length)
             distances[k] = travelled / metres_per_unit
         potentials = simulate_potentials(
             slam,
@@ -513,6 +513,7 @@ class GreedyOracle(GreedyOneStep):
             self.area_cap,
             log_area=self.log_area,
             scratch=self._trials,
+            sensor=None if sensor.trivial else sensor,
         )
         if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap, self.log_area):
             return bootstrap_movement(self.codec, view)

@@ -45,6 +45,7 @@ from .belief import ObservationView
 from .env_access import bearing_env_of
 from .heuristics import GreedyOneStep, _allowed_turns
 from .planning import Sensor, bearings_from, uncertainty_potential
+from .visibility import TrueSensor
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -282,10 +283,11 @@ class Lookahead(GreedyOneStep):
 class LookaheadOracle(Lookahead):
     """PRIVILEGED upper reference: :class:`Lookahead` on the *true* map.
 
-    One world, the truth: true landmarks and pose, the true FL scale, and every planned
-    move cut where the true arena wall would stop it. It reads ground truth, so it is not
-    a robot policy: it bounds what this search could do with a perfect map. ``hypotheses``
-    is ignored (there is one world).
+    One world, the truth: true landmarks and pose, the true FL scale, every planned move
+    cut where the true arena wall or an obstacle would stop it, and the readings the real
+    sensor would miss missed (:class:`~bearing_env.agents.visibility.TrueSensor`). It
+    reads ground truth, so it is not a robot policy: it bounds what this search could do
+    with a perfect map. ``hypotheses`` is ignored (there is one world).
     """
 
     name = "lookahead_oracle"
@@ -303,7 +305,7 @@ class LookaheadOracle(Lookahead):
             np.array([complex(position[0], position[1])]),
         )
         heading_fl = world.heading - math.atan2(unit.imag, unit.real)
-        arena, margin = world.arena, world.arena.wall_margin
+        sensor = TrueSensor(world)  # the real field of view, range and obstacles
         rotation = unit / scale
 
         def mover(positions: ComplexArray, headings: FloatArray, lengths: FloatArray) -> FloatArray:
@@ -313,12 +315,15 @@ class LookaheadOracle(Lookahead):
                     at = origin + unit * positions[n, h]
                     for k in range(lengths.size):
                         direction = float(np.angle(np.exp(1j * headings[n, k]) * rotation))
-                        free = arena.free_distance((at.real, at.imag), direction, margin)
-                        travelled = min(float(lengths[k]), free)
-                        out[n, k, h] = 0.0 if travelled < self.min_baseline else travelled / scale
+                        travelled = sensor.travel(
+                            np.array([at.real, at.imag]), direction, float(lengths[k])
+                        )
+                        out[n, k, h] = travelled / scale
             return out
 
         started = time.perf_counter()
-        movement = self._search(view, slam, worlds, heading_fl, mover)
+        movement = self._search(
+            view, slam, worlds, heading_fl, mover, None if sensor.trivial else sensor
+        )
         self.planning_times.append(time.perf_counter() - started)
         return movement

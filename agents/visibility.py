@@ -25,7 +25,10 @@ import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
+from bearing_env.envs.core import WorldView
 from bearing_env.numerics import wrap_angle
+from bearing_env.sensing import pack_polygons, visible_rows
+from bearing_env.world import World, obstructed_move
 
 from .env_access import bearing_env_of
 
@@ -170,3 +173,72 @@ def keep_in_view(
     spread = np.min(np.where(inside, np.abs(np.sin(after)), 1.0), axis=1)
     spread = np.where(inside.any(axis=1), spread, 0.0)
     return np.asarray(inside.sum(axis=1) + 2.0 * frame + 0.99 * spread, dtype=np.float64)
+
+
+class TrueSensor:
+    """PRIVILEGED: what the env's sensor really sees, and how far a move really goes,
+    for the oracles (:class:`~bearing_env.agents.heuristics.GreedyOracle`,
+    :class:`~bearing_env.agents.lookahead.LookaheadOracle`), never for robot policies.
+
+    Built from the ground truth of a row (its world view, or a :class:`World` copy):
+    the true landmarks, the camera's field of view and range, and every obstacle. As a
+    planner's ``sensor`` it takes simulated bearings (S + (n,)) from poses given in FL
+    (positions and headings of shape S) and puts NaN where the real sensor would miss a
+    landmark.
+    """
+
+    def __init__(self, world: World | WorldView) -> None:
+        self.half_fov = world.half_fov
+        self.max_range = world.max_range
+        self.arena = world.arena
+        self.obstacles = bool(world.obstacles)
+        self.vertices, self.starts = pack_polygons(world.obstacles)
+        self.landmarks = np.array(world.landmarks, dtype=np.float64)
+        l1, l2 = complex(*self.landmarks[0]), complex(*self.landmarks[1])
+        #: FL -> world: z_world = origin + unit * z_fl.
+        self.origin, self.unit = l1, l2 - l1
+
+    @property
+    def trivial(self) -> bool:
+        """True for the paper's sensor in an empty arena: every landmark always seen."""
+        return self.half_fov >= math.pi and math.isinf(self.max_range) and not self.obstacles
+
+    def __call__(
+        self,
+        bearings: NDArray[np.float64],
+        positions: NDArray[np.complex128],
+        headings: NDArray[np.float64],
+    ) -> NDArray[np.float64]:
+        if self.trivial:
+            return bearings
+        flat = bearings.reshape(-1, bearings.shape[-1])
+        at = self.origin + self.unit * np.broadcast_to(positions, bearings.shape[:-1]).ravel()
+        world_headings = np.broadcast_to(headings, bearings.shape[:-1]).ravel() + np.angle(
+            self.unit
+        )
+        count, n = flat.shape
+        landmarks = np.ascontiguousarray(np.broadcast_to(self.landmarks[:n], (count, n, 2)))
+        seen = np.empty((count, n), dtype=bool)
+        visible_rows(
+            landmarks, np.ascontiguousarray(np.column_stack([at.real, at.imag])),
+            np.ascontiguousarray(world_headings, dtype=np.float64), self.half_fov,
+            self.max_range, self.vertices, self.starts, seen,
+        )  # fmt: skip
+        return np.where(seen, flat, np.nan).reshape(bearings.shape)
+
+    def travel(self, position: NDArray[np.float64], heading: float, length: float) -> float:
+        """How far (metres) a move from ``position`` (world, metres) along ``heading``
+        (world) really goes: stopped by the walls and the obstacles, 0 when it could not
+        go the shortest move that changes frames."""
+        if not self.obstacles:
+            free = self.arena.free_distance(position, heading, self.arena.wall_margin)
+            travelled = min(length, free)
+            return 0.0 if travelled < self.arena.min_baseline else travelled
+        settings = (
+            self.arena.width, self.arena.height, self.arena.wall_margin, self.arena.min_baseline
+        )  # fmt: skip
+        _, _, travelled, _ = obstructed_move(
+            float(position[0]), float(position[1]), float(heading), float(length), settings,
+            self.vertices, self.starts,
+        )  # fmt: skip
+        return float(travelled)

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.numerics import JIT_OPTIONS, wrap, wrap_angle
 from bearing_env.obstacles import Obstacle, box
-from bearing_env.sensing import Packed, clearance, free_length
+from bearing_env.sensing import Packed, clearance, free_length, pack_polygons, visible_rows
 from bearing_env.validation import float_in, non_negative_float, positive_float
 
 FloatArray = NDArray[np.float64]
@@ -480,6 +480,10 @@ class World:
         noise: the true bearing noise model.
         epsilon: the SLAM's bearing error bound in radians (the default noise bounds are
             expressed relative to it).
+        half_fov: half the camera's field of view, radians (pi, the default: the paper's
+            panoramic camera).
+        max_range: the camera's range, metres (default: no limit).
+        obstacles: polygons that stop moves and hide landmarks (default: none).
     """
 
     def __init__(
@@ -490,6 +494,9 @@ class World:
         heading: float,
         noise: NoiseModel,
         epsilon: float,
+        half_fov: float = math.pi,
+        max_range: float = math.inf,
+        obstacles: tuple[Obstacle, ...] = (),
     ) -> None:
         self.arena = arena
         self.landmarks = np.array(landmarks, dtype=np.float64)
@@ -499,6 +506,10 @@ class World:
         self.heading = float(wrap_angle(heading))
         self.noise = noise
         self.epsilon = float(epsilon)
+        self.half_fov = float(half_fov)
+        self.max_range = float(max_range)
+        self.obstacles = tuple(obstacles)
+        self._packed = pack_polygons(self.obstacles)
 
     @property
     def n_landmarks(self) -> int:
@@ -513,7 +524,16 @@ class World:
         self.heading = float(wrap_angle(self.heading + angle))
 
     def move(self, length: float) -> MoveResult:
-        """Move straight ahead by ``length`` metres, stopping at the wall margin."""
+        """Move straight ahead by ``length`` metres, stopping at the wall margin or an
+        obstacle's."""
+        if self.obstacles:
+            arena = self.arena
+            x, y, travelled_, blocked_ = obstructed_move(
+                float(self.position[0]), float(self.position[1]), self.heading, float(length),
+                (arena.width, arena.height, arena.wall_margin, self.min_baseline), *self._packed,
+            )  # fmt: skip
+            self.position = np.array([x, y])
+            return MoveResult(float(length), float(travelled_), bool(blocked_))
         travelled, blocked, position = straight_moves(
             self.arena,
             self.position[None],
@@ -528,9 +548,21 @@ class World:
         """Noise-free bearings (n,) of all landmarks, relative to the heading, [-pi, pi)."""
         return true_bearings(self.landmarks[None], self.position[None], np.array([self.heading]))[0]
 
+    def seen(self) -> NDArray[np.bool_]:
+        """Which landmarks (n,) the camera sees from the pose: within the field of view
+        and the range, in line of sight."""
+        out = np.empty((1, self.n_landmarks), dtype=bool)
+        visible_rows(
+            self.landmarks[None], self.position[None], np.array([self.heading]), self.half_fov,
+            self.max_range, *self._packed, out,
+        )  # fmt: skip
+        return out[0]
+
     def read_bearings(self, rng: np.random.Generator) -> FloatArray:
-        """A panoramic reading: noisy bearings (n,) relative to the heading, [-pi, pi)."""
-        return self.noise.corrupt(rng, self.true_bearings(), self.epsilon)
+        """A reading: noisy bearings (n,) relative to the heading, [-pi, pi); NaN for a
+        landmark the camera does not see (:meth:`seen`) or the noise model misses."""
+        bearings = self.noise.corrupt(rng, self.true_bearings(), self.epsilon)
+        return np.where(self.seen(), bearings, np.nan)
 
 
 # --------------------------------------------------------------------------------------

@@ -36,6 +36,7 @@ from bearing_env.envs.kernels import Settings
 from bearing_env.envs.observations import FL_COORD_LIMIT, observation_size
 from bearing_env.envs.state import BatchState
 from bearing_env.numerics import wrap_angle
+from bearing_env.obstacles import Obstacle
 from bearing_env.sensing import visible_rows
 from bearing_env.slam import MapSettings, PolygonSLAM
 from bearing_env.slam.batch import (
@@ -259,11 +260,28 @@ class WorldView:
         """Noise-free bearings (n,) of all landmarks, relative to the heading, [-pi, pi)."""
         return true_bearings(self.landmarks[None], self.position[None], np.array([self.heading]))[0]
 
+    @property
+    def half_fov(self) -> float:
+        """Half the camera's field of view, radians (pi: panoramic)."""
+        return self.config.sensor.half_fov
+
+    @property
+    def max_range(self) -> float:
+        """The camera's range, metres."""
+        return self.config.sensor.max_range
+
+    @property
+    def obstacles(self) -> tuple[Obstacle, ...]:
+        """The arena's obstacles (polygons of (x, y) metres)."""
+        return self.config.layout.obstacles
+
     def copy(self) -> World:
-        """An independent, mutable snapshot of this ground truth."""
+        """An independent, mutable snapshot of this ground truth (the camera and the
+        obstacles included)."""
         return World(
-            self.arena, self.landmarks, self.position, self.heading, self.noise, self.epsilon
-        )
+            self.arena, self.landmarks, self.position, self.heading, self.noise, self.epsilon,
+            self.half_fov, self.max_range, self.obstacles,
+        )  # fmt: skip
 
     def __deepcopy__(self, memo: dict[int, Any]) -> World:
         return self.copy()

@@ -119,3 +119,52 @@ def test_planners_change_frames_with_a_forward_camera(
             done = terminated or truncated
     assert frames >= 3
     env.close()
+
+
+def test_the_oracles_true_sensor_misses_what_the_camera_cannot_see() -> None:
+    """FL poses map back to the world: a bearing is kept exactly when the true landmark
+    lies within half the field of view of the pose's world heading."""
+    from bearing_env.agents.env_access import world_of
+    from bearing_env.agents.visibility import TrueSensor
+
+    env = gym.make("bearing_env:BearingSLAM-Khepera-Camera90-v0")
+    env.reset(seed=4)
+    world = world_of(env)
+    sensor = TrueSensor(world)
+    assert not sensor.trivial
+    rng = np.random.default_rng(3)
+    positions = rng.uniform(-1, 2, 50) + 1j * rng.uniform(-1, 2, 50)
+    headings = rng.uniform(-math.pi, math.pi, 50)
+    bearings = rng.uniform(-1, 1, (50, 4))
+    kept = sensor(bearings, positions, headings)
+    l1, l2 = (complex(*point) for point in world.landmarks[:2])
+    at = l1 + (l2 - l1) * positions
+    world_headings = headings + np.angle(l2 - l1)
+    targets = world.landmarks[:, 0] + 1j * world.landmarks[:, 1]
+    directions = np.angle(targets[None] - at[:, None]) - world_headings[:, None]
+    angles = np.angle(np.exp(1j * directions))
+    outside = np.abs(angles) > math.radians(45)
+    np.testing.assert_array_equal(np.isnan(kept), outside)
+    np.testing.assert_array_equal(kept[~outside], bearings[~outside])
+    env.close()
+
+
+def test_the_oracles_true_moves_stop_at_the_furniture_as_the_env_does() -> None:
+    from bearing_env.agents.env_access import world_of
+    from bearing_env.agents.visibility import TrueSensor
+
+    env = gym.make("bearing_env:BearingSLAM-FurnishedRoom-v0")
+    codec = ActionCodec(env)
+    blocked = 0
+    for seed in range(6):
+        env.reset(seed=seed)
+        world = world_of(env)
+        sensor = TrueSensor(world)
+        for turn in (-2.0, 0.0, 1.0, 2.5):
+            heading = world.heading + turn
+            predicted = sensor.travel(np.array(world.position), heading, codec.max_length)
+            _, _, _, _, info = env.step(codec.movement(turn, codec.max_length).action)
+            assert info["path_length"] == pytest.approx(predicted, abs=1e-6)  # float32 info
+            blocked += predicted < codec.max_length
+    assert blocked > 0  # some of those moves did run into a wall or the furniture
+    env.close()

@@ -262,3 +262,35 @@ def test_a_movements_draws_are_two_readings_draws_in_order(noise):
             np.testing.assert_array_equal(got.replacement, want.replacement)
     # And the generators end in the same state.
     assert [r.random() for r in rngs] == [r.random() for r in again]
+
+
+def test_a_world_copy_keeps_the_camera_and_the_obstacles() -> None:
+    """A copy of a row's ground truth moves and reads as the env does: its moves stop at
+    the furniture and its readings miss what the camera cannot see."""
+    import gymnasium as gym
+
+    from bearing_env.agents.base import ActionCodec
+    from bearing_env.agents.env_access import world_of
+
+    env = gym.make(
+        "bearing_env:BearingSLAM-FurnishedRoom-v0", field_of_view_deg=90, sensor_info=True
+    )
+    codec = ActionCodec(env)
+    rng = np.random.default_rng(0)
+    stopped = missed = 0
+    for seed in range(5):
+        env.reset(seed=seed)
+        for turn in (0.0, 2.0, -1.0):
+            copy = world_of(env).copy()
+            assert copy.obstacles and copy.half_fov == pytest.approx(np.pi / 4)
+            copy.turn(turn)
+            moved = copy.move(codec.max_length)
+            _, _, _, _, info = env.step(codec.movement(turn, codec.max_length).action)
+            np.testing.assert_allclose(copy.position, world_of(env).position, atol=1e-12)
+            assert moved.blocked == info["blocked"]
+            seen = ~np.isnan(copy.read_bearings(rng))
+            np.testing.assert_array_equal(seen, info["seen"])
+            stopped += moved.blocked
+            missed += (~seen).sum()
+    assert stopped > 0 and missed > 0
+    env.close()
