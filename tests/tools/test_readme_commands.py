@@ -167,6 +167,8 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "scenario=khepera \"noise={'kind':'uniform','bound_deg':2,'outlier_rate':0.05}\" "
     "fusion=robust --episodes 200 --out outputs/faults_robust": ("parse", ()),
     "bearing-env observability": ("parse", ()),
+    "bearing-env observability --env BearingSLAM-Khepera-v0 --fov 360 180 90 "
+    "--oracle-episodes 20": ("parse", ()),
     "bearing-env observability --env BearingSLAM-Khepera-v0 --fov 360 180 90 --plot "
     "docs/figures/observability_khepera.png": ("parse", ()),
     "bearing-env observability --env BearingSLAM-FurnishedRoom-v0 --fov 360 180 90 --plot "
