@@ -167,6 +167,14 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "scenario=khepera \"noise={'kind':'uniform','bound_deg':2,'outlier_rate':0.05}\" "
     "fusion=robust --episodes 200 --out outputs/faults_robust": ("parse", ()),
     "bearing-env observability": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAM-FurnishedRoom-v0 --seed 0 --eval-freq 250000 "
+    "--output runs/ppo_furnished_room": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAM-FurnishedRoom-v0 --output runs/ppo_furnished_room "
+    "--export agents/pretrained/ppo_furnished_room --export-only": ("parse", ()),
+    "bearing-env suite --tasks BearingSLAM-FurnishedRoom-v0 --episodes 200 --workers 2": (
+        "parse",
+        (),
+    ),
     "bearing-env observability --env BearingSLAM-Khepera-v0 --fov 360 180 90 "
     "--oracle-episodes 20": ("parse", ()),
     "bearing-env observability --env BearingSLAM-Khepera-v0 --fov 360 180 90 --plot "

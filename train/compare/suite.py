@@ -93,7 +93,11 @@ def task_models(task: Task) -> list[str]:
     for name in pretrained_names():
         record = pretrained_record(name)
         trained_on = str(record.get("env_id", "")).rpartition(":")[2]
-        if trained_on == task.base_id and resolved(dict(record.get("env_kwargs", {}))) == wanted:
+        settings = dict(record.get("env_kwargs", {}))
+        if trained_on in TASKS_BY_ID:  # trained on a task's own id: its settings first
+            settings = {**TASKS_BY_ID[trained_on].kwargs(), **settings}
+            trained_on = TASKS_BY_ID[trained_on].base_id
+        if trained_on == task.base_id and resolved(settings) == wanted:
             specs.append(f"pretrained:{name}")
     return specs
 
