@@ -169,8 +169,11 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env observability": ("parse", ()),
     "bearing-env train --algo ppo --env BearingSLAM-FurnishedRoom-v0 --seed 0 --eval-freq 250000 "
     "--output runs/ppo_furnished_room": ("parse", ()),
-    "bearing-env train --algo ppo --env BearingSLAM-FurnishedRoom-v0 --output runs/ppo_furnished_room "
-    "--export agents/pretrained/ppo_furnished_room --export-only": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAM-FurnishedRoom-v0 --output "
+    "runs/ppo_furnished_room --export agents/pretrained/ppo_furnished_room --export-only": (
+        "parse",
+        (),
+    ),
     "bearing-env suite --tasks BearingSLAM-FurnishedRoom-v0 --episodes 200 --workers 2": (
         "parse",
         (),
