@@ -388,8 +388,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--headings", type=COUNT, default=36, help="headings per start")
     parser.add_argument("--lengths", type=COUNT, default=3, help="move lengths per heading")
-    parser.add_argument("--plot", type=Path, default=None, help="also draw the arenas here (PNG)")
-    parser.add_argument("--json", type=Path, default=None, help="also write the figures here")
+    parser.add_argument(
+        "--plot", type=Path, default=None, help="also draw the arenas here (PNG; default: none)"
+    )
+    parser.add_argument(
+        "--json", type=Path, default=None, help="also write the figures here (default: none)"
+    )
     parser.add_argument(
         "--oracle-episodes",
         type=NON_NEGATIVE,
