@@ -167,6 +167,9 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "scenario=khepera \"noise={'kind':'uniform','bound_deg':2,'outlier_rate':0.05}\" "
     "fusion=robust --episodes 200 --out outputs/faults_robust": ("parse", ()),
     "bearing-env observability": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAM-v0 --seed 1 --timesteps 10000000 "
+    "--hyperparams \"policy_kwargs='dict(net_arch=dict(pi=[256, 256], vf=[256, 256]))'\" "
+    "--eval-freq 500000 --output runs/ppo_khepera_wide": ("parse", ()),
     "bearing-env train --algo ppo --env BearingSLAM-FurnishedRoom-v0 --seed 0 --eval-freq 250000 "
     "--output runs/ppo_furnished_room": ("parse", ()),
     "bearing-env train --algo ppo --env BearingSLAM-FurnishedRoom-v0 --output "
