@@ -441,3 +441,31 @@ def test_the_report_gives_the_worst_case_from_the_logged_episodes(tmp_path: Path
     report = (tmp_path / "report.md").read_text()
     assert "mean of the worst 5%" in report and "90th pct, 10" in report
     assert "area10_p90" in (tmp_path / "summary.csv").read_text().splitlines()[0]
+
+
+ROOM = "bearing_env:BearingSLAM-FurnishedRoom-v0"
+
+
+@pytest.mark.parametrize(
+    ("env", "arguments", "expected", "scenario"),
+    [
+        (ROOM, [], {}, "furnished_room"),
+        ("bearing_env:BearingSLAM-Khepera-Camera180-v0", [], {}, "khepera"),
+        ("bearing_env:BearingSLAM-v0", [], {"scenario": "khepera"}, "khepera"),
+        (ROOM, ["--env-kwargs", "max_moves=5"], {"max_moves": 5}, "furnished_room"),
+    ],
+)
+def test_a_task_id_keeps_its_own_arena(
+    env: str, arguments: list[str], expected: dict[str, Any], scenario: str
+) -> None:
+    """The Khepera default of the base ids must not replace a task's own scenario."""
+    import gymnasium as gym
+
+    from bearing_env.train.compare.cli import build_parser, config_from_args
+
+    args = build_parser().parse_args(["--env", env, "--policies", "random", *arguments])
+    config, _ = config_from_args(args)
+    assert config.env_kwargs == expected
+    made = gym.make(config.env_id, **config.env_kwargs)
+    assert made.unwrapped.config.scenario == scenario
+    made.close()

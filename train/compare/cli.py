@@ -68,6 +68,7 @@ from typing import Any
 
 from bearing_env.agents.model_task import ModelTask, TaskMismatchError, setting_differences
 from bearing_env.extras import DISTRIBUTIONS, install_command
+from bearing_env.tasks import TASKS_BY_ID
 from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import (
     COUNT,
@@ -148,7 +149,7 @@ def _add_episode_options(group: argparse._ArgumentGroup) -> None:
         default=None,
         metavar="KEY=VALUE",
         help="env kwargs (default: the task of the pretrained:NAME models in --policies, "
-        "else scenario=khepera)",
+        "else none for a task id such as BearingSLAM-FurnishedRoom-v0, else scenario=khepera)",
     )
     group.add_argument(
         "--episodes",
@@ -315,7 +316,10 @@ def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
     """The comparison the arguments describe, and its output folder. Without
     ``--env-kwargs``, pretrained models run on their own task (:func:`models_task`)."""
     registered_env_id(args.env)
-    env_id, env_kwargs = args.env, dict(DEFAULT_ENV_KWARGS)
+    # A task id carries its own settings (scenario included): the Khepera default is
+    # for the base ids only, or it would silently replace a task's arena.
+    is_task = args.env.rpartition(":")[2] in TASKS_BY_ID
+    env_id, env_kwargs = args.env, {} if is_task else dict(DEFAULT_ENV_KWARGS)
     task = None if args.env_kwargs is not None else models_task(args.policies or [])
     if args.env_kwargs is not None:
         env_kwargs = parse_key_values(args.env_kwargs, "--env-kwargs")
