@@ -140,14 +140,23 @@ def bootstrap_movement(
     view: ObservationView,
     memory: NDArray[np.float64] | None = None,
     half_fov: float = math.pi,
+    obstacles: NDArray[np.complex128] | None = None,
 ) -> Movement:
     """The move made before there is a map (or a scale): longest length, in the direction
     that keeps every landmark farthest from the line of motion (see ``spread_turn``).
 
     With a forward camera (``half_fov`` below pi) and the robot's ``memory`` of bearings
     (:class:`~bearing_env.agents.visibility.BearingMemory`) it turns to keep L1, L2 and
-    as many landmarks as it can in view instead (:func:`limited_view_movement`)."""
+    as many landmarks as it can in view instead (:func:`limited_view_movement`).
+    ``obstacles``: where moves were blocked (metres, in the robot's frame, heading 0):
+    only the turns that get furthest before them are considered."""
     turns = _bootstrap_turns(codec)
+    if obstacles is not None and obstacles.size:
+        travelled = travel_until(
+            np.zeros(turns.size, dtype=np.complex128), turns, np.full(turns.size, codec.max_length),
+            obstacles, OBSTACLE_RADIUS,
+        )  # fmt: skip
+        turns = turns[travelled >= travelled.max() - 1e-12]
     if memory is not None and half_fov < math.pi:
         return limited_view_movement(codec, view, turns, memory, half_fov)
     allowed = _allowed_turns(turns, view)
@@ -516,6 +525,12 @@ class GreedyOneStep(BeliefPolicy):
             self.visibility.missed, landmarks=landmarks, metres_per_unit=pose.metres_per_unit
         )
 
+    def _bootstrap(self, view: ObservationView) -> Movement:
+        obstacles = self.rays.bump_offsets() if self.avoid_bumps else None
+        return bootstrap_movement(
+            self.codec, view, self.memory.bearings, self.half_fov, obstacles=obstacles
+        )
+
     def _without_map(
         self, view: ObservationView, slam: PolygonSLAM, pose: PoseBelief | None = None
     ) -> Movement:
@@ -539,7 +554,7 @@ class GreedyOneStep(BeliefPolicy):
         if pose is not None and scale is not None:
             worlds = planner.fill_unmapped(
                 self._map_worlds(slam, pose.position, planner.hypotheses),
-                offsets, pose.heading, scale,
+                offsets, pose.heading, scale, self._vague(slam),
             )  # fmt: skip
             movement = planner.plan(
                 slam, worlds, pose.heading, scale, allowed, self.bootstrap_depth,
@@ -558,6 +573,12 @@ class GreedyOneStep(BeliefPolicy):
         if view.blocked and pose.metres_per_unit is not None:
             ahead = (BUMP_RADIUS / pose.metres_per_unit) * np.exp(1j * pose.heading)
             self.bumps.append(pose.position + ahead)
+
+    def _vague(self, slam: PolygonSLAM) -> NDArray[np.bool_]:
+        """Which landmarks (n,) the map places too vaguely to plan on (a region at the
+        cap or wider: its centroid can be far off): the hypothesised worlds put them
+        where the robot saw them instead."""
+        return np.concatenate([[False, False], ~(slam.areas < self.area_cap)])
 
     def _map_worlds(self, slam: PolygonSLAM, position: complex, count: int) -> Worlds:
         """``count`` copies of the map's world: its estimates and the believed position."""

@@ -55,6 +55,85 @@ from .visibility import BUMP_RADIUS, OBSTACLE_RADIUS, VisibilityPredictor, trave
 RANGE_PRIOR = (0.5, 3.0)
 
 
+#: How much the plans' earlier moves count (:func:`beam_search`'s ``early_weight``):
+#: with walls it does not know, the first move of a plan should already help.
+EARLY_WEIGHT = 1.0
+#: The prior on the arena, in longest moves: its walls stand about this far beyond the
+#: landmarks and the robot (their convex hull), so planned moves stop there.
+ARENA_MARGIN = 0.5
+
+
+def arena_limits(
+    landmarks: ComplexArray, positions: ComplexArray, margin: float
+) -> tuple[ComplexArray, FloatArray]:
+    """Per world (H,), the half-planes of the prior arena: the convex hull of the known
+    ``landmarks`` (H x n, NaN: unknown) and the robot's ``positions`` (H,), each edge
+    pushed out by ``margin``; (H x E) outward unit normals and offsets (a point p is
+    inside when Re(p conj(normal)) <= offset for every edge; padding: offset inf)."""
+    hulls = [
+        _convex_hull(np.concatenate([row[np.isfinite(row)], [position]]))
+        for row, position in zip(landmarks, positions, strict=True)
+    ]
+    edges = max(max(hull.size, 2) for hull in hulls)
+    normals = np.ones((len(hulls), edges), dtype=np.complex128)
+    offsets = np.full((len(hulls), edges), np.inf)
+    for h, hull in enumerate(hulls):
+        if hull.size < 2:
+            continue
+        if hull.size == 2:
+            # A segment: its two sides and its two ends.
+            along = (hull[1] - hull[0]) / abs(hull[1] - hull[0])
+            sides = np.array([along * -1j, along * 1j, along, -along])
+            anchors = np.array([hull[0], hull[0], hull[1], hull[0]])
+        else:
+            following = np.roll(hull, -1)
+            sides = (following - hull) * -1j  # counter-clockwise hull: outward normals
+            sides = sides / np.abs(sides)
+            anchors = hull
+        normals[h, : sides.size] = sides
+        offsets[h, : sides.size] = (anchors * sides.conjugate()).real + margin
+    return normals, offsets
+
+
+def _convex_hull(points: ComplexArray) -> ComplexArray:
+    """The convex hull of points, counter-clockwise (Andrew's monotone chain)."""
+    unique = np.unique(points)  # sorted by real part, then imaginary
+    if unique.size < 3:
+        return unique
+
+    def cross(o: complex, a: complex, b: complex) -> float:
+        return ((a - o).conjugate() * (b - o)).imag
+
+    lower: list[complex] = []
+    for point in unique:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], point) <= 0.0:
+            lower.pop()
+        lower.append(complex(point))
+    upper: list[complex] = []
+    for point in unique[::-1]:
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], point) <= 0.0:
+            upper.pop()
+        upper.append(complex(point))
+    return np.array(lower[:-1] + upper[:-1], dtype=np.complex128)
+
+
+def travel_inside(
+    positions: ComplexArray,
+    headings: FloatArray,
+    distances: FloatArray,
+    normals: ComplexArray,
+    offsets: FloatArray,
+) -> FloatArray:
+    """Distances (nodes, K, H) cut where moves from ``positions`` (nodes, H) along
+    ``headings`` (nodes, K) leave the half-planes (H x E, :func:`arena_limits`); a move
+    from outside that goes further out gets 0."""
+    starts = (positions[:, None, :, None] * normals.conjugate()[None, None]).real
+    rates = (np.exp(1j * headings)[:, :, None, None] * normals.conjugate()[None, None]).real
+    with np.errstate(divide="ignore", invalid="ignore"):
+        limits = np.where(rates > 1e-12, (offsets[None, None] - starts) / rates, np.inf)
+    return np.minimum(distances, np.maximum(limits.min(axis=-1), 0.0))
+
+
 class RayMemory:
     """The rays along which the robot saw each landmark, in its odometry frame.
 
@@ -197,6 +276,8 @@ class HypothesisPlanner:
         self.turns = np.array([c.turn for c in self.candidates], dtype=np.float64)
         self.lengths = np.array([c.length for c in self.candidates], dtype=np.float64)
         self.ranges = (low * codec.max_length, high * codec.max_length)
+        #: The prior arena's margin beyond the landmarks, metres (:data:`ARENA_MARGIN`).
+        self.margin = ARENA_MARGIN * codec.max_length
         #: The search's copies of the map, by role and size, refilled at each decision.
         self._beam: dict[tuple[str, int], BatchedPolygonSLAM] = {}
 
@@ -208,20 +289,33 @@ class HypothesisPlanner:
 
     @staticmethod
     def fill_unmapped(
-        worlds: Worlds, offsets: ComplexArray, heading: float, metres_per_unit: float
+        worlds: Worlds,
+        offsets: ComplexArray,
+        heading: float,
+        metres_per_unit: float,
+        replace: NDArray[np.bool_] | None = None,
     ) -> Worlds:
-        """FL worlds (from the map) with every landmark they do not place (NaN) put at
-        ``offsets`` (H x n, metres in the robot's frame) from the robot, turned by its
-        believed ``heading`` and scaled to FL."""
+        """FL worlds (from the map) with every landmark they do not place (NaN), and those
+        flagged in ``replace`` (n,), put at ``offsets`` (H x n, metres in the robot's
+        frame) from the robot, turned by its believed ``heading`` and scaled to FL
+        (where the offsets know the landmark)."""
         guessed = worlds.positions[:, None] + offsets * (np.exp(1j * heading) / metres_per_unit)
-        landmarks = np.where(np.isfinite(worlds.landmarks), worlds.landmarks, guessed)
+        keep = np.isfinite(worlds.landmarks)
+        if replace is not None:
+            keep &= ~(replace[None, :] & np.isfinite(guessed))
+        landmarks = np.where(keep, worlds.landmarks, guessed)
         return Worlds(landmarks, worlds.positions)
 
-    def mover(self, metres_per_unit: float, obstacles: ComplexArray | None) -> Mover:
-        """The distances moves travel in worlds of ``metres_per_unit`` metres per unit:
-        their lengths, cut at the ``obstacles`` (that frame), 0 below the minimum
-        baseline."""
+    def mover(
+        self, worlds: Worlds, metres_per_unit: float, obstacles: ComplexArray | None
+    ) -> Mover:
+        """The distances moves travel in ``worlds`` of ``metres_per_unit`` metres per
+        unit: their lengths, cut at the ``obstacles`` (that frame) and at the prior
+        arena's walls (:func:`arena_limits`), 0 below the minimum baseline."""
         radius = OBSTACLE_RADIUS / metres_per_unit
+        normals, offsets = arena_limits(
+            worlds.landmarks, worlds.positions, self.margin / metres_per_unit
+        )
 
         def mover(positions: ComplexArray, headings: FloatArray, lengths: FloatArray) -> FloatArray:
             distances = np.broadcast_to(
@@ -232,6 +326,7 @@ class HypothesisPlanner:
                 distances = travel_until(
                     positions[:, None, :], headings[:, :, None], distances, obstacles, radius
                 )
+            distances = travel_inside(positions, headings, distances, normals, offsets)
             return np.where(distances * metres_per_unit >= self.min_baseline, distances, 0.0)
 
         return mover
@@ -257,7 +352,7 @@ class HypothesisPlanner:
         if not first_allowed.any():
             return None
 
-        mover = self.mover(metres_per_unit, obstacles)
+        mover = self.mover(worlds, metres_per_unit, obstacles)
 
         sensor: Sensor | None = None
         if self.visibility is not None:
@@ -270,7 +365,7 @@ class HypothesisPlanner:
         first, score = beam_search(
             slam, worlds, heading, self.turns, self.lengths, first_allowed, mover,
             self.depth if depth is None else depth, self.width, self.area_cap,
-            scratch=self._beam, sensor=sensor,
+            scratch=self._beam, sensor=sensor, early_weight=EARLY_WEIGHT,
         )  # fmt: skip
         if first < 0 or score >= uncertainty_potential(slam.areas, self.area_cap):
             return None

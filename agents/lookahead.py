@@ -38,8 +38,9 @@ from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM, world_to_fl
 from bearing_env.validation import int_at_least
 
 from .base import Movement
-from .belief import ObservationView
+from .belief import ObservationView, PoseBelief
 from .heuristics import GreedyOneStep, _allowed_turns
+from .hypotheses import EARLY_WEIGHT
 from .planning import (
     ComplexArray,
     FloatArray,
@@ -113,7 +114,9 @@ class Lookahead(GreedyOneStep):
         if self.before_map is not None:
             # A limited camera: the landmarks not mapped yet where the robot remembers them.
             offsets = self.rays.offsets(worlds.positions.size, self.before_map.ranges, self.rng)
-            worlds = self.before_map.fill_unmapped(worlds, offsets, pose.heading, scale)
+            worlds = self.before_map.fill_unmapped(
+                worlds, offsets, pose.heading, scale, self._vague(slam)
+            )
 
         self._record_bump(view, pose)
 
@@ -126,8 +129,11 @@ class Lookahead(GreedyOneStep):
             shape = (positions.shape[0], lengths.size, positions.shape[1])
             return np.broadcast_to((metres / scale)[None, :, None], shape)
 
+        if self.before_map is not None:
+            # A limited camera: moves stop at the bumps and at the prior arena's walls.
+            mover = self.before_map.mover(worlds, scale, np.array(self.bumps, dtype=np.complex128))
         sensor = self._sensor(view, pose, worlds.landmarks)
-        movement = self._search(view, slam, worlds, pose.heading, mover, sensor)
+        movement = self._search(view, slam, worlds, pose.heading, mover, sensor, pose)
         self.planning_times.append(time.perf_counter() - started)
         return movement
 
@@ -139,6 +145,7 @@ class Lookahead(GreedyOneStep):
         heading: float,
         mover: Mover,
         sensor: Sensor | None = None,
+        pose: PoseBelief | None = None,
     ) -> Movement:
         turns = np.array([c.turn for c in self.candidates])
         lengths = np.array([c.length for c in self.candidates])
@@ -156,9 +163,10 @@ class Lookahead(GreedyOneStep):
             self.area_cap,
             scratch=self._beam,
             sensor=sensor,
+            early_weight=0.0 if self.before_map is None else EARLY_WEIGHT,
         )
         if first < 0 or score >= uncertainty_potential(slam.areas, self.area_cap):
-            return self._without_map(view, slam)
+            return self._without_map(view, slam, pose)
         return self.candidates[first]
 
     def _worlds(self, slam: PolygonSLAM, position: complex) -> Worlds:
