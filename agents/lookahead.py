@@ -120,7 +120,9 @@ class Lookahead(GreedyOneStep):
 
         self._record_bump(view, pose)
 
-        def mover(positions: ComplexArray, headings: FloatArray, lengths: FloatArray) -> FloatArray:
+        def by_length(
+            positions: ComplexArray, headings: FloatArray, lengths: FloatArray
+        ) -> FloatArray:
             if self.avoid_bumps and self.bumps:
                 return self._travel(
                     positions[:, None, :], headings[:, :, None], lengths[None, :, None], scale
@@ -129,6 +131,7 @@ class Lookahead(GreedyOneStep):
             shape = (positions.shape[0], lengths.size, positions.shape[1])
             return np.broadcast_to((metres / scale)[None, :, None], shape)
 
+        mover: Mover = by_length
         if self.before_map is not None:
             # A limited camera: moves stop at the bumps and at the prior arena's walls.
             mover = self.before_map.mover(worlds, scale, np.array(self.bumps, dtype=np.complex128))
