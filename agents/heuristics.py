@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 from bearing_env.envs.core import WorldView
 from bearing_env.numerics import wrap, wrap_angle
 from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM, world_to_fl
+from bearing_env.validation import int_at_least
 
 from .base import Action, ActionCodec, Movement, policy_rng
 from .belief import (
@@ -428,9 +429,11 @@ class GreedyOneStep(BeliefPolicy):
             discrete id, how many of the table's lengths to use, longest first.
         predict_visibility: simulate missed readings (above); False simulates the
             panoramic camera whatever the env's sensor.
-        bootstrap_worlds: with a limited camera, the worlds the move before the map is
-            planned in (:class:`~bearing_env.agents.hypotheses.HypothesisPlanner`); 0:
-            the bearing-memory bootstrap alone. Unused with the panoramic camera.
+        bootstrap_worlds: with a limited camera, the worlds the moves the map gives
+            nothing to plan on are planned in
+            (:class:`~bearing_env.agents.hypotheses.HypothesisPlanner`); 0: the
+            bearing-memory bootstrap alone. Unused with the panoramic camera.
+        bootstrap_depth: the longest plan tried there (the shortest that helps wins).
     """
 
     name = "greedy_one_step"
@@ -443,7 +446,7 @@ class GreedyOneStep(BeliefPolicy):
         lengths: int | tuple[float, ...] = 2,
         predict_visibility: bool = True,
         bootstrap_worlds: int = 8,
-        bootstrap_depth: int = 1,
+        bootstrap_depth: int = 2,
     ) -> None:
         super().__init__(env)
         self.visibility = VisibilityPredictor(env) if predict_visibility else None
@@ -471,8 +474,8 @@ class GreedyOneStep(BeliefPolicy):
         #: The last resected position (FL) and the last commanded (turn, length).
         self._resected: complex | None = None
         self._last_move = (0.0, 0.0)
-        #: Moves per plan of the planner in hypothesised worlds.
-        self.bootstrap_depth = int(bootstrap_depth)
+        #: The longest plan (moves) tried in hypothesised worlds.
+        self.bootstrap_depth = int_at_least(bootstrap_depth, 1, "bootstrap_depth")
         if int(n_turns) < 1:
             raise ValueError(f"n_turns must be >= 1, got {n_turns!r}")
         self.candidates = self.codec.candidates(int(n_turns), lengths)
@@ -556,16 +559,13 @@ class GreedyOneStep(BeliefPolicy):
                 self._map_worlds(slam, pose.position, planner.hypotheses),
                 offsets, pose.heading, scale, self._vague(slam),
             )  # fmt: skip
-            movement = planner.plan(
-                slam, worlds, pose.heading, scale, allowed, self.bootstrap_depth,
-                obstacles=np.array(self.bumps, dtype=np.complex128),
-            )  # fmt: skip
+            bumps = np.array(self.bumps, dtype=np.complex128)
+            movement = self._shortest_plan(slam, worlds, pose.heading, scale, allowed, bumps)
         elif not np.any(np.isfinite(slam.areas)):
             worlds = planner.robot_frame_worlds(offsets)
-            movement = planner.plan(
-                slam, worlds, 0.0, 1.0, allowed, self.bootstrap_depth, with_bumps=False,
-                obstacles=self.rays.bump_offsets(),
-            )  # fmt: skip
+            movement = self._shortest_plan(
+                slam, worlds, 0.0, 1.0, allowed, self.rays.bump_offsets(), in_fl=False
+            )
         return self._bootstrap(view) if movement is None else movement
 
     def _record_bump(self, view: ObservationView, pose: PoseBelief) -> None:
@@ -573,6 +573,30 @@ class GreedyOneStep(BeliefPolicy):
         if view.blocked and pose.metres_per_unit is not None:
             ahead = (BUMP_RADIUS / pose.metres_per_unit) * np.exp(1j * pose.heading)
             self.bumps.append(pose.position + ahead)
+
+    def _shortest_plan(
+        self,
+        slam: PolygonSLAM,
+        worlds: Worlds,
+        heading: float,
+        metres_per_unit: float,
+        allowed: NDArray[np.bool_],
+        obstacles: ComplexArray,
+        in_fl: bool = True,
+    ) -> Movement | None:
+        """The first move of the shortest plan (1, 2, ... :attr:`bootstrap_depth` moves)
+        predicted to help in hypothesised worlds: when no move helps at once, a pair of
+        moves whose first one leads to a better view (a deeper plan's first move more
+        often runs into walls the robot does not know)."""
+        assert self.before_map is not None
+        for depth in range(1, self.bootstrap_depth + 1):
+            movement = self.before_map.plan(
+                slam, worlds, heading, metres_per_unit, allowed, depth,
+                with_bumps=in_fl, obstacles=obstacles,
+            )  # fmt: skip
+            if movement is not None:
+                return movement
+        return None
 
     def _vague(self, slam: PolygonSLAM) -> NDArray[np.bool_]:
         """Which landmarks (n,) the map places too vaguely to plan on (a region at the

@@ -55,9 +55,6 @@ from .visibility import BUMP_RADIUS, OBSTACLE_RADIUS, VisibilityPredictor, trave
 RANGE_PRIOR = (0.5, 3.0)
 
 
-#: How much the plans' earlier moves count (:func:`beam_search`'s ``early_weight``):
-#: with walls it does not know, the first move of a plan should already help.
-EARLY_WEIGHT = 1.0
 #: The prior on the arena, in longest moves: its walls stand about this far beyond the
 #: landmarks and the robot (their convex hull), so planned moves stop there.
 ARENA_MARGIN = 0.5
@@ -365,7 +362,7 @@ class HypothesisPlanner:
         first, score = beam_search(
             slam, worlds, heading, self.turns, self.lengths, first_allowed, mover,
             self.depth if depth is None else depth, self.width, self.area_cap,
-            scratch=self._beam, sensor=sensor, early_weight=EARLY_WEIGHT,
+            scratch=self._beam, sensor=sensor,
         )  # fmt: skip
         if first < 0 or score >= uncertainty_potential(slam.areas, self.area_cap):
             return None

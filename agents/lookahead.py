@@ -38,9 +38,8 @@ from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM, world_to_fl
 from bearing_env.validation import int_at_least
 
 from .base import Movement
-from .belief import ObservationView, PoseBelief
+from .belief import ObservationView
 from .heuristics import GreedyOneStep, _allowed_turns
-from .hypotheses import EARLY_WEIGHT
 from .planning import (
     ComplexArray,
     FloatArray,
@@ -105,18 +104,20 @@ class Lookahead(GreedyOneStep):
         self.planning_times = []
 
     def _choose(self, view: ObservationView, slam: PolygonSLAM) -> Movement:
+        if self.before_map is not None:
+            # A limited camera: GreedyOneStep's route with this planner's candidates, up
+            # to this depth in hypothesised worlds when no move helps at once (the
+            # uncertainty-region worlds below did worse there: docs/policies.md).
+            started = time.perf_counter()
+            movement = super()._choose(view, slam)
+            self.planning_times.append(time.perf_counter() - started)
+            return movement
         pose = self._pose(view, slam)
         if pose is None or pose.metres_per_unit is None:
             return self._without_map(view, slam, pose)
         scale = pose.metres_per_unit
         started = time.perf_counter()
         worlds = self._worlds(slam, pose.position)
-        if self.before_map is not None:
-            # A limited camera: the landmarks not mapped yet where the robot remembers them.
-            offsets = self.rays.offsets(worlds.positions.size, self.before_map.ranges, self.rng)
-            worlds = self.before_map.fill_unmapped(
-                worlds, offsets, pose.heading, scale, self._vague(slam)
-            )
 
         self._record_bump(view, pose)
 
@@ -131,12 +132,8 @@ class Lookahead(GreedyOneStep):
             shape = (positions.shape[0], lengths.size, positions.shape[1])
             return np.broadcast_to((metres / scale)[None, :, None], shape)
 
-        mover: Mover = by_length
-        if self.before_map is not None:
-            # A limited camera: moves stop at the bumps and at the prior arena's walls.
-            mover = self.before_map.mover(worlds, scale, np.array(self.bumps, dtype=np.complex128))
         sensor = self._sensor(view, pose, worlds.landmarks)
-        movement = self._search(view, slam, worlds, pose.heading, mover, sensor, pose)
+        movement = self._search(view, slam, worlds, pose.heading, by_length, sensor)
         self.planning_times.append(time.perf_counter() - started)
         return movement
 
@@ -148,7 +145,6 @@ class Lookahead(GreedyOneStep):
         heading: float,
         mover: Mover,
         sensor: Sensor | None = None,
-        pose: PoseBelief | None = None,
     ) -> Movement:
         turns = np.array([c.turn for c in self.candidates])
         lengths = np.array([c.length for c in self.candidates])
@@ -166,10 +162,9 @@ class Lookahead(GreedyOneStep):
             self.area_cap,
             scratch=self._beam,
             sensor=sensor,
-            early_weight=0.0 if self.before_map is None else EARLY_WEIGHT,
         )
         if first < 0 or score >= uncertainty_potential(slam.areas, self.area_cap):
-            return self._without_map(view, slam, pose)
+            return self._without_map(view, slam)
         return self.candidates[first]
 
     def _worlds(self, slam: PolygonSLAM, position: complex) -> Worlds:

@@ -192,7 +192,6 @@ def beam_search(
     area_cap: float,
     scratch: dict[tuple[str, int], BatchedPolygonSLAM] | None = None,
     sensor: Sensor | None = None,
-    early_weight: float = 0.0,
 ) -> tuple[int, float]:
     """The index of the first candidate of the best plan, and that plan's mean score.
 
@@ -203,9 +202,7 @@ def beam_search(
     by role and size, kept between calls and refilled in place
     (:meth:`BatchedPolygonSLAM.take`) instead of made anew at each depth. ``sensor``
     predicts the readings' misses (its landmarks are the worlds'; None: every landmark
-    seen). ``early_weight``: plans are ranked by their last potential plus this times
-    the potentials after their earlier moves (progress sooner rather than later); the
-    score returned is the last potential alone.
+    seen).
     """
     batches: dict[tuple[str, int], BatchedPolygonSLAM] = {} if scratch is None else scratch
     n_worlds = worlds.positions.size
@@ -216,7 +213,6 @@ def beam_search(
     positions = worlds.positions[None, :]  # (nodes, H)
     headings = np.array([heading])  # (nodes,)
     firsts = np.array([-1])
-    early = np.zeros(1)  # (nodes,): early_weight x the potentials along each node's plan
     best_first, best_score = -1, math.inf
     for level in range(depth):
         allowed = first_allowed if level == 0 else np.ones(turns.size, dtype=bool)
@@ -248,8 +244,7 @@ def beam_search(
         potentials = uncertainty_potential(trials.areas, area_cap).reshape(n_nodes, n_k, n_worlds)
         scores = potentials.mean(axis=2)  # (nodes, K)
         node_firsts = np.where(firsts[:, None] < 0, ks[None, :], firsts[:, None])
-        ranked = scores if not early_weight else scores + early[:, None]
-        order = np.argsort(ranked, axis=None, kind="stable")
+        order = np.argsort(scores, axis=None, kind="stable")
         best = int(order[0])
         best_first, best_score = int(node_firsts.reshape(-1)[best]), float(scores.reshape(-1)[best])
         if level == depth - 1:
@@ -263,5 +258,4 @@ def beam_search(
         positions = ends[node_index, k_index]
         headings = new_headings[node_index, k_index]
         firsts = node_firsts[node_index, k_index]
-        early = early[node_index] + early_weight * scores[node_index, k_index]
     return best_first, best_score
