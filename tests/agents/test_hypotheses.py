@@ -20,7 +20,7 @@ from .test_agents import PoisonedWorld, play, play_with_truth_swapped, same_acti
 CAMERA180 = "bearing_env:BearingSLAM-Khepera-Camera180-v0"
 #: Evaluation episodes of the 180 degree task (compare's seeds) where the old bootstrap
 #: maps no landmark in 20 moves and the hypothesised worlds map both.
-SEEDS_WHERE_IT_HELPS = (1_000_001, 1_000_002, 1_000_004, 1_000_009)
+SEEDS_WHERE_IT_HELPS = (1_000_000, 1_000_002, 1_000_004, 1_000_009)
 
 
 def _final_total_area(env: gym.Env, policy: Any, seed: int) -> float:
@@ -72,14 +72,17 @@ def test_the_new_path_is_deterministic_under_a_seed() -> None:
     assert not same_actions(first, other)
 
 
-def test_hypothesised_worlds_map_more_than_the_bearing_memory_bootstrap() -> None:
-    """On the first evaluation episodes of the 180 degree task (where the difference is
-    large: the old bootstrap maps no landmark in them) Lookahead ends with a smaller
-    total area than the same planner with the old bootstrap alone."""
+@pytest.mark.parametrize("policy_class", [GreedyOneStep, Lookahead])
+def test_hypothesised_worlds_map_more_than_the_bearing_memory_bootstrap(
+    policy_class: type[GreedyOneStep],
+) -> None:
+    """On a few of the first evaluation episodes of the 180 degree task (where the
+    difference is large: the old bootstrap maps no landmark in them) the planner ends
+    with a much smaller total area than the same planner with the old bootstrap alone."""
     env = gym.make(CAMERA180)
     for seed in SEEDS_WHERE_IT_HELPS:
-        new = _final_total_area(env, Lookahead(env), seed)
-        old = _final_total_area(env, Lookahead(env, bootstrap_worlds=0), seed)
+        new = _final_total_area(env, policy_class(env), seed)
+        old = _final_total_area(env, policy_class(env, bootstrap_worlds=0), seed)
         assert new < old - 5.0, (seed, new, old)
 
 
