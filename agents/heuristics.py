@@ -420,6 +420,14 @@ class GreedyOneStep(BeliefPolicy):
     camera a move that turns L1 or L2 out of view predicts no progress, as the real
     update skips it. With the paper's panoramic camera it changes nothing.
 
+    With a limited camera (a forward field of view or a range) the moves the map gives
+    nothing to plan on are planned in hypothesised worlds
+    (:mod:`bearing_env.agents.hypotheses`; the shortest plan predicted to help, up to
+    ``bootstrap_depth`` moves), and the believed position is resected from the latest
+    bearings of L1 and L2 (:func:`~bearing_env.agents.belief.resect_position`). With a
+    limited camera or obstacles in the arena, simulated moves stop at the places where
+    moves were blocked, and so does the bootstrap's choice of turn.
+
     Args:
         env: the env it acts in (either id).
         n_turns: turns evenly spaced over the circle (continuous id; the discrete id

@@ -1,25 +1,26 @@
-"""Planning before the map: moves scored in worlds hypothesised from remembered bearings.
+"""Planning where the map gives nothing to plan on: moves scored in hypothesised worlds.
 
 With a forward camera a movement maps a landmark only when L1, L2 and it stay in view
 at both readings and the move gives them parallax. Before the robot's map holds a
-landmark (and often before it holds a frame) the map-based planners have nothing to
-simulate; :class:`HypothesisPlanner` builds the worlds it plans in from what the robot
-knows instead:
+landmark (and often before it holds a frame), and whenever no move is predicted to
+help on the map, the map-based planners have nothing to simulate;
+:class:`HypothesisPlanner` scores moves in worlds built from what the robot knows:
 
-- the bearings it remembers (:class:`~bearing_env.agents.visibility.BearingMemory`,
-  relative to its current heading; a landmark never seen stays unknown and predicts
-  no progress);
-- a range for each of them, unknown to the robot: every world draws it log-uniformly
-  from the prior :data:`RANGE_PRIOR`, in units of the robot's longest move (its own
-  hardware: the landmarks of a room it can cross in a few moves stand a few moves
-  away);
-- its camera (field of view and range, :class:`~bearing_env.agents.visibility.VisibilityPredictor`);
-  the obstacles it bumped into are in FL, not in these worlds' frame, so they are left
-  out here.
+- where it saw each landmark (:class:`RayMemory`: rays in its odometry frame, from its
+  own commands): at the rays' triangulation when two of them cross, else along the
+  last ray at a range unknown to the robot, drawn log-uniformly from the prior
+  :data:`RANGE_PRIOR` in units of its longest move (its own hardware: the landmarks of
+  a room it crosses in a few moves stand a few moves away); a landmark never seen
+  stays unknown and predicts no progress;
+- once the map has a pose, the map itself (FL): its estimates, and the landmarks it
+  has not mapped, or only vaguely, put where the rays say (:meth:`HypothesisPlanner.fill_unmapped`);
+- its camera (field of view and range, :class:`~bearing_env.agents.visibility.VisibilityPredictor`),
+  the places where moves were blocked, and a prior arena (:func:`arena_limits`: the
+  walls stand about :data:`ARENA_MARGIN` longest moves beyond the landmarks).
 
-Each world is in the robot's own frame, in metres (the robot at 0, heading 0): bearings
+Worlds in the robot's own frame are in metres (the robot at 0, heading 0): bearings
 are invariant under the similarity to FL, so the world model's update needs no scale.
-Candidate moves and pairs of moves are scored by the same beam search as
+Candidate moves and plans of several moves are scored by the same beam search as
 :class:`~bearing_env.agents.lookahead.Lookahead` (:func:`~bearing_env.agents.planning.beam_search`)
 on copies of the robot's map, by the mean predicted potential over the worlds.
 Nothing here reads ground truth.
@@ -53,8 +54,6 @@ from .visibility import BUMP_RADIUS, OBSTACLE_RADIUS, VisibilityPredictor, trave
 #: The prior on a remembered landmark's range, in units of the robot's longest move
 #: (low, high; log-uniform).
 RANGE_PRIOR = (0.5, 3.0)
-
-
 #: The prior on the arena, in longest moves: its walls stand about this far beyond the
 #: landmarks and the robot (their convex hull), so planned moves stop there.
 ARENA_MARGIN = 0.5

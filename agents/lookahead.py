@@ -74,6 +74,11 @@ class Lookahead(GreedyOneStep):
 
     ``planning_times`` holds the wall-clock seconds of every planned move of the episode
     (bootstrap moves excluded), for reports.
+
+    With a limited camera it takes :class:`GreedyOneStep`'s route with its own
+    candidates and ``depth`` as the longest plan in hypothesised worlds: its worlds drawn
+    inside the uncertainty regions did worse there (docs/policies.md, "A limited
+    sensor"); then ``planning_times`` holds every decision's time.
     """
 
     name = "lookahead"
