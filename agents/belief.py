@@ -259,6 +259,35 @@ class RobotBelief:
         return PoseBelief(position=position, heading=heading, metres_per_unit=scale)
 
 
+def resect_position(
+    heading: float, bearings: NDArray[np.float64], landmarks: NDArray[np.complex128]
+) -> complex | None:
+    """The robot's FL position from its heading in FL and the bearings it reads (NaN:
+    missed) of landmarks at known FL positions (NaN: unknown): the point nearest (least
+    squares) to the lines of sight back from the landmarks. None without two usable
+    lines that cross at 1 degree or more, or if it lies behind one."""
+    usable = np.isfinite(bearings) & np.isfinite(landmarks)
+    if np.count_nonzero(usable) < 2:
+        return None
+    directions = np.exp(1j * (heading + bearings[usable]))
+    points = landmarks[usable]
+    spread = np.abs((directions[:, None].conjugate() * directions[None, :]).imag).max()
+    if spread < math.sin(math.radians(1.0)):
+        return None
+    normal_sum = np.zeros((2, 2))
+    target = np.zeros(2)
+    for point, direction in zip(points, directions, strict=True):
+        unit = np.array([direction.real, direction.imag])
+        projector = np.eye(2) - np.outer(unit, unit)
+        normal_sum += projector
+        target += projector @ np.array([point.real, point.imag])
+    solution = np.linalg.solve(normal_sum, target)
+    position = complex(solution[0], solution[1])
+    if np.any(((points - position) * directions.conjugate()).real <= 0.0):
+        return None
+    return position
+
+
 def spread_turn(bearings: NDArray[np.float64], turns: NDArray[np.float64]) -> int:
     """Index of the turn after which every landmark is farthest from the line of motion.
 

@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 from bearing_env.envs.core import WorldView
 from bearing_env.numerics import wrap, wrap_angle
 from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM, world_to_fl
+from bearing_env.validation import int_at_least
 
 from .base import Action, ActionCodec, Movement, policy_rng
 from .belief import (
@@ -22,17 +23,34 @@ from .belief import (
     ObservationView,
     PoseBelief,
     RobotBelief,
+    resect_position,
     spread_turn,
 )
 from .env_access import MapReader, bearing_env_of, world_of
+from .hypotheses import HypothesisPlanner, RayMemory
 from .planning import (
+    ComplexArray,
+    FloatArray,
     Sensor,
+    Worlds,
     landmark_positions_fl,
     simulate_potentials,
     uncertainty_potential,
 )
-from .visibility import TOO_CLOSE, BearingMemory, TrueSensor, VisibilityPredictor, keep_in_view
+from .visibility import (
+    BUMP_RADIUS,
+    OBSTACLE_RADIUS,
+    TOO_CLOSE,
+    BearingMemory,
+    TrueSensor,
+    VisibilityPredictor,
+    keep_in_view,
+    travel_until,
+)
 
+#: The largest region (FL units²) of a mapped landmark whose estimate is precise enough
+#: to resect the robot's position from its bearing (a limited camera).
+RESECTION_AREA = 0.5
 #: Turns tried by the bootstrap move on the continuous id (every 5 degrees).
 BOOTSTRAP_TURNS = 72
 #: After a move stopped by the wall, turns closer than this to straight ahead are avoided:
@@ -124,14 +142,23 @@ def bootstrap_movement(
     view: ObservationView,
     memory: NDArray[np.float64] | None = None,
     half_fov: float = math.pi,
+    obstacles: NDArray[np.complex128] | None = None,
 ) -> Movement:
     """The move made before there is a map (or a scale): longest length, in the direction
     that keeps every landmark farthest from the line of motion (see ``spread_turn``).
 
     With a forward camera (``half_fov`` below pi) and the robot's ``memory`` of bearings
     (:class:`~bearing_env.agents.visibility.BearingMemory`) it turns to keep L1, L2 and
-    as many landmarks as it can in view instead (:func:`limited_view_movement`)."""
+    as many landmarks as it can in view instead (:func:`limited_view_movement`).
+    ``obstacles``: where moves were blocked (metres, in the robot's frame, heading 0):
+    only the turns that get furthest before them are considered."""
     turns = _bootstrap_turns(codec)
+    if obstacles is not None and obstacles.size:
+        travelled = travel_until(
+            np.zeros(turns.size, dtype=np.complex128), turns, np.full(turns.size, codec.max_length),
+            obstacles, OBSTACLE_RADIUS,
+        )  # fmt: skip
+        turns = turns[travelled >= travelled.max() - 1e-12]
     if memory is not None and half_fov < math.pi:
         return limited_view_movement(codec, view, turns, memory, half_fov)
     allowed = _allowed_turns(turns, view)
@@ -394,6 +421,14 @@ class GreedyOneStep(BeliefPolicy):
     camera a move that turns L1 or L2 out of view predicts no progress, as the real
     update skips it. With the paper's panoramic camera it changes nothing.
 
+    With a limited camera (a forward field of view or a range) the moves the map gives
+    nothing to plan on are planned in hypothesised worlds
+    (:mod:`bearing_env.agents.hypotheses`; the shortest plan predicted to help, up to
+    ``bootstrap_depth`` moves), and the believed position is resected from the latest
+    bearings of L1 and L2 (:func:`~bearing_env.agents.belief.resect_position`). With a
+    limited camera or obstacles in the arena, simulated moves stop at the places where
+    moves were blocked, and so does the bootstrap's choice of turn.
+
     Args:
         env: the env it acts in (either id).
         n_turns: turns evenly spaced over the circle (continuous id; the discrete id
@@ -403,6 +438,11 @@ class GreedyOneStep(BeliefPolicy):
             discrete id, how many of the table's lengths to use, longest first.
         predict_visibility: simulate missed readings (above); False simulates the
             panoramic camera whatever the env's sensor.
+        bootstrap_worlds: with a limited camera, the worlds the moves the map gives
+            nothing to plan on are planned in
+            (:class:`~bearing_env.agents.hypotheses.HypothesisPlanner`); 0: the
+            bearing-memory bootstrap alone. Unused with the panoramic camera.
+        bootstrap_depth: the longest plan tried there (the shortest that helps wins).
     """
 
     name = "greedy_one_step"
@@ -414,9 +454,37 @@ class GreedyOneStep(BeliefPolicy):
         n_turns: int = 8,
         lengths: int | tuple[float, ...] = 2,
         predict_visibility: bool = True,
+        bootstrap_worlds: int = 8,
+        bootstrap_depth: int = 2,
     ) -> None:
         super().__init__(env)
         self.visibility = VisibilityPredictor(env) if predict_visibility else None
+        #: Plans the moves before the map with a limited camera (None: panoramic, or
+        #: ``bootstrap_worlds=0``).
+        self.before_map: HypothesisPlanner | None = None
+        camera = VisibilityPredictor(env)
+        if camera.limited and int(bootstrap_worlds) > 0:
+            self.before_map = HypothesisPlanner(
+                self.codec,
+                float(bearing_env_of(env).config.layout.arena.min_baseline),
+                float(bearing_env_of(env).config.task.area_cap),
+                self.visibility,
+                hypotheses=int(bootstrap_worlds),
+            )
+        #: Plan moves around the places where moves were blocked (:attr:`bumps`): with a
+        #: limited camera, or in an arena that has obstacles (the robot is told it is in
+        #: a furnished room, not where the furniture stands).
+        self.avoid_bumps = camera.limited or bool(bearing_env_of(env).config.layout.obstacles)
+        #: Where moves were blocked this episode (FL, just ahead of the believed pose).
+        self.bumps: list[complex] = []
+        self.min_baseline = float(bearing_env_of(env).config.layout.arena.min_baseline)
+        #: Where the robot saw each landmark (odometry rays), for the hypothesised worlds.
+        self.rays = RayMemory(bearing_env_of(env).epsilon)
+        #: The last resected position (FL) and the last commanded (turn, length).
+        self._resected: complex | None = None
+        self._last_move = (0.0, 0.0)
+        #: The longest plan (moves) tried in hypothesised worlds.
+        self.bootstrap_depth = int_at_least(bootstrap_depth, 1, "bootstrap_depth")
         if int(n_turns) < 1:
             raise ValueError(f"n_turns must be >= 1, got {n_turns!r}")
         self.candidates = self.codec.candidates(int(n_turns), lengths)
@@ -438,8 +506,21 @@ class GreedyOneStep(BeliefPolicy):
 
     def reset(self, seed: int | None = None) -> None:
         super().reset(seed)
+        self.rays.reset()
+        self.bumps = []
+        self._resected = None
+        self._last_move = (0.0, 0.0)
         if self.visibility is not None:
             self.visibility.reset()
+
+    def _observe(self, view: ObservationView) -> None:
+        super()._observe(view)
+        self.rays.observe(view.bearings, view.seen, view.progress == 0.0, view.blocked)
+
+    def _commanded(self, movement: Movement, view: ObservationView) -> None:
+        super()._commanded(movement, view)
+        self.rays.commanded(movement.turn, movement.length)
+        self._last_move = (movement.turn, movement.length)
 
     def _sensor(
         self, view: ObservationView, pose: PoseBelief, landmarks: NDArray[np.complex128]
@@ -456,22 +537,140 @@ class GreedyOneStep(BeliefPolicy):
             self.visibility.missed, landmarks=landmarks, metres_per_unit=pose.metres_per_unit
         )
 
-    def _choose(self, view: ObservationView, slam: PolygonSLAM) -> Movement:
-        pose = self.belief.pose(slam)
-        if pose is None or pose.metres_per_unit is None:
+    def _bootstrap(self, view: ObservationView) -> Movement:
+        obstacles = self.rays.bump_offsets() if self.avoid_bumps else None
+        return bootstrap_movement(
+            self.codec, view, self.memory.bearings, self.half_fov, obstacles=obstacles
+        )
+
+    def _without_map(
+        self, view: ObservationView, slam: PolygonSLAM, pose: PoseBelief | None = None
+    ) -> Movement:
+        """The move when the map gives nothing to plan on. With a limited camera it is
+        planned in hypothesised worlds (:class:`~bearing_env.agents.hypotheses.HypothesisPlanner`):
+        in FL, from the map and the believed ``pose`` with a scale, the landmarks not yet
+        mapped where the robot remembers them; or, while no landmark is mapped, in the
+        robot's own frame. Else (or when that predicts no progress) the bootstrap."""
+        memory = self.memory.bearings
+        planner = self.before_map
+        if planner is None or memory.size < 2 or not np.all(np.isfinite(memory[:2])):
             return self._bootstrap(view)
+        allowed = _allowed_turns(planner.turns, view)
+        movement = None
+        offsets = self.rays.offsets(planner.hypotheses, planner.ranges, self.rng)
+        scale = None if pose is None else pose.metres_per_unit
+        if pose is not None and scale is None:
+            # No scale from the map's movements yet: |L1 - L2| in metres as the rays put it.
+            spans = np.abs(offsets[:, 0] - offsets[:, 1])
+            scale = float(np.median(spans)) if np.all(np.isfinite(spans)) else None
+        if pose is not None and scale is not None:
+            worlds = planner.fill_unmapped(
+                self._map_worlds(slam, pose.position, planner.hypotheses),
+                offsets, pose.heading, scale, self._vague(slam),
+            )  # fmt: skip
+            bumps = np.array(self.bumps, dtype=np.complex128)
+            movement = self._shortest_plan(slam, worlds, pose.heading, scale, allowed, bumps)
+        elif not np.any(np.isfinite(slam.areas)):
+            worlds = planner.robot_frame_worlds(offsets)
+            movement = self._shortest_plan(
+                slam, worlds, 0.0, 1.0, allowed, self.rays.bump_offsets(), in_fl=False
+            )
+        return self._bootstrap(view) if movement is None else movement
+
+    def _record_bump(self, view: ObservationView, pose: PoseBelief) -> None:
+        """After a blocked move, remember (FL) that something stands just ahead."""
+        if view.blocked and pose.metres_per_unit is not None:
+            ahead = (BUMP_RADIUS / pose.metres_per_unit) * np.exp(1j * pose.heading)
+            self.bumps.append(pose.position + ahead)
+
+    def _shortest_plan(
+        self,
+        slam: PolygonSLAM,
+        worlds: Worlds,
+        heading: float,
+        metres_per_unit: float,
+        allowed: NDArray[np.bool_],
+        obstacles: ComplexArray,
+        in_fl: bool = True,
+    ) -> Movement | None:
+        """The first move of the shortest plan (1, 2, ... :attr:`bootstrap_depth` moves)
+        predicted to help in hypothesised worlds: when no move helps at once, a pair of
+        moves whose first one leads to a better view (a deeper plan's first move more
+        often runs into walls the robot does not know)."""
+        assert self.before_map is not None
+        for depth in range(1, self.bootstrap_depth + 1):
+            movement = self.before_map.plan(
+                slam, worlds, heading, metres_per_unit, allowed, depth,
+                with_bumps=in_fl, obstacles=obstacles,
+            )  # fmt: skip
+            if movement is not None:
+                return movement
+        return None
+
+    def _vague(self, slam: PolygonSLAM) -> NDArray[np.bool_]:
+        """Which landmarks (n,) the map places too vaguely to plan on (a region at the
+        cap or wider: its centroid can be far off): the hypothesised worlds put them
+        where the robot saw them instead."""
+        return np.concatenate([[False, False], ~(slam.areas < self.area_cap)])
+
+    def _map_worlds(self, slam: PolygonSLAM, position: complex, count: int) -> Worlds:
+        """``count`` copies of the map's world: its estimates and the believed position."""
+        landmarks = np.broadcast_to(landmark_positions_fl(slam), (count, slam.n_landmarks))
+        return Worlds(landmarks.copy(), np.full(count, position, dtype=np.complex128))
+
+    def _pose(self, view: ObservationView, slam: PolygonSLAM) -> PoseBelief | None:
+        """The believed pose; with a limited camera its position is resected from the
+        latest reading of L1, L2 and the landmarks mapped within :data:`RESECTION_AREA`
+        when it saw two of them (the map's robot region is wide when few movements
+        changed frames)."""
+        pose = self.belief.pose(slam)
+        if pose is None or self.before_map is None:
+            return pose
+        landmarks = landmark_positions_fl(slam)
+        sharp = np.concatenate([[True, True], slam.areas <= RESECTION_AREA])
+        position = resect_position(
+            pose.heading, view.readings, np.where(sharp, landmarks, complex(np.nan, np.nan))
+        )
+        if position is None and self._resected is not None and pose.metres_per_unit is not None:
+            # Not resected now: the last resection carried by the move made since.
+            _, length = self._last_move
+            ahead = (length / pose.metres_per_unit) * np.exp(1j * pose.heading)
+            position = self._resected + (0.5 if view.blocked else 1.0) * ahead
+        self._resected = position
+        if position is None:
+            return pose
+        return PoseBelief(position, pose.heading, pose.metres_per_unit)
+
+    def _travel(
+        self, positions: ComplexArray, headings: FloatArray, lengths: FloatArray, scale: float
+    ) -> FloatArray:
+        """FL distances of moves of ``lengths`` metres: cut at the recorded bumps when the
+        policy avoids them (0 below the minimum baseline), else the full lengths."""
+        distances = np.asarray(lengths / scale, dtype=np.float64)
+        if not (self.avoid_bumps and self.bumps):
+            return distances
+        obstacles = np.array(self.bumps, dtype=np.complex128)
+        cut = travel_until(positions, headings, distances, obstacles, OBSTACLE_RADIUS / scale)
+        return np.where(cut * scale >= self.min_baseline, cut, 0.0)
+
+    def _choose(self, view: ObservationView, slam: PolygonSLAM) -> Movement:
+        pose = self._pose(view, slam)
+        if pose is None or pose.metres_per_unit is None:
+            return self._without_map(view, slam, pose)
+        self._record_bump(view, pose)
         allowed = np.flatnonzero(_allowed_turns(self._turns, view))
         landmarks = landmark_positions_fl(slam)
+        headings = pose.heading + self._turns[allowed]
         potentials = simulate_potentials(
-            slam, pose.position, landmarks,
-            pose.heading + self._turns[allowed], self._lengths[allowed] / pose.metres_per_unit,
+            slam, pose.position, landmarks, headings,
+            self._travel(np.array(pose.position), headings, self._lengths[allowed],
+                         pose.metres_per_unit),
             self.area_cap, log_area=self.log_area, scratch=self._trials,
             sensor=self._sensor(view, pose, landmarks),
         )  # fmt: skip
         if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap, self.log_area):
-            # No candidate is predicted to help (e.g. every landmark is uninitialised):
-            # fall back on the move that keeps every landmark off the line of motion.
-            return self._bootstrap(view)
+            # No candidate is predicted to help (e.g. every landmark is uninitialised).
+            return self._without_map(view, slam, pose)
         return self.candidates[int(allowed[int(np.argmin(potentials))])]
 
 

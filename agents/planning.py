@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -19,6 +20,9 @@ from bearing_env.envs.config import AREA_FLOOR
 from bearing_env.envs.kernels import potential_of
 from bearing_env.numerics import JIT_OPTIONS, wrap_angle
 from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
+
+FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
 
 
 def uncertainty_potential(
@@ -140,3 +144,118 @@ def landmark_positions_fl(slam: PolygonSLAM) -> NDArray[np.complex128]:
     estimates = slam.estimates
     mapped = estimates[:, 0] + 1j * estimates[:, 1]
     return np.concatenate([[0.0 + 0.0j, 1.0 + 0.0j], mapped])
+
+
+@dataclass(frozen=True)
+class Worlds:
+    """The hypothesised worlds a plan is scored in (all in FL)."""
+
+    #: Landmark positions (H, n): L1 = 0, L2 = 1, then one position per mapped landmark
+    #: (NaN where it has no region yet).
+    landmarks: ComplexArray
+    #: The robot's position in each world (H,).
+    positions: ComplexArray
+
+
+def sample_in_polygon(vertices: ComplexArray, count: int, rng: np.random.Generator) -> ComplexArray:
+    """``count`` points drawn uniformly inside a convex polygon (its vertices, in order)."""
+    if vertices.size < 3:
+        return np.full(count, vertices.mean() if vertices.size else complex(np.nan, np.nan))
+    # A fan of triangles from vertex 0, chosen by area, then a uniform point in each.
+    a, b, c = vertices[0], vertices[1:-1], vertices[2:]
+    areas = np.abs(((b - a).conjugate() * (c - a)).imag)
+    total = float(areas.sum())
+    if total <= 0.0:
+        return np.full(count, vertices.mean())
+    triangle = rng.choice(areas.size, size=count, p=areas / total)
+    u, v = rng.random(count), rng.random(count)
+    flip = u + v > 1.0
+    u, v = np.where(flip, 1.0 - u, u), np.where(flip, 1.0 - v, v)
+    return np.asarray(a + u * (b[triangle] - a) + v * (c[triangle] - a))
+
+
+#: Distances (nodes, K, H) in FL units travelled by each candidate from each node's
+#: positions (nodes, H) with headings (nodes, K).
+Mover = Callable[[ComplexArray, FloatArray, FloatArray], FloatArray]
+
+
+def beam_search(
+    slam: PolygonSLAM,
+    worlds: Worlds,
+    heading: float,
+    turns: FloatArray,
+    lengths: FloatArray,
+    first_allowed: NDArray[np.bool_],
+    mover: Mover,
+    depth: int,
+    width: int,
+    area_cap: float,
+    scratch: dict[tuple[str, int], BatchedPolygonSLAM] | None = None,
+    sensor: Sensor | None = None,
+) -> tuple[int, float]:
+    """The index of the first candidate of the best plan, and that plan's mean score.
+
+    Candidates are ``(turns[k], lengths[k])`` (turn relative to the heading, length in
+    metres); only the ``first_allowed`` ones may start a plan. Each depth's expansions
+    are one batched update (:meth:`BatchedPolygonSLAM.update_trusted`: the bearings are
+    made here) on copies of the beam's maps; ``scratch``: the caller's batches of copies
+    by role and size, kept between calls and refilled in place
+    (:meth:`BatchedPolygonSLAM.take`) instead of made anew at each depth. ``sensor``
+    predicts the readings' misses (its landmarks are the worlds'; None: every landmark
+    seen).
+    """
+    batches: dict[tuple[str, int], BatchedPolygonSLAM] = {} if scratch is None else scratch
+    n_worlds = worlds.positions.size
+    known = np.isfinite(worlds.landmarks)  # (H, n)
+    targets = np.where(known, worlds.landmarks, 0.0)
+    maps = slam.replicate(n_worlds, into=batches.get(("root", n_worlds)))  # node 0, per world
+    batches["root", n_worlds] = maps
+    positions = worlds.positions[None, :]  # (nodes, H)
+    headings = np.array([heading])  # (nodes,)
+    firsts = np.array([-1])
+    best_first, best_score = -1, math.inf
+    for level in range(depth):
+        allowed = first_allowed if level == 0 else np.ones(turns.size, dtype=bool)
+        ks = np.flatnonzero(allowed)
+        n_nodes, n_k = positions.shape[0], ks.size
+        new_headings = headings[:, None] + turns[ks][None, :]  # (nodes, K)
+        distances = mover(positions, new_headings, lengths[ks])  # (nodes, K, H)
+        step = distances * np.exp(1j * new_headings)[:, :, None]
+        starts = np.broadcast_to(positions[:, None, :], step.shape)
+        ends = starts + step
+        heading_grid = np.broadcast_to(new_headings[:, :, None], step.shape)
+        b1 = bearings_from(starts, heading_grid, targets[None, None, :, :])
+        b2 = bearings_from(ends, heading_grid, targets[None, None, :, :])
+        # A landmark without a region, or a move too short, gives no information.
+        moving = (distances > 0.0)[..., None] & known[None, None, :, :]
+        b2 = np.where(moving, b2, b1)
+        if sensor is not None:
+            b1, b2 = sensor(b1, starts, heading_grid), sensor(b2, ends, heading_grid)
+        rows = np.arange(n_nodes)[:, None, None] * n_worlds + np.arange(n_worlds)[None, None, :]
+        rows = np.broadcast_to(rows, step.shape).reshape(-1)
+        trials = maps.take(rows.astype(np.int64), into=batches.get(("trials", rows.size)))
+        batches["trials", rows.size] = trials
+        n = slam.n_landmarks
+        trials.update_trusted(
+            np.ascontiguousarray(b1.reshape(-1, n), dtype=np.float64),
+            np.ascontiguousarray(b2.reshape(-1, n), dtype=np.float64),
+            robot=False,
+        )
+        potentials = uncertainty_potential(trials.areas, area_cap).reshape(n_nodes, n_k, n_worlds)
+        scores = potentials.mean(axis=2)  # (nodes, K)
+        node_firsts = np.where(firsts[:, None] < 0, ks[None, :], firsts[:, None])
+        order = np.argsort(scores, axis=None, kind="stable")
+        best = int(order[0])
+        best_first, best_score = int(node_firsts.reshape(-1)[best]), float(scores.reshape(-1)[best])
+        if level == depth - 1:
+            break
+        keep = order[: min(width, order.size)]
+        node_index, k_index = np.unravel_index(keep, scores.shape)
+        chosen = (node_index * n_k + k_index)[:, None] * n_worlds + np.arange(n_worlds)[None, :]
+        chosen_rows = chosen.reshape(-1).astype(np.int64)
+        maps = trials.take(chosen_rows, into=batches.get(("beam", chosen_rows.size)))
+        batches["beam", chosen_rows.size] = maps
+        positions = ends[node_index, k_index]
+        headings = new_headings[node_index, k_index]
+        firsts = node_firsts[node_index, k_index]
+    return best_first, best_score

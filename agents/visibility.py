@@ -35,6 +35,9 @@ from .env_access import bearing_env_of
 #: The radius (metres) of the obstacle a bump reveals: the robot knows only that
 #: something stopped it about a robot's radius ahead, so it assumes a robot-sized thing.
 BUMP_RADIUS = 0.05
+#: The radius (metres) of the obstacle a bump is taken for when planning moves: a wall
+#: or a piece of furniture is wider than the robot, so paths near a bump are cut too.
+OBSTACLE_RADIUS = 0.1
 #: The part of the half field of view that counts as well inside it for
 #: :func:`keep_in_view`: a landmark's bearing grows over the move.
 IN_VIEW = 0.7
@@ -59,6 +62,12 @@ class VisibilityPredictor:
         self.bumps: list[complex] = []
 
     @property
+    def limited(self) -> bool:
+        """True when the camera itself misses landmarks (a forward field of view or a
+        range), whatever the obstacles."""
+        return self.half_fov < math.pi or not math.isinf(self.max_range)
+
+    @property
     def trivial(self) -> bool:
         """True when every landmark is predicted visible from everywhere (the paper's
         panoramic camera, no range limit, no bump yet): planners may skip the prediction."""
@@ -80,10 +89,12 @@ class VisibilityPredictor:
         headings: NDArray[np.float64],
         landmarks: NDArray[np.complex128],
         metres_per_unit: float,
+        with_bumps: bool = True,
     ) -> NDArray[np.bool_]:
         """Which landmarks the sensor would see from poses: positions and headings (FL)
         of one shape S, landmarks (..., n) that broadcast against S + (n,) (NaN where
-        unknown: predicted seen); out (S + (n,))."""
+        unknown: predicted seen); out (S + (n,)). ``with_bumps=False``: the camera alone
+        (field of view and range), for poses in another frame than the bumps' FL."""
         positions = np.asarray(positions, dtype=np.complex128)[..., None]
         headings = np.asarray(headings, dtype=np.float64)[..., None]
         known = np.isfinite(landmarks)
@@ -95,7 +106,7 @@ class VisibilityPredictor:
         if not math.isinf(self.max_range):
             seen &= np.abs(offsets) * metres_per_unit <= self.max_range
         radius = BUMP_RADIUS / metres_per_unit
-        for bump in self.bumps:
+        for bump in self.bumps if with_bumps else ():
             seen &= _distance_to_segments(bump, positions, offsets) > radius
         return np.asarray(seen | ~np.broadcast_to(known, seen.shape))
 
@@ -106,12 +117,13 @@ class VisibilityPredictor:
         headings: NDArray[np.float64],
         landmarks: NDArray[np.complex128],
         metres_per_unit: float,
+        with_bumps: bool = True,
     ) -> NDArray[np.float64]:
         """Simulated ``bearings`` (S + (n,)) with NaN (a missed reading) where
         :meth:`seen` predicts the landmark out of sight; unchanged when :attr:`trivial`."""
         if self.trivial:
             return bearings
-        seen = self.seen(positions, headings, landmarks, metres_per_unit)
+        seen = self.seen(positions, headings, landmarks, metres_per_unit, with_bumps)
         return np.where(seen, bearings, np.nan)
 
 
@@ -126,6 +138,28 @@ def _distance_to_segments(
     )
     along = np.clip(along, 0.0, 1.0)
     return np.asarray(np.abs(relative - along * offsets))
+
+
+def travel_until(
+    starts: NDArray[np.complex128],
+    headings: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    obstacles: NDArray[np.complex128],
+    radius: float,
+) -> NDArray[np.float64]:
+    """How far moves (``starts``, ``headings``, ``lengths`` broadcast together) get before
+    they touch a disc of ``radius`` around one of the ``obstacles`` (the same frame and
+    units); a move from inside a disc and toward its centre gets 0."""
+    travelled = np.broadcast_to(np.asarray(lengths, dtype=np.float64), np.broadcast(
+        starts, headings, lengths).shape).copy()  # fmt: skip
+    turn_back = np.exp(-1j * np.asarray(headings))
+    for obstacle in obstacles:
+        relative = (obstacle - starts) * turn_back
+        along, across = relative.real, relative.imag
+        hit = (along > 0.0) & (np.abs(across) < radius)
+        contact = np.maximum(along - np.sqrt(np.maximum(radius**2 - across**2, 0.0)), 0.0)
+        travelled = np.where(hit, np.minimum(travelled, contact), travelled)
+    return travelled
 
 
 class BearingMemory:

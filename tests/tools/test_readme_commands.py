@@ -80,6 +80,9 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env compare --env bearing_env:BearingSLAM-Khepera-Camera90-v0 --policies random "
     'parallax greedy "greedy:predict_visibility=False,label=greedy_blind" lookahead '
     "--episodes 200": ("parse", ()),
+    "bearing-env compare --env bearing_env:BearingSLAM-Khepera-Camera180-v0 --policies random "
+    'greedy "greedy:predict_visibility=False,label=greedy_blind" lookahead --episodes 50 '
+    "--workers 1": ("parse", ()),
     "bearing-env bench --sections single,vector --seconds 1 --num-envs 64 256 --landmarks 4": (
         "parse",
         (),
