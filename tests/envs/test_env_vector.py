@@ -592,7 +592,8 @@ def test_the_vector_envs_own_arrays_are_writable_after_a_read_only_unpickle() ->
     env.reset(seed=0)
     clone = _read_only_clone(env)
     for name, value in vars(clone._state).items():
-        assert value.flags.writeable, name
+        if isinstance(value, np.ndarray):
+            assert value.flags.writeable, name
     for name in ("_config_index", "_autoreset_envs", "_elapsed_steps"):
         assert getattr(clone, name).flags.writeable, name
 
