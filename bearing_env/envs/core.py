@@ -40,6 +40,7 @@ from bearing_env.slam import MapSettings, PolygonSLAM
 from bearing_env.slam import kernels as slam_kernels
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
+    STATE_ARRAYS,
     BatchedPolygonSLAM,
 )
 from bearing_env.world import (
@@ -365,15 +366,21 @@ def step(
     comes from the rows' noise buffers, which the rows' generators fill ahead
     (:func:`fill_noise`, called at reset and whenever a block is spent).
     """
-    rows, config = group.rows, group.config
-    map_info, relaxed = _map_info(group)
+    rows, config, inputs = group.rows, group.config, group.inputs
     turns = np.ascontiguousarray(turns, dtype=np.float64)
     lengths = np.ascontiguousarray(lengths, dtype=np.float64)
     threads = slam_kernels.threads()
+    map_slots = config.observations.max_landmarks - 2
     while True:
-        status, report, *encoded = kernels.step_rows(
-            rows, turns, lengths, group.inputs, state.trajectory, threads, map_info, relaxed
-        )
+        if config.observations.robot_map_info:
+            status, report, encoded = kernels.step_rows(
+                rows, turns, lengths, inputs, state.trajectory, threads, map_slots
+            )
+        else:
+            status, report = kernels.step_rows_bare(
+                rows, turns, lengths, inputs, state.trajectory, threads
+            )
+            encoded = None
         if status == kernels.STEP_DONE:
             return report, _robot_map(group, encoded)
         if status == kernels.STEP_NEEDS_NOISE:
@@ -386,25 +393,22 @@ def step(
 def report(state: BatchState, group: Group) -> tuple[kernels.Report, dict[str, Any] | None]:
     """The group's observations and infos as they stand (after a reset: nothing moved,
     nothing earned), with the ``robot_map`` info (None with ``robot_map_info`` off)."""
-    map_info, relaxed = _map_info(group)
-    report, *encoded = kernels.report_rows(group.rows, group.inputs, map_info, relaxed)
+    slots = group.config.observations.max_landmarks - 2
+    report, encoded = kernels.report_rows(group.rows, group.inputs, slots)
     return report, _robot_map(group, encoded)
 
 
-def _map_info(group: Group) -> tuple[int, bool]:
-    """What the kernels encode of the robot map: its landmark slots (0: no map info), and
-    whether the relaxed fusion's window too."""
-    observations = group.config.observations
-    slots = observations.max_landmarks - 2 if observations.robot_map_info else 0
-    return slots, group.batch.fusion == "relaxed"
-
-
-def _robot_map(group: Group, encoded: list[Any]) -> dict[str, Any] | None:
-    """The ``robot_map`` info from the kernel's encoded arrays; None when it is off."""
-    if not group.config.observations.robot_map_info:
+def _robot_map(group: Group, encoded: tuple[Any, ...] | None) -> dict[str, Any] | None:
+    """The ``robot_map`` info from the kernel's encoded arrays, with the relaxed fusion's
+    window and bases (one more compiled call); None when the setting is off."""
+    if encoded is None or not group.config.observations.robot_map_info:
         return None
-    arrays = (*encoded[0], *encoded[1]) if group.batch.fusion == "relaxed" else encoded[0]
-    return robot_map.as_info(group.batch.state_names, arrays)
+    batch = group.batch
+    if batch.fusion != "relaxed":
+        return robot_map.as_info(robot_map.MAP_ARRAYS, encoded)
+    slots = max(group.config.observations.max_landmarks - 2, group.n - 2)
+    encoded += robot_map.encode_window(batch._kernel_state(), group.rows, slots)
+    return robot_map.as_info(STATE_ARRAYS, encoded)
 
 
 # ----------------------------------------------------------------------------------------

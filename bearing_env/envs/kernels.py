@@ -27,7 +27,7 @@ from numba.experimental import structref
 from numpy.typing import NDArray
 
 from bearing_env.envs.observations import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
-from bearing_env.envs.robot_map import encode_map, encode_window
+from bearing_env.envs.robot_map import encode_map
 from bearing_env.numerics import JIT_OPTIONS as _JIT
 from bearing_env.numerics import wrap
 from bearing_env.slam.batch import PARALLEL_MIN_MAPS
@@ -360,28 +360,28 @@ def _write_info(i: int, row: int, inputs: Inputs, report: Report) -> None:
 
 
 @njit(**_JIT)
-def _observe(rows: np.ndarray, inputs: Inputs, report: Report, map_info: int, relaxed: bool) -> Any:
-    """Observations and infos of ``rows`` into ``report``; returns it with the robot map's
-    encoded arrays (``robot_map.encode``'s, with ``map_info`` landmark slots; of no row
-    when ``map_info`` is 0, and the window's of no row unless ``relaxed``)."""
+def _observe(rows: np.ndarray, inputs: Inputs, report: Report) -> None:
+    """Observations and infos of ``rows`` into ``report``."""
     for i in range(rows.shape[0]):
         _write_observation(rows[i], inputs, report.observations[i])
         _write_info(i, rows[i], inputs, report)
-    mapped = rows if map_info > 0 else rows[:0]
-    slots = max(map_info, inputs.settings.n - 2)
-    window = mapped if relaxed else rows[:0]
-    return report, encode_map(inputs.maps, mapped, slots), encode_window(inputs.maps, window, slots)
 
 
 @njit(**_JIT)
-def report_rows(rows: np.ndarray, inputs: Inputs, map_info: int, relaxed: bool) -> Any:
-    """The observations and infos of ``rows`` as they stand (after a reset: nothing moved,
-    nothing earned), as :func:`step_rows` returns them."""
+def _observation_size(settings: Settings) -> int:
+    slots = settings.n_slots
+    return _ROBOT_FEATURES + _LANDMARK_FEATURES * (slots - 2) + _BEARING_FEATURES * slots
+
+
+@njit(**_JIT)
+def report_rows(rows: np.ndarray, inputs: Inputs, map_slots: int) -> Any:
+    """The report of ``rows`` as they stand (after a reset: nothing moved, nothing
+    earned), with their robot map's encoded arrays (``robot_map.encode``'s, with
+    ``map_slots`` landmark slots, the relaxed fusion's window aside)."""
     settings = inputs.settings
-    size = _ROBOT_FEATURES + _LANDMARK_FEATURES * (settings.n_slots - 2)
-    size += _BEARING_FEATURES * settings.n_slots
-    report = _new_report(rows.shape[0], settings.n - 2, size)
-    return _observe(rows, inputs, report, map_info, relaxed)
+    report = _new_report(rows.shape[0], settings.n - 2, _observation_size(settings))
+    _observe(rows, inputs, report)
+    return report, encode_map(inputs.maps, rows, max(map_slots, settings.n - 2))
 
 
 @njit(**_JIT)
@@ -434,6 +434,44 @@ def _update_maps(
 
 
 @njit(**_JIT)
+def step_rows_bare(
+    rows: np.ndarray,
+    turns: np.ndarray,
+    lengths: np.ndarray,
+    inputs: Inputs,
+    trajectory: np.ndarray,
+    threads: int,
+) -> tuple[int, Report]:
+    """One movement of every row of a group: turn, read, move straight (stopped at the
+    wall), read, update the map; then rewards, terminations, truncations, observations
+    and infos. Returns ``(status, report)``; unless the status is :data:`STEP_DONE`,
+    nothing was done (and the report is of no row). ``turns`` and ``lengths`` are the
+    decoded actions (radians, metres); ``trajectory`` is the state's (replaced when it
+    grows). Maps of at least ``PARALLEL_MIN_MAPS`` rows are updated on ``threads``
+    threads."""
+    settings, state = inputs.settings, inputs.state
+    size, n = rows.shape[0], settings.n
+    status = _room_for_step(rows, inputs, state.trajectory_length, trajectory.shape[1])
+    report = _new_report(size if status == STEP_DONE else 0, n - 2, _observation_size(settings))
+    if status != STEP_DONE:
+        return status, report
+    start, end = np.empty((size, n)), np.empty((size, n))
+    for i in range(size):
+        row = rows[i]
+        report.path_length[i] = move_and_read(row, turns[i], lengths[i], inputs, start[i], end[i])
+        at = state.trajectory_length[row]
+        trajectory[row, at, 0] = state.positions[row, 0]
+        trajectory[row, at, 1] = state.positions[row, 1]
+        state.trajectory_length[row] = at + 1
+    _update_maps(start, end, rows, inputs, threads, report)
+    for i in range(size):
+        state.frame_changed[rows[i]] = report.frame_changed[i]
+        _finish_row(i, rows[i], inputs, report)
+    _observe(rows, inputs, report)
+    return STEP_DONE, report
+
+
+@njit(**_JIT)
 def step_rows(
     rows: np.ndarray,
     turns: np.ndarray,
@@ -441,37 +479,13 @@ def step_rows(
     inputs: Inputs,
     trajectory: np.ndarray,
     threads: int,
-    map_info: int,
-    relaxed: bool,
+    map_slots: int,
 ) -> Any:
-    """One movement of every row of a group: turn, read, move straight (stopped at the
-    wall), read, update the map; then rewards, terminations, truncations, observations
-    and infos. Returns ``(status, report, robot map arrays, window arrays)`` (see
-    :func:`report_rows`); unless the status is :data:`STEP_DONE`, nothing was done (and
-    the report is of no row). ``turns`` and ``lengths`` are the decoded actions
-    (radians, metres); ``trajectory`` the state's (it is replaced when it grows)."""
-    settings, state = inputs.settings, inputs.state
-    status = _room_for_step(rows, inputs, state.trajectory_length, trajectory.shape[1])
-    if status != STEP_DONE:
-        return (status, *report_rows(rows[:0], inputs, map_info, relaxed))
-    size, n = rows.shape[0], settings.n
-    observation_size = _ROBOT_FEATURES + _LANDMARK_FEATURES * (settings.n_slots - 2)
-    report = _new_report(size, n - 2, observation_size + _BEARING_FEATURES * settings.n_slots)
-    start, end = np.empty((size, n)), np.empty((size, n))
-    for i in range(size):
-        row = rows[i]
-        report.path_length[i] = move_and_read(row, turns[i], lengths[i], inputs, start[i], end[i])
-        at = state.trajectory_length[row]
-        trajectory[row, at, 0], trajectory[row, at, 1] = (
-            state.positions[row, 0],
-            state.positions[row, 1],
-        )
-        state.trajectory_length[row] = at + 1
-    _update_maps(start, end, rows, inputs, threads, report)
-    for i in range(size):
-        state.frame_changed[rows[i]] = report.frame_changed[i]
-        _finish_row(i, rows[i], inputs, report)
-    return (STEP_DONE, *_observe(rows, inputs, report, map_info, relaxed))
+    """:func:`step_rows_bare`, with the robot map's encoded arrays after the report (as
+    :func:`report_rows`; of no row unless the status is :data:`STEP_DONE`)."""
+    status, report = step_rows_bare(rows, turns, lengths, inputs, trajectory, threads)
+    done = rows if status == STEP_DONE else rows[:0]
+    return status, report, encode_map(inputs.maps, done, max(map_slots, inputs.settings.n - 2))
 
 
 #: Outcomes of :func:`decode_continuous`.

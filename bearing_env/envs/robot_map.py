@@ -28,13 +28,21 @@ from numpy.typing import NDArray
 
 from bearing_env.numerics import JIT_OPTIONS
 from bearing_env.slam import MapSettings, PolygonSLAM
-from bearing_env.slam.batch import LANDMARK_AXES, BatchedPolygonSLAM
+from bearing_env.slam.batch import (
+    LANDMARK_AXES,
+    RELAXED_STATE_ARRAYS,
+    STATE_ARRAYS,
+    BatchedPolygonSLAM,
+)
 
 #: The info key of the robot's own map: the one key of an info robot policies read.
 KEY = "robot_map"
 #: Fill of the empty landmark slots (default 0: count 0 is an empty region), as the
 #: compiled encoding (:func:`encode_map`, :func:`encode_window`) writes them.
 PADDING: dict[str, Any] = {"areas": np.inf, "centroids": complex(np.inf, np.inf)}
+#: The arrays every fusion uses, as :func:`encode_map` gives them (the relaxed fusion's
+#: are these, then :data:`~bearing_env.slam.batch.RELAXED_STATE_ARRAYS`).
+MAP_ARRAYS: tuple[str, ...] = STATE_ARRAYS[: len(STATE_ARRAYS) - len(RELAXED_STATE_ARRAYS)]
 #: The arrays whose unknown values (NaN in the map) are inf in an info.
 UNKNOWN_AS_INF: tuple[str, ...] = ("centroids", "robot_centroid", "robot_heading")
 
