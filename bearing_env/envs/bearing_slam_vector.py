@@ -48,14 +48,15 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
     `num_envs` copies of :class:`~bearing_env.envs.bearing_slam.BearingSLAMEnv` stepped
     together. The sub-envs are rows of one structure of arrays
-    (:class:`~bearing_env.envs.state.BatchState`), and each step is a few compiled kernel
-    calls per group of rows with the same settings (`EnvConfig`) and landmark count: all
-    robots move at once, all maps fuse their movement in one
-    :class:`BatchedPolygonSLAM` update (most of the work), and observations, rewards and
-    infos are built for the whole group. Only the random draws loop over sub-envs in
-    Python, because each owns its random generator. The functions are
-    :mod:`bearing_env.envs.core`'s, which the single env runs with a batch of one, so the
-    two cannot drift apart.
+    (:class:`~bearing_env.envs.state.BatchState`), and each step is one compiled call per
+    group of rows with the same settings (`EnvConfig`) and landmark count: all robots
+    move at once, all maps fuse their movement in one batched update (most of the work),
+    and observations, rewards, episode ends and infos are written for the whole group
+    (the relaxed fusion's window in the infos takes one more call). The readings' noise
+    is drawn ahead, a block of moves at a time, by each sub-env's own generator, so no
+    Python runs per sub-env on a step; resets (new layouts) run in Python for the
+    sub-envs that ended. The functions are :mod:`bearing_env.envs.core`'s, which the
+    single env runs with a batch of one, so the two cannot drift apart.
 
     For the same per-env seeds and actions it reproduces
     `gym.make_vec(id, num_envs, vectorization_mode="sync")` exactly: observations,

@@ -5,15 +5,20 @@ In the spirit of Gymnasium's ``phys2d/cartpole.py``: one
 state of ``N`` envs as a structure of arrays (one row per env), and plain functions
 compute on a group of rows at once:
 
-- :func:`reset_rows` starts new episodes;
+- :func:`reset_rows` starts new episodes (in Python: a layout's rejection sampling
+  draws from the row's generator), and draws each row's first block of movement noise
+  ahead (:func:`fill_noise`);
 - :func:`step` moves the robots, reads the sensors, updates the maps and computes the
-  rewards (:func:`rewards`), terminations and truncations;
-- :func:`observations` and :func:`infos` build the observations and infos.
+  rewards, terminations, truncations, observations and infos, in one compiled call
+  (``kernels.step_rows``); :func:`report` gives the observations and infos alone;
+- :func:`infos` and :func:`single_info` make the info dicts of the step's arrays.
 
 ``BearingSLAMEnv`` is a batch of one; ``BearingSLAMVectorEnv`` steps the whole batch.
 Both call exactly these functions, so they agree bit for bit: every computation is
 row-wise (a row's result does not depend on the other rows of its batch), and every
-random draw comes from the row's own generator, in the same order as in a batch of one.
+random draw comes from the row's own generator, in the same order as in a batch of one
+(and as drawing move by move: the noise drawn ahead that an episode does not spend is
+handed back, :func:`release_noise`).
 
 A *group* is a set of rows that share one :class:`~bearing_env.envs.config.EnvConfig`
 and one landmark count ``n`` (so one map batch, and arrays ``[:, :n]`` without padding).
@@ -40,6 +45,7 @@ from bearing_env.slam import MapSettings, PolygonSLAM
 from bearing_env.slam import kernels as slam_kernels
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
+    PARALLEL_MIN_MAPS,
     STATE_ARRAYS,
     BatchedPolygonSLAM,
 )
@@ -369,7 +375,8 @@ def step(
     rows, config, inputs = group.rows, group.config, group.inputs
     turns = np.ascontiguousarray(turns, dtype=np.float64)
     lengths = np.ascontiguousarray(lengths, dtype=np.float64)
-    threads = slam_kernels.threads()
+    # Small batches stay on one thread (see PARALLEL_MIN_MAPS): asking numba costs ~2 us.
+    threads = slam_kernels.threads() if rows.size >= PARALLEL_MIN_MAPS else 1
     map_slots = config.observations.max_landmarks - 2
     while True:
         if config.observations.robot_map_info:

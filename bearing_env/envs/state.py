@@ -4,11 +4,10 @@
 (a structure of arrays); its field list is the only place these arrays are listed
 (:data:`STATE_ARRAYS`). The kernels of :mod:`bearing_env.envs.kernels` reach it through
 a :class:`BatchStateRef`, a numba ``structref`` of the same arrays (all but the
-trajectory, :data:`KERNEL_ARRAYS`) that the state makes once
-(:meth:`BatchState.kernel_ref`) and that goes into the group's ``kernels.InputsRef``.
-A namedtuple would be typed field by field on every call (3.5 us for 14 arrays against
-1.3 us for a structref, measured here), in each of the single env's four kernel calls
-per step.
+trajectory and the noise generators and marks, :data:`KERNEL_ARRAYS`) that the state
+makes once (:meth:`BatchState.kernel_ref`) and that goes into the group's
+``kernels.InputsRef``. A namedtuple would be typed field by field on every call (3.5 us
+for 14 arrays against 1.3 us for a structref, measured here).
 """
 
 from __future__ import annotations
