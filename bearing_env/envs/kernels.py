@@ -44,7 +44,7 @@ FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
 #: The flat observation's block sizes (numba compile-time constants), from the feature
-#: tuples of :mod:`bearing_env.envs.observations`; :func:`write_observations` writes the
+#: tuples of :mod:`bearing_env.envs.observations`; :func:`_write_observation` writes the
 #: blocks in that module's order.
 _ROBOT_FEATURES = len(ROBOT_FEATURES)
 _LANDMARK_FEATURES = len(LANDMARK_FEATURES)
