@@ -72,13 +72,27 @@ class ObservationView:
     progress: float
     frame_changed: bool
     blocked: bool
-    #: Latest bearings (n_landmarks,), radians, relative to the current heading.
+    #: Latest bearings (n_landmarks,), radians, relative to the current heading; 0 for
+    #: a landmark the reading missed (see :attr:`seen`).
     bearings: NDArray[np.float64]
+    #: Which landmarks the latest reading saw (n_landmarks,): a missed one reads
+    #: (cos, sin) = (0, 0) in the observation.
+    seen: NDArray[np.bool_]
 
     @property
     def n_landmarks(self) -> int:
         """Landmarks in this episode (the bearing slots flagged present)."""
         return int(self.bearings.size)
+
+    @property
+    def readings(self) -> NDArray[np.float64]:
+        """The bearings with NaN where the reading missed the landmark."""
+        return np.where(self.seen, self.bearings, np.nan)
+
+    @property
+    def seen_bearings(self) -> NDArray[np.float64]:
+        """The bearings of the landmarks the latest reading saw."""
+        return self.bearings[self.seen]
 
 
 class ObservationReader:
@@ -116,6 +130,7 @@ class ObservationReader:
             frame_changed=bool(robot[_FRAME_CHANGED] > 0.5),
             blocked=bool(robot[_BLOCKED] > 0.5),
             bearings=np.arctan2(bearings[:, sin], bearings[:, cos]),
+            seen=np.hypot(bearings[:, sin], bearings[:, cos]) > 0.5,
         )
 
 
@@ -153,6 +168,8 @@ def scale_sample(
     """Metres per FL unit from one movement of ``length`` metres (None if ill-conditioned)."""
     points = []
     for index in (0, 1):
+        if not (math.isfinite(bearings_start[index]) and math.isfinite(bearings_end[index])):
+            return None  # a missed reading of L1 or L2
         parallax = abs(wrap(float(bearings_end[index] - bearings_start[index])))
         if parallax < MIN_PARALLAX_EPSILONS * epsilon:
             return None
@@ -194,7 +211,7 @@ class RobotBelief:
             self._turn_since_fix = 0.0
             self._legs = []
             start = np.array([wrap(float(b) - movement.turn) for b in bearings_before])
-            sample = scale_sample(start, view.bearings, movement.length, self.epsilon)
+            sample = scale_sample(start, view.readings, movement.length, self.epsilon)
             if sample is not None:
                 # A move stopped by the wall travelled less than commanded, so its sample
                 # overestimates the scale: kept apart, used only while there is no other.
@@ -204,9 +221,20 @@ class RobotBelief:
             if not view.blocked:
                 self._legs.append((self._turn_since_fix, movement.length))
 
-    def commanded(self, movement: Movement, view: ObservationView) -> None:
-        """Remember the movement about to be sent, with the reading it started from."""
-        self._pending = (movement, view.bearings.copy())
+    def commanded(
+        self,
+        movement: Movement,
+        view: ObservationView,
+        remembered: NDArray[np.float64] | None = None,
+    ) -> None:
+        """Remember the movement about to be sent, with the reading it started from; a
+        landmark that reading missed takes its ``remembered`` bearing when given (a
+        forward camera's :class:`~bearing_env.agents.visibility.BearingMemory`: stale by
+        the moves since it was seen, so a rougher scale sample than none)."""
+        readings = view.readings
+        if remembered is not None and remembered.size == readings.size:
+            readings = np.where(view.seen, readings, remembered)
+        self._pending = (movement, readings)
 
     def metres_per_unit(self) -> float | None:
         samples = self._scale_samples or self._blocked_samples

@@ -26,10 +26,12 @@ from .belief import (
 )
 from .env_access import MapReader, bearing_env_of, world_of
 from .planning import (
+    Sensor,
     landmark_positions_fl,
     simulate_potentials,
     uncertainty_potential,
 )
+from .visibility import TOO_CLOSE, BearingMemory, VisibilityPredictor, keep_in_view
 
 #: Turns tried by the bootstrap move on the continuous id (every 5 degrees).
 BOOTSTRAP_TURNS = 72
@@ -91,7 +93,7 @@ def landmark_direction(bearings: NDArray[np.float64]) -> float | None:
     """Direction (relative to the heading) of the landmarks as a group: the circular mean
     of their bearings; None when they surround the robot (no clear direction)."""
     total = complex(np.sum(np.cos(bearings)), np.sum(np.sin(bearings)))
-    if abs(total) < 0.25 * bearings.size:
+    if bearings.size == 0 or abs(total) < 0.25 * bearings.size:
         return None
     return math.atan2(total.imag, total.real)
 
@@ -109,7 +111,7 @@ def _allowed_turns(
     if not view.blocked:
         return np.ones(turns.shape, dtype=bool)
     allowed = np.abs(turns) >= BLOCKED_AHEAD
-    inward = landmark_direction(view.bearings)
+    inward = landmark_direction(view.seen_bearings)
     if inward is not None:
         allowed &= np.cos(turns - inward) > math.cos(INWARD_AFTER_BLOCK)
     if fallback and not allowed.any():
@@ -117,18 +119,58 @@ def _allowed_turns(
     return allowed
 
 
-def bootstrap_movement(codec: ActionCodec, view: ObservationView) -> Movement:
+def bootstrap_movement(
+    codec: ActionCodec,
+    view: ObservationView,
+    memory: NDArray[np.float64] | None = None,
+    half_fov: float = math.pi,
+) -> Movement:
     """The move made before there is a map (or a scale): longest length, in the direction
-    that keeps every landmark farthest from the line of motion (see ``spread_turn``)."""
+    that keeps every landmark farthest from the line of motion (see ``spread_turn``).
+
+    With a forward camera (``half_fov`` below pi) and the robot's ``memory`` of bearings
+    (:class:`~bearing_env.agents.visibility.BearingMemory`) it turns to keep L1, L2 and
+    as many landmarks as it can in view instead (:func:`limited_view_movement`)."""
     turns = _bootstrap_turns(codec)
+    if memory is not None and half_fov < math.pi:
+        return limited_view_movement(codec, view, turns, memory, half_fov)
     allowed = _allowed_turns(turns, view)
-    inward = landmark_direction(view.bearings)
+    inward = landmark_direction(view.seen_bearings)
     if inward is not None and np.any(allowed & (np.cos(turns - inward) > 0.0)):
         # |sin| does not tell a direction from its opposite: take the one toward the
         # landmarks, away from the walls.
         allowed &= np.cos(turns - inward) > 0.0
-    choice = spread_turn(view.bearings, turns[allowed])
+    choice = spread_turn(view.seen_bearings if view.seen.any() else view.bearings, turns[allowed])
     return codec.movement(float(turns[allowed][choice]), codec.max_length)
+
+
+def limited_view_movement(
+    codec: ActionCodec,
+    view: ObservationView,
+    turns: NDArray[np.float64],
+    memory: NDArray[np.float64],
+    half_fov: float,
+) -> Movement:
+    """The bootstrap move of a forward camera: while L1 or L2 has never been seen, turn
+    most of a field of view on and make the shortest move (looking around); then the
+    longest move in the turn that keeps the most remembered landmarks in view, L1 and L2
+    first (:func:`~bearing_env.agents.visibility.keep_in_view`), among the turns allowed
+    after a blocked move when there are such. A landmark ahead drifts out of a forward
+    view as the robot nears it: when L1 and L2 are too far apart in the view (more than
+    :data:`~bearing_env.agents.visibility.TOO_CLOSE` of its half-width, the robot is too
+    close to both to keep them in view over a move) it backs off first, the longest move
+    away from them, unless a wall just stopped it."""
+    if memory.size < 2 or not np.all(np.isfinite(memory[:2])):
+        return codec.movement(wrap(min(1.8 * half_fov, math.pi)), codec.length_range[0])
+    if not view.blocked and abs(wrap(float(memory[0] - memory[1]))) > TOO_CLOSE * half_fov:
+        between = math.atan2(math.sin(memory[0]) + math.sin(memory[1]),
+                             math.cos(memory[0]) + math.cos(memory[1]))  # fmt: skip
+        return codec.movement(wrap(between + math.pi), codec.max_length)
+    scores = keep_in_view(memory, turns, half_fov)
+    allowed = _allowed_turns(turns, view, fallback=False)
+    if allowed.any():
+        scores = np.where(allowed, scores, -np.inf)
+    return codec.movement(float(turns[int(np.argmax(scores))]), codec.max_length)
 
 
 class RandomPolygonal(MovementPolicy):
@@ -183,10 +225,27 @@ class BeliefPolicy(MovementPolicy):
     def __init__(self, env: gym.Env) -> None:
         super().__init__(env)
         self.belief = RobotBelief(bearing_env_of(env).epsilon)
+        #: The camera's half field of view (pi: panoramic) and the remembered bearings.
+        self.half_fov = VisibilityPredictor(env).half_fov
+        self.memory = BearingMemory()
 
     def reset(self, seed: int | None = None) -> None:
         super().reset(seed)
         self.belief.reset()
+        self.memory.reset()
+
+    def _observe(self, view: ObservationView) -> None:
+        """Take in the observation: the pose belief and the bearing memory."""
+        self.belief.observe(view)
+        self.memory.observe(view.bearings, view.seen, view.progress == 0.0)
+
+    def _commanded(self, movement: Movement, view: ObservationView) -> None:
+        remembered = self.memory.bearings if self.half_fov < math.pi else None
+        self.belief.commanded(movement, view, remembered)
+        self.memory.commanded(movement.turn)
+
+    def _bootstrap(self, view: ObservationView) -> Movement:
+        return bootstrap_movement(self.codec, view, self.memory.bearings, self.half_fov)
 
 
 class Parallax(BeliefPolicy):
@@ -213,6 +272,12 @@ class Parallax(BeliefPolicy):
     (see :func:`bootstrap_movement`). Uses only the robot's map, its own commands and the
     observation, never ground truth.
 
+    With a forward camera (``field_of_view_deg`` below 360 for the env) a landmark at
+    right angles to the move is out of view at both readings, so the move crosses the
+    line of sight at the widest angle that keeps the landmark in view (80% of half the
+    field of view); a target the last reading missed is aimed at from its estimate and
+    the believed pose.
+
     Args:
         env: the env it acts in (either id).
         length: metres per move; default the longest the env allows.
@@ -230,24 +295,27 @@ class Parallax(BeliefPolicy):
             raise ValueError(f"sign_rule must be one of {PARALLAX_SIGN_RULES}, got {sign_rule!r}")
         self.length = self.codec.max_length if length is None else float(length)
         self.sign_rule = sign_rule
+        half_fov = VisibilityPredictor(env).half_fov
+        #: The angle between the move and the line of sight to the target.
+        self.across = math.pi / 2 if half_fov >= math.pi / 2 else 0.8 * half_fov
 
     def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
         view = self.reader.read(observation)
-        self.belief.observe(view)
+        self._observe(view)
         slam = self.maps.read(info, view.n_landmarks)
         pose = self.belief.pose(slam)
         if pose is None:
-            movement = bootstrap_movement(self.codec, view)
+            movement = self._bootstrap(view)
         else:
             movement = self.codec.movement(self._turn(view, slam, pose), self.length)
-        self.belief.commanded(movement, view)
+        self._commanded(movement, view)
         return movement.action
 
     def _turn(self, view: ObservationView, slam: PolygonSLAM, pose: PoseBelief) -> float:
         target = int(np.argmax(slam.areas))  # inf (uninitialised) first
-        sight = float(view.bearings[2 + target])
-        options = np.array([wrap(sight + math.pi / 2), wrap(sight - math.pi / 2)])
-        inward = landmark_direction(view.bearings)
+        sight = _sight(view, slam, pose, target)
+        options = np.array([wrap(sight + self.across), wrap(sight - self.across)])
+        inward = landmark_direction(view.seen_bearings)
         if view.blocked:
             allowed = _allowed_turns(options, view, fallback=False)
             if not allowed.any():
@@ -256,6 +324,11 @@ class Parallax(BeliefPolicy):
             options = options[allowed]
         if options.size == 1:
             return float(options[0])
+        if self.half_fov < math.pi:
+            # A forward camera: the perpendicular that keeps L1 and L2 in view.
+            scores = keep_in_view(self.memory.bearings, options, self.half_fov)
+            if scores[0] != scores[1]:
+                return float(options[int(np.argmax(scores))])
         if self.sign_rule == "inward" and inward is not None:
             return float(options[int(np.argmax(np.cos(options - inward)))])
         polygon = slam.polygons[target]
@@ -271,6 +344,17 @@ class Parallax(BeliefPolicy):
             # |sin| of the angle between the new line of sight and the long axis.
             across.append(abs(math.sin(np.angle(estimate - end) - axis)))
         return float(options[int(np.argmax(across))])
+
+
+def _sight(view: ObservationView, slam: PolygonSLAM, pose: PoseBelief, target: int) -> float:
+    """The bearing of mapped landmark ``target``: as read, or (missed) as predicted from
+    its estimate and the believed pose, or straight ahead when it has no estimate."""
+    if view.seen[2 + target]:
+        return float(view.bearings[2 + target])
+    estimate = complex(*slam.estimates[target])
+    if not (math.isfinite(estimate.real) and math.isfinite(estimate.imag)):
+        return 0.0
+    return wrap(float(np.angle(estimate - pose.position)) - pose.heading)
 
 
 def _principal_axis(polygon: NDArray[np.float64]) -> float:
@@ -304,6 +388,12 @@ class GreedyOneStep(BeliefPolicy):
     Scoring fuses every candidate into its own copy of the map in one batched update
     (``PolygonSLAM.replicate``; see :func:`bearing_env.agents.planning.simulate_potentials`).
 
+    With ``predict_visibility`` (the default) the simulated readings miss what the robot
+    expects its sensor to miss (:class:`~bearing_env.agents.visibility.VisibilityPredictor`:
+    its field of view and range, obstacles where it bumped into them): with a forward
+    camera a move that turns L1 or L2 out of view predicts no progress, as the real
+    update skips it. With the paper's panoramic camera it changes nothing.
+
     Args:
         env: the env it acts in (either id).
         n_turns: turns evenly spaced over the circle (continuous id; the discrete id
@@ -311,15 +401,22 @@ class GreedyOneStep(BeliefPolicy):
         lengths: number of lengths, evenly spaced down from the longest to the shortest
             of the env's range, or explicit lengths in metres (continuous id); on the
             discrete id, how many of the table's lengths to use, longest first.
+        predict_visibility: simulate missed readings (above); False simulates the
+            panoramic camera whatever the env's sensor.
     """
 
     name = "greedy_one_step"
     reads_robot_map = True
 
     def __init__(
-        self, env: gym.Env, n_turns: int = 8, lengths: int | tuple[float, ...] = 2
+        self,
+        env: gym.Env,
+        n_turns: int = 8,
+        lengths: int | tuple[float, ...] = 2,
+        predict_visibility: bool = True,
     ) -> None:
         super().__init__(env)
+        self.visibility = VisibilityPredictor(env) if predict_visibility else None
         if int(n_turns) < 1:
             raise ValueError(f"n_turns must be >= 1, got {n_turns!r}")
         self.candidates = self.codec.candidates(int(n_turns), lengths)
@@ -334,25 +431,47 @@ class GreedyOneStep(BeliefPolicy):
 
     def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
         view = self.reader.read(observation)
-        self.belief.observe(view)
+        self._observe(view)
         movement = self._choose(view, self.maps.read(info, view.n_landmarks))
-        self.belief.commanded(movement, view)
+        self._commanded(movement, view)
         return movement.action
+
+    def reset(self, seed: int | None = None) -> None:
+        super().reset(seed)
+        if self.visibility is not None:
+            self.visibility.reset()
+
+    def _sensor(
+        self, view: ObservationView, pose: PoseBelief, landmarks: NDArray[np.complex128]
+    ) -> Sensor | None:
+        """The visibility prediction of this decision (None: every landmark seen), after
+        recording a bump when the last move was blocked."""
+        if self.visibility is None or pose.metres_per_unit is None:
+            return None
+        if view.blocked:
+            self.visibility.bumped(pose.position, pose.heading, pose.metres_per_unit)
+        if self.visibility.trivial:
+            return None
+        return partial(
+            self.visibility.missed, landmarks=landmarks, metres_per_unit=pose.metres_per_unit
+        )
 
     def _choose(self, view: ObservationView, slam: PolygonSLAM) -> Movement:
         pose = self.belief.pose(slam)
         if pose is None or pose.metres_per_unit is None:
-            return bootstrap_movement(self.codec, view)
+            return self._bootstrap(view)
         allowed = np.flatnonzero(_allowed_turns(self._turns, view))
+        landmarks = landmark_positions_fl(slam)
         potentials = simulate_potentials(
-            slam, pose.position, landmark_positions_fl(slam),
+            slam, pose.position, landmarks,
             pose.heading + self._turns[allowed], self._lengths[allowed] / pose.metres_per_unit,
             self.area_cap, log_area=self.log_area, scratch=self._trials,
+            sensor=self._sensor(view, pose, landmarks),
         )  # fmt: skip
         if np.min(potentials) >= uncertainty_potential(slam.areas, self.area_cap, self.log_area):
             # No candidate is predicted to help (e.g. every landmark is uninitialised):
             # fall back on the move that keeps every landmark off the line of motion.
-            return bootstrap_movement(self.codec, view)
+            return self._bootstrap(view)
         return self.candidates[int(allowed[int(np.argmin(potentials))])]
 
 

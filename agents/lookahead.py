@@ -43,8 +43,8 @@ from bearing_env.validation import int_at_least
 from .base import Movement
 from .belief import ObservationView
 from .env_access import bearing_env_of
-from .heuristics import GreedyOneStep, _allowed_turns, bootstrap_movement
-from .planning import bearings_from, uncertainty_potential
+from .heuristics import GreedyOneStep, _allowed_turns
+from .planning import Sensor, bearings_from, uncertainty_potential
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -95,6 +95,7 @@ def beam_search(
     width: int,
     area_cap: float,
     scratch: dict[tuple[str, int], BatchedPolygonSLAM] | None = None,
+    sensor: Sensor | None = None,
 ) -> tuple[int, float]:
     """The index of the first candidate of the best plan, and that plan's mean score.
 
@@ -103,7 +104,9 @@ def beam_search(
     are one batched update (:meth:`BatchedPolygonSLAM.update_trusted`: the bearings are
     made here) on copies of the beam's maps; ``scratch``: the caller's batches of copies
     by role and size, kept between calls and refilled in place
-    (:meth:`BatchedPolygonSLAM.take`) instead of made anew at each depth.
+    (:meth:`BatchedPolygonSLAM.take`) instead of made anew at each depth. ``sensor``
+    predicts the readings' misses (its landmarks are the worlds'; None: every landmark
+    seen).
     """
     batches: dict[tuple[str, int], BatchedPolygonSLAM] = {} if scratch is None else scratch
     n_worlds = worlds.positions.size
@@ -130,6 +133,8 @@ def beam_search(
         # A landmark without a region, or a move too short, gives no information.
         moving = (distances > 0.0)[..., None] & known[None, None, :, :]
         b2 = np.where(moving, b2, b1)
+        if sensor is not None:
+            b1, b2 = sensor(b1, starts, heading_grid), sensor(b2, ends, heading_grid)
         rows = np.arange(n_nodes)[:, None, None] * n_worlds + np.arange(n_worlds)[None, None, :]
         rows = np.broadcast_to(rows, step.shape).reshape(-1)
         trials = maps.take(rows.astype(np.int64), into=batches.get(("trials", rows.size)))
@@ -209,7 +214,7 @@ class Lookahead(GreedyOneStep):
     def _choose(self, view: ObservationView, slam: PolygonSLAM) -> Movement:
         pose = self.belief.pose(slam)
         if pose is None or pose.metres_per_unit is None:
-            return bootstrap_movement(self.codec, view)
+            return self._bootstrap(view)
         scale = pose.metres_per_unit
         started = time.perf_counter()
         worlds = self._worlds(slam, pose.position)
@@ -219,7 +224,8 @@ class Lookahead(GreedyOneStep):
             shape = (positions.shape[0], lengths.size, positions.shape[1])
             return np.broadcast_to((metres / scale)[None, :, None], shape)
 
-        movement = self._search(view, slam, worlds, pose.heading, mover)
+        sensor = self._sensor(view, pose, worlds.landmarks)
+        movement = self._search(view, slam, worlds, pose.heading, mover, sensor)
         self.planning_times.append(time.perf_counter() - started)
         return movement
 
@@ -230,6 +236,7 @@ class Lookahead(GreedyOneStep):
         worlds: Worlds,
         heading: float,
         mover: Mover,
+        sensor: Sensor | None = None,
     ) -> Movement:
         turns = np.array([c.turn for c in self.candidates])
         lengths = np.array([c.length for c in self.candidates])
@@ -246,9 +253,10 @@ class Lookahead(GreedyOneStep):
             self.width,
             self.area_cap,
             scratch=self._beam,
+            sensor=sensor,
         )
         if first < 0 or score >= uncertainty_potential(slam.areas, self.area_cap):
-            return bootstrap_movement(self.codec, view)
+            return self._bootstrap(view)
         return self.candidates[first]
 
     def _worlds(self, slam: PolygonSLAM, position: complex) -> Worlds:

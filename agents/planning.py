@@ -9,6 +9,7 @@ provided the move length is converted to FL units.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numba import njit
@@ -65,6 +66,14 @@ def bearings_from(
     return wrap_angle(angles)
 
 
+#: A visibility prediction: simulated bearings (S + (n,)) from positions and headings
+#: (S) with NaN where the reading would miss the landmark
+#: (:meth:`bearing_env.agents.visibility.VisibilityPredictor.missed`).
+Sensor = Callable[
+    [NDArray[np.float64], NDArray[np.complex128], NDArray[np.float64]], NDArray[np.float64]
+]
+
+
 def simulate_potentials(
     slam: PolygonSLAM,
     start: complex,
@@ -75,6 +84,7 @@ def simulate_potentials(
     min_distance: float = 1e-9,
     log_area: bool = True,
     scratch: dict[int, BatchedPolygonSLAM] | None = None,
+    sensor: Sensor | None = None,
 ) -> NDArray[np.float64]:
     """The uncertainty potential after each candidate move, simulated on a copy of ``slam``.
 
@@ -91,6 +101,7 @@ def simulate_potentials(
         log_area: the env's ``reward`` is ``"log_area"`` (True) or ``"area"`` (False).
         scratch: the caller's batches of copies by size, kept between calls and refilled
             (see :meth:`PolygonSLAM.replicate`) instead of made anew for each decision.
+        sensor: the visibility prediction (None: the panoramic camera sees every landmark).
 
     Every moving candidate is fused into its own copy of the map, all in one batched
     update; the bearings are computed here, so the update skips its input checks.
@@ -109,6 +120,9 @@ def simulate_potentials(
     _move_ends(complex(start), headings, distances, ends)
     bearings_start = bearings_from(start, headings, targets)
     bearings_end = np.where(known, bearings_from(ends, headings, targets), bearings_start)
+    if sensor is not None:
+        bearings_start = sensor(bearings_start, np.full(headings.shape, start), headings)
+        bearings_end = sensor(bearings_end, ends, headings)
     if scratch is None:
         trials = slam.replicate(moving.size)
     else:

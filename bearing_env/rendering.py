@@ -44,6 +44,11 @@ MUTED = (110, 110, 118)
 ROBOT = (40, 40, 48)
 TRAJECTORY = (120, 120, 130)
 FRAME_LANDMARK = (55, 55, 62)
+OBSTACLE = (120, 104, 88)
+OBSTACLE_EDGE = (70, 60, 50)
+#: The camera's field of view (a translucent wedge) and a landmark the last reading missed.
+FIELD_OF_VIEW = (230, 190, 60)
+MISSED = (175, 175, 180)
 # Tableau-like palette for landmarks L3, L4, ...: distinct and readable on light green.
 PALETTE = (
     (214, 39, 40),
@@ -141,6 +146,11 @@ class Scene:
     n_initialised: int
     frame_changed: bool
     robot_radius: float
+    #: The arena's obstacles (polygons of (x, y) vertices, metres).
+    obstacles: tuple[tuple[tuple[float, float], ...], ...] = ()
+    #: The camera's half field of view (radians; pi: panoramic) and range (metres).
+    half_fov: float = math.pi
+    max_range: float = math.inf
 
 
 def scene(state: BatchState, row: int, config: EnvConfig, slam: PolygonSLAM) -> Scene:
@@ -175,6 +185,9 @@ def scene(state: BatchState, row: int, config: EnvConfig, slam: PolygonSLAM) -> 
         n_initialised=int(np.sum(slam.initialised)),
         frame_changed=bool(state.frame_changed[row]),
         robot_radius=config.layout.arena.wall_margin,
+        obstacles=config.layout.obstacles,
+        half_fov=config.sensor.half_fov,
+        max_range=config.sensor.max_range,
     )
 
 
@@ -255,11 +268,13 @@ class Renderer:
         overlay.fill((0, 0, 0, 0))
         pygame.draw.rect(canvas, FIELD, self.field_rect)
 
+        self._draw_fields_of_view(scene)
         self._draw_cones(scene)
         self._draw_regions(scene)
         # Everything translucent stays inside the field.
         canvas.set_clip(self.field_rect)
         canvas.blit(overlay, (0, 0))
+        self._draw_obstacles(scene)
         self._draw_region_outlines(scene)
         self._draw_trajectory(scene)
         canvas.set_clip(None)
@@ -295,6 +310,29 @@ class Renderer:
                 outline = self._clipped_outline(np.vstack([origin, tips]))
                 if outline is not None:
                     pygame.draw.polygon(self._overlay, (*landmark_colour(index), alpha), outline)
+
+    def _draw_fields_of_view(self, scene: Scene) -> None:
+        """The camera's field of view (cut at its range) at both readings of the last
+        move, light at R1 and stronger at R2; nothing for the panoramic camera."""
+        if scene.half_fov >= math.pi and math.isinf(scene.max_range):
+            return
+        reach = min(scene.max_range, math.hypot(self.arena.width, self.arena.height))
+        readings = [(scene.robot_position, 60)]
+        if scene.start_position is not None:
+            readings.insert(0, (scene.start_position, 30))
+        for origin, alpha in readings:
+            angles = scene.robot_heading + np.linspace(-1, 1, 33) * min(scene.half_fov, math.pi)
+            rim = origin + reach * np.stack([np.cos(angles), np.sin(angles)], axis=-1)
+            wedge = rim if scene.half_fov >= math.pi else np.vstack([origin, rim])
+            outline = self._clipped_outline(wedge)
+            if outline is not None:
+                self._pygame.draw.polygon(self._overlay, (*FIELD_OF_VIEW, alpha), outline)
+
+    def _draw_obstacles(self, scene: Scene) -> None:
+        for polygon in scene.obstacles:
+            outline = [tuple(p) for p in self.to_pixels(np.asarray(polygon))]
+            self._pygame.draw.polygon(self._canvas, OBSTACLE, outline)
+            self._pygame.draw.polygon(self._canvas, OBSTACLE_EDGE, outline, width=2)
 
     def _draw_regions(self, scene: Scene) -> None:
         pygame = self._pygame
@@ -334,6 +372,7 @@ class Renderer:
         pygame = self._pygame
         radius = 11
         for index, landmark in enumerate(scene.landmarks):
+            # A landmark the last reading missed is drawn grey: the sensor did not see it.
             colour = landmark_colour(index)
             centre = self.to_pixels(landmark)
             if index >= 2:
@@ -345,7 +384,9 @@ class Renderer:
                     pygame.draw.circle(self._canvas, (255, 255, 255), tuple(at), 7)
                     pygame.draw.circle(self._canvas, colour, tuple(at), 7, width=3)
             star = _star(centre, radius, 0.45 * radius)
-            pygame.draw.polygon(self._canvas, colour, star)
+            # A landmark the last reading missed is drawn grey: the sensor did not see it.
+            seen = not math.isnan(scene.end_bearings[index])
+            pygame.draw.polygon(self._canvas, colour if seen else MISSED, star)
             pygame.draw.polygon(self._canvas, (255, 255, 255), star, width=1)
             label = self._small_font.render(f"L{index + 1}", True, colour)
             self._canvas.blit(label, (centre[0] + radius - 1, centre[1] - radius - 4))
@@ -364,9 +405,7 @@ class Renderer:
 
     def _draw_header(self, scene: Scene) -> None:
         n_mapped = len(scene.regions)
-        total = (
-            f"{scene.total_area:.4f} FL units²" if math.isfinite(scene.total_area) else "n/a"
-        )
+        total = f"{scene.total_area:.4f} FL units²" if math.isfinite(scene.total_area) else "n/a"
         status = "map updated" if scene.frame_changed else "no update"
         if scene.moves == 0:
             status = "start"

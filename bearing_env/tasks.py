@@ -22,12 +22,15 @@ from typing import Any
 
 #: How the task ids are formed (Markdown; the task index quotes it).
 NAMING_RULE = """\
-`<kind>-<setting>[-<fault>]-v<version>`:
+`<kind>-<setting>[-<sensor>][-<fault>]-v<version>`:
 
 - `kind` is the base id's name: `BearingSLAM` (continuous actions) or
   `BearingSLAMDiscrete` (the discrete action grid);
-- `setting` names the layout: `Khepera` (the paper's real arena, fixed landmarks) or
-  `Random<N>` (a new random layout of N landmarks every episode, on the Khepera field);
+- `setting` names the layout: `Khepera` (the paper's real arena, fixed landmarks),
+  `Random<N>` (a new random layout of N landmarks every episode, on the Khepera field)
+  or `FurnishedRoom` (a room whose furniture blocks motion and sight, fixed landmarks);
+- `sensor` names a camera narrower than the paper's panoramic one: `Camera<D>` (a
+  forward field of view of D degrees about the move's direction);
 - `fault` names a sensor that breaks the paper's assumptions, mapped with the robust
   fusion (`fusion="relaxed"`): `Outliers` (some bearings replaced by random angles) or
   `Missed` (some landmarks not detected in a reading);
@@ -110,6 +113,16 @@ def _random(n_landmarks: int) -> Task:
     )
 
 
+def _camera(degrees: int) -> Task:
+    return Task(
+        id=f"BearingSLAM-Khepera-Camera{degrees}-v0",
+        base_id=BASE_IDS["continuous"],
+        settings={"scenario": "khepera", "field_of_view_deg": degrees},
+        description=f"Khepera arena, a forward camera of {degrees} deg: landmarks outside it "
+        "are missed",
+    )
+
+
 #: Every task, in the order of the tables.
 TASKS: tuple[Task, ...] = (
     _khepera("continuous"),
@@ -128,6 +141,15 @@ TASKS: tuple[Task, ...] = (
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "khepera", "noise": MISSED_NOISE, "fusion": "relaxed"},
         description="Khepera arena, each landmark missed in 20% of readings, robust fusion",
+    ),
+    _camera(90),
+    _camera(180),
+    Task(
+        id="BearingSLAM-FurnishedRoom-v0",
+        base_id=BASE_IDS["continuous"],
+        settings={"scenario": "furnished_room"},
+        description="a furnished room of 2 x 1.5 m (5 landmarks): furniture blocks moves "
+        "and hides landmarks",
     ),
 )
 

@@ -24,6 +24,8 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.numerics import JIT_OPTIONS, wrap, wrap_angle
+from bearing_env.obstacles import Obstacle, box
+from bearing_env.sensing import Packed, clearance, free_length
 from bearing_env.validation import float_in, non_negative_float, positive_float
 
 FloatArray = NDArray[np.float64]
@@ -334,12 +336,14 @@ def _add_wrapped_with_outliers(
 
 @dataclass(frozen=True)
 class Scenario:
-    """A named world: arena size and, unless random, fixed landmark positions."""
+    """A named world: arena size, unless random fixed landmark positions, and its
+    obstacles (polygons, see :mod:`bearing_env.obstacles`)."""
 
     name: str
     arena_size: tuple[float, float]
     landmarks: tuple[tuple[float, float], ...] | None
     description: str = field(default="", compare=False)
+    obstacles: tuple[Obstacle, ...] = ()
 
     @property
     def n_landmarks(self) -> int | None:
@@ -365,6 +369,32 @@ SCENARIOS: dict[str, Scenario] = {
         landmarks=((0.75, 0.60), (1.25, 0.60), (1.35, 1.30), (0.65, 1.40)),
         description="the paper's simulation: 4 landmarks around the centre of a 2 x 2 m square",
     ),
+    # A living room of 2 x 1.5 m with a table in the middle, a sofa along the top wall,
+    # a shelf against the right wall and an armchair: each hides some landmarks from
+    # some places, and the robot must go round them.
+    "furnished_room": Scenario(
+        name="furnished_room",
+        arena_size=(2.0, 1.5),
+        landmarks=((0.45, 0.25), (1.05, 0.25), (1.85, 0.85), (1.2, 1.35), (0.12, 0.7)),
+        description="a furnished room: 2 x 1.5 m, 5 landmarks, a table, a sofa, a shelf "
+        "and an armchair that block motion and sight",
+        obstacles=(
+            box(0.8, 0.55, 1.2, 0.85),
+            box(0.2, 1.15, 0.9, 1.35),
+            box(1.6, 0.1, 1.85, 0.6),
+            box(1.45, 1.0, 1.7, 1.25),
+        ),
+    ),
+    # A corridor 0.7 m wide that turns a corner: the block fills the rest of a 2 x 2 m
+    # square, so no place sees both ends.
+    "l_corridor": Scenario(
+        name="l_corridor",
+        arena_size=(2.0, 2.0),
+        landmarks=((0.35, 0.15), (0.95, 0.15), (1.8, 0.5), (0.15, 1.2), (0.55, 1.85)),
+        description="a corridor with an L-turn: 0.7 m wide along two walls of a 2 x 2 m "
+        "square, 5 landmarks",
+        obstacles=(box(0.7, 0.7, 2.0, 2.0),),
+    ),
     "random": Scenario(
         name="random",
         arena_size=KHEPERA_ARENA_SIZE,
@@ -381,7 +411,11 @@ SCENARIOS: dict[str, Scenario] = {
 
 
 def random_layout(
-    rng: np.random.Generator, arena: Arena, n_landmarks: int, max_attempts: int = 200
+    rng: np.random.Generator,
+    arena: Arena,
+    n_landmarks: int,
+    max_attempts: int = 200,
+    obstacles: Packed | None = None,
 ) -> FloatArray:
     """Draw ``n_landmarks`` landmark positions (n, 2) uniformly in the arena.
 
@@ -389,6 +423,8 @@ def random_layout(
     from each other (two landmarks on top of each other are one landmark). L1 and L2 are
     at least a quarter of the arena's shorter side apart, so the landmark frame FL is well
     conditioned: the FL unit |L1 - L2| is then never tiny compared with the arena.
+    Among ``obstacles`` (packed, see :mod:`bearing_env.sensing`) they also keep as far
+    from them as from the walls.
     """
     if n_landmarks < 2:
         raise ValueError(f"n_landmarks must be >= 2, got {n_landmarks}")
@@ -406,6 +442,8 @@ def random_layout(
         while count < n_landmarks and attempts < max_attempts * n_landmarks:
             attempts += 1
             candidate = rng.uniform(low, high)
+            if obstacles is not None and _clearance(candidate, obstacles) < inset:
+                continue
             if count > 0:
                 distances = np.hypot(*(points[:count] - candidate).T)
                 if distances.min() < spacing or (count == 1 and distances[0] < frame_spacing):
@@ -420,21 +458,35 @@ def random_layout(
 
 
 def random_start(
-    rng: np.random.Generator, arena: Arena, landmarks: FloatArray, max_attempts: int = 1000
+    rng: np.random.Generator,
+    arena: Arena,
+    landmarks: FloatArray,
+    max_attempts: int = 1000,
+    obstacles: Packed | None = None,
 ) -> tuple[FloatArray, float]:
     """A random start pose: position inside the wall margin, not on top of a landmark,
+    twice the wall margin from ``obstacles`` (packed, see :mod:`bearing_env.sensing`),
     and a uniform heading."""
     margin = arena.wall_margin
     low = np.array([margin, margin])
     high = np.array([arena.width - margin, arena.height - margin])
-    clearance = 0.04 * arena.scale
+    landmark_clearance = 0.04 * arena.scale
     position = rng.uniform(low, high)
     for _ in range(max_attempts):
-        if np.min(np.hypot(*(landmarks - position).T)) >= clearance:
+        if np.min(np.hypot(*(landmarks - position).T)) >= landmark_clearance and (
+            obstacles is None or _clearance(position, obstacles) >= 2.0 * margin
+        ):
             break
         position = rng.uniform(low, high)
+    else:
+        if obstacles is not None and _clearance(position, obstacles) < margin:
+            raise ValueError(f"found no free start position among the obstacles in {arena}")
     heading = float(rng.uniform(-np.pi, np.pi))
     return position, heading
+
+
+def _clearance(point: FloatArray, obstacles: Packed) -> float:
+    return float(clearance(float(point[0]), float(point[1]), *obstacles))
 
 
 # --------------------------------------------------------------------------------------
@@ -555,6 +607,31 @@ def straight_move(
     new_x = min(max(x + travelled * dx, margin), width - margin)
     new_y = min(max(y + travelled * dy, margin), height - margin)
     return new_x, new_y, travelled, free < length
+
+
+@njit(**JIT_OPTIONS)
+def obstructed_move(
+    x: float,
+    y: float,
+    heading: float,
+    length: float,
+    settings: tuple[float, float, float, float],
+    vertices: FloatArray,
+    starts: NDArray[np.int64],
+) -> tuple[float, float, float, bool]:
+    """:func:`straight_move` that also stops ``margin`` short of the obstacles (packed,
+    see :mod:`bearing_env.sensing`); ``settings`` is (width, height, margin,
+    min_baseline). Without obstacles it is :func:`straight_move`, bit for bit."""
+    width, height, margin, min_baseline = settings
+    room = free_length(x, y, heading, vertices, starts, margin)
+    if room >= length:
+        return straight_move(x, y, heading, length, width, height, margin, min_baseline)
+    if room < min_baseline:
+        room = 0.0
+    new_x, new_y, travelled, _ = straight_move(
+        x, y, heading, room, width, height, margin, min_baseline
+    )
+    return new_x, new_y, travelled, True
 
 
 @njit(**JIT_OPTIONS)

@@ -194,6 +194,14 @@ def _relative(ratio: float | None, reference: str) -> str:
     return "" if ratio is None else f"{_times(ratio)} {reference}"
 
 
+#: The limited-sensor rows of the single section: (case, the reference of its step cost).
+SENSOR_ROW_CASES: dict[str, tuple[str, str]] = {
+    "furnished_room": ("furnished room, 4 obstacles", "without them"),
+    "furnished_room_empty": ("furnished room, no obstacles", ""),
+    "khepera_camera90": ("khepera, 90 deg camera", "panoramic"),
+}
+
+
 def table_rows(results: dict[str, Any]) -> list[tuple[str, ...]]:
     """(section, case, steps/s, % nearest ref, ref, % start ref, relative) rows."""
     rows: list[tuple[str, ...]] = []
@@ -218,6 +226,11 @@ def table_rows(results: dict[str, Any]) -> list[tuple[str, ...]]:
             case = "khepera, gym.make wrappers"
         elif row["name"] == "khepera_no_robot_map":
             case = "khepera, robot_map_info=False"
+        elif row["name"] in SENSOR_ROW_CASES:
+            case, reference = SENSOR_ROW_CASES[row["name"]]
+            cost = row.get("step_cost_ratio")
+            add("single", case, row, "" if cost is None else f"step {cost:.2f}x {reference}")
+            continue
         else:
             case = f"random, {row['n_landmarks']} landmarks"
         add("single", case, row, _relative(row["ratio_to_4_landmarks"], "4-landmark rate"))

@@ -136,7 +136,18 @@ def single_env_cases(landmarks: Sequence[int]) -> list[tuple[str, dict[str, Any]
         )
     cases.append(("khepera_wrapped", {"scenario": "khepera"}, False))
     cases.append(("khepera_no_robot_map", {"scenario": "khepera", **NO_ROBOT_MAP}, True))
+    cases.extend(SENSOR_CASES)
     return cases
+
+
+#: The rows of the limited sensor: the furnished room with its furniture (obstacles that
+#: block moves and sight) and without (the same room, the panoramic camera in an empty
+#: arena: the reference of its cost), and the Khepera arena with a 90 degree camera.
+SENSOR_CASES: tuple[tuple[str, dict[str, Any], bool], ...] = (
+    ("furnished_room", {"scenario": "furnished_room"}, True),
+    ("furnished_room_empty", {"scenario": "furnished_room", "obstacles": []}, True),
+    ("khepera_camera90", {"scenario": "khepera", "field_of_view_deg": 90}, True),
+)
 
 
 def make_single_env(env_kwargs: dict[str, Any], unwrapped: bool = True) -> gym.Env[Any, Any]:
@@ -204,7 +215,20 @@ def bench_single(bench: Bench, landmarks: Sequence[int]) -> list[dict[str, Any]]
             if base is not None and row["name"].startswith("random_")
             else None
         )
+    _step_cost_ratios(rows)
     return rows
+
+
+def _step_cost_ratios(rows: list[dict[str, Any]]) -> None:
+    """``step_cost_ratio``: a limited-sensor row's step time over its panoramic, empty
+    reference's (the furnished room without its furniture, or Khepera); None elsewhere."""
+    rates = {row["name"]: row["steps_per_s"] for row in rows}
+    references = {"furnished_room": "furnished_room_empty", "khepera_camera90": "khepera"}
+    for row in rows:
+        reference = references.get(row["name"])
+        row["step_cost_ratio"] = (
+            rates[reference] / row["steps_per_s"] if reference in rates else None
+        )
 
 
 # --------------------------------------------------------------------------------------

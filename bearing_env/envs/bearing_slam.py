@@ -270,18 +270,30 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     - `scenario`: `"random"` (default unless `landmarks` is given; a new layout of
       `n_landmarks` every episode), `"khepera"` (the paper's real arena, 4 landmarks),
       `"paper_sim"` (the paper's simulation: 4 landmarks around the centre of a 2 x 2 m
-      square) or `"custom"` (default when `landmarks` is given).
+      square), `"furnished_room"` (2 x 1.5 m, 5 landmarks, four pieces of furniture),
+      `"l_corridor"` (a corridor with an L-turn, 5 landmarks) or `"custom"` (default when
+      `landmarks` is given).
     - `n_landmarks`: number of landmarks (3 to 1024) for `"random"`; default 4. A range
       `(lo, hi)` draws the count anew every episode (for policies that must generalise
       across landmark counts); `max_landmarks` then defaults to `max(8, hi)`.
     - `landmarks`: explicit landmark positions `(n, 2)` in metres (L1 first, then L2).
     - `arena`: `(width, height)` in metres; default the scenario's (Khepera 1.05 x 0.68).
+    - `obstacles`: polygons that block moves (a move stops at the wall margin from them,
+      and the observation's `last_move_blocked` says so) and sight: a list of polygons
+      of `(x, y)` vertices in metres, the path of a JSON or YAML file, or
+      `{"random": count, "seed": seed}` (see `bearing_env.obstacles`); default the
+      scenario's (none but for `"furnished_room"` and `"l_corridor"`).
     - `epsilon_deg`: the SLAM's bearing error bound in degrees, in (0, 90) (the world
       model's own bound); default 2.
     - `noise`: the true sensor noise: a `NoiseModel`, a mapping of its fields
       (`kind` = `"uniform"` | `"gaussian"` | `"none"`, `bound_deg`, `sigma_deg`,
       `outlier_rate`, `detection_rate`: a missed landmark's bearing is NaN, and the map
       skips it for that movement) or a kind name; default uniform within +-epsilon.
+    - `field_of_view_deg`: the camera's field of view in (0, 360] degrees about the
+      heading (the move's direction); default 360, the paper's panoramic camera.
+    - `max_range`: the camera's range in metres; default inf. A landmark outside the
+      field of view, beyond the range or behind an obstacle is a missed reading: its
+      bearing is NaN for the map, and reads (cos, sin) = (0, 0) in the observation.
     - `transfer`: `"conservative"` (default; regions contain the truth whenever the noise
       is within +-epsilon) or `"paper"` (the paper's vertex hull).
     - `reward`: `"log_area"` (default) or `"area"`.
@@ -308,6 +320,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
       Info). The map-based planners (`Parallax`, `GreedyOneStep`, `Lookahead` and their
       oracles) need it and refuse an env without it; training runs that never read it
       can turn it off to save its cost (observations and rewards are the same either way).
+    - `sensor_info`: False (default) or True: whether infos carry `seen` (which
+      landmarks the last reading saw) and `blocked` (a wall or an obstacle stopped the
+      move).
     - `render_mode`: `None`, `"human"` or `"rgb_array"`.
     - `config`: an `EnvConfig` (`bearing_env.envs.config`) holding all the settings
       above but `render_mode`, instead of the keywords (`EnvConfig.create(...)` takes
@@ -450,12 +465,12 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         core.reset_rows(self._state, rows, config, [self.np_random], self._maps)
         if self._world is None:
             self._world = WorldView(self._state, 0, config)
-        report, robot_map_info = core.report(
-            self._state, self._maps.group(self._state, rows, config)
-        )
+        group = self._maps.group(self._state, rows, config)
+        report, robot_map_info = core.report(self._state, group)
         if self.render_mode == "human":
             self.render()
-        return self._observation(report.observations[0]), core.single_info(report, robot_map_info)
+        info = core.single_info(report, robot_map_info, core.sensor_info(self._state, group))
+        return self._observation(report.observations[0]), info
 
     def step(
         self, action: NDArray[np.float32] | ArrayLike
@@ -476,7 +491,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             report.rewards.item(),
             report.terminated.item(),
             report.truncated.item(),
-            core.single_info(report, robot_map_info),
+            core.single_info(report, robot_map_info, core.sensor_info(self._state, group)),
         )
 
     def _observation(self, flat: NDArray[np.float32]) -> Any:

@@ -297,7 +297,8 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         self._elapsed_steps[rows] += 1
         if self.max_episode_steps is not None:
             report.truncated[:] |= self._elapsed_steps[rows] >= self.max_episode_steps
-        return report, self._padded(core.infos(report, robot_map_info))
+        infos = core.infos(report, robot_map_info, core.sensor_info(self._state, group))
+        return report, self._padded(infos)
 
     def _returned(self, flat: NDArray[np.float32]) -> Any:
         """The observations ``reset`` or ``step`` returns, kept as the latest ones."""
@@ -498,11 +499,13 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             rngs = [self._rng(row) for row in group.tolist()]
             core.reset_rows(self._state, group, config, rngs, self._maps)
         for config, group in self._groups(rows):
-            report, robot_map_info = core.report(
-                self._state, self._maps.group(self._state, group, config)
-            )
+            rows_group = self._maps.group(self._state, group, config)
+            report, robot_map_info = core.report(self._state, rows_group)
             observations[group] = report.observations
-            infos = self._merge_rows(infos, self._padded(core.infos(report, robot_map_info)), group)
+            group_infos = core.infos(
+                report, robot_map_info, core.sensor_info(self._state, rows_group)
+            )
+            infos = self._merge_rows(infos, self._padded(group_infos), group)
         self._elapsed_steps[rows] = 0
         return infos
 
@@ -534,6 +537,10 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             values = info[key]
             padded[key] = np.full((*values.shape[:-1], self._info_slots), fill, values.dtype)
             padded[key][..., : values.shape[-1]] = values
+        if "seen" in info:  # every landmark, L1 and L2 included: two more slots
+            seen = info["seen"]
+            padded["seen"] = np.zeros((seen.shape[0], self._info_slots + 2), dtype=bool)
+            padded["seen"][:, : seen.shape[1]] = seen
         return padded
 
     def _merge_final(

@@ -10,12 +10,14 @@ its own fields in ``__post_init__`` (:class:`EnvConfig` checks what spans groups
 ==============  =========================  ===================================================
 group           class                      fields
 ==============  =========================  ===================================================
-``layout``      :class:`LayoutSettings`    scenario, landmark_counts, landmarks, arena
-``sensor``      :class:`SensorSettings`    epsilon_deg, noise
+``layout``      :class:`LayoutSettings`    scenario, landmark_counts, landmarks, arena,
+                                           obstacles
+``sensor``      :class:`SensorSettings`    epsilon_deg, noise, field_of_view_deg, max_range
 ``mapping``     :class:`MappingSettings`   transfer, fusion, max_outliers, on_inconsistency
 ``task``        :class:`TaskSettings`      reward, target_area, max_moves, path_cost, ...
 ``actions``     :class:`ActionSettings`    move_length, n_turns, n_move_lengths
-``observations``:class:`ObservationSettings` max_landmarks, observation, robot_map_info
+``observations``:class:`ObservationSettings` max_landmarks, observation, robot_map_info,
+                                           sensor_info
 ==============  =========================  ===================================================
 
 **The groups' fields are the one home of the settings.** A field made by :func:`setting`
@@ -63,12 +65,15 @@ from typing import Any, TypeVar, cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from bearing_env.obstacles import Obstacle, parse_obstacles
+from bearing_env.sensing import clearance, pack_polygons
 from bearing_env.slam import FUSIONS, INCONSISTENCY_POLICIES, TRANSFERS, MapSettings
 from bearing_env.slam.settings import DEFAULT_MAX_OUTLIERS, DEFAULT_WINDOW
 from bearing_env.validation import (
     EPSILON_RANGE,
     choice,
     flag,
+    float_in,
     int_at_least,
     int_at_most,
     is_real,
@@ -224,7 +229,9 @@ def _normalise(group: object, name: str, value: object) -> None:
 class LayoutSettings(SettingsGroup):
     """Where the landmarks are: the scenario, the landmark count range ``(lo, hi)``
     (equal for a fixed count), the fixed positions as ``(x, y)`` tuples (None for random
-    layouts) and the arena."""
+    layouts), the arena and its obstacles (polygons of ``(x, y)`` vertices; the keyword
+    takes the forms of :func:`bearing_env.obstacles.parse_obstacles`, None for the
+    scenario's)."""
 
     scenario: str = setting(accepts="str | None", keyword_default=None)
     landmark_counts: tuple[int, int] = setting(
@@ -235,6 +242,11 @@ class LayoutSettings(SettingsGroup):
     )
     arena: Arena = setting(  # noqa: RUF009  (setting() makes the field: no shared default)
         accepts="tuple[float, float] | Arena | None", keyword_default=None
+    )
+    obstacles: tuple[Obstacle, ...] = setting(
+        (),
+        accepts="Sequence[ArrayLike] | str | os.PathLike[str] | Mapping[str, int] | None",
+        keyword_default=None,
     )
 
     @classmethod
@@ -249,6 +261,7 @@ class LayoutSettings(SettingsGroup):
             landmark_counts=_resolve_landmark_counts(keywords["n_landmarks"], fixed, name),
             landmarks=fixed,
             arena=_resolve_arena(keywords["arena"], spec.arena_size),
+            obstacles=spec.obstacles if keywords["obstacles"] is None else keywords["obstacles"],
         )
 
     @classmethod
@@ -264,6 +277,9 @@ class LayoutSettings(SettingsGroup):
             _normalise(self, "arena", _resolve_arena(arena, SCENARIOS[self.scenario].arena_size))
         lo, hi = _resolve_count_pair(self.landmark_counts)
         _normalise(self, "landmark_counts", (lo, hi))
+        _normalise(
+            self, "obstacles", parse_obstacles(self.obstacles, self.arena.width, self.arena.height)
+        )
         if self.landmarks is not None:
             points = _landmark_points(self.landmarks)
             if points.shape[0] != lo or lo != hi:
@@ -272,7 +288,19 @@ class LayoutSettings(SettingsGroup):
                     f"{points.shape[0]} fixed landmark positions"
                 )
             _check_layout(points, self.arena)
+            self._check_landmarks_free(points)
             _normalise(self, "landmarks", tuple((float(x), float(y)) for x, y in points))
+
+    def _check_landmarks_free(self, points: NDArray[np.float64]) -> None:
+        vertices, starts = self.packed_obstacles
+        for x, y in points:
+            if clearance(float(x), float(y), vertices, starts) <= 0.0:
+                raise ValueError(f"landmark ({x:g}, {y:g}) lies inside an obstacle")
+
+    @cached_property
+    def packed_obstacles(self) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+        """The obstacles as the compiled geometry takes them (:mod:`bearing_env.sensing`)."""
+        return pack_polygons(self.obstacles)
 
     @property
     def fixed_landmarks(self) -> NDArray[np.float64] | None:
@@ -287,13 +315,18 @@ class LayoutSettings(SettingsGroup):
 
 @dataclass(frozen=True)
 class SensorSettings(SettingsGroup):
-    """The bearing sensor: the bearing error bound the map assumes (degrees) and the
-    true noise. A later field of view and range belong here."""
+    """The bearing sensor: the bearing error bound the map assumes (degrees), the true
+    noise, the field of view (degrees, centred on the heading, which is the move's
+    direction; 360 = the paper's panoramic camera) and the range (metres; inf = no limit).
+    A landmark outside the field of view, beyond the range or behind an obstacle is a
+    missed reading (NaN), as is one the noise's ``detection_rate`` misses."""
 
     epsilon_deg: float = setting(2.0)
     noise: NoiseModel = setting(  # noqa: RUF009  (setting() makes the field; NoiseModel is frozen)
         NoiseModel(), accepts="NoiseModel | Mapping[str, Any] | str | None", keyword_default=None
     )
+    field_of_view_deg: float = setting(360.0)
+    max_range: float = setting(math.inf)
 
     def __post_init__(self) -> None:
         if not is_real(self.epsilon_deg):
@@ -305,11 +338,25 @@ class SensorSettings(SettingsGroup):
             )
         _normalise(self, "epsilon_deg", float(self.epsilon_deg))
         _normalise(self, "noise", NoiseModel.parse(self.noise))
+        fov = float_in(self.field_of_view_deg, "field_of_view_deg", 0.0, 360.0, closed_low=False)
+        _normalise(self, "field_of_view_deg", fov)
+        if not is_real(self.max_range):
+            raise TypeError(f"max_range must be a number of metres, got {self.max_range!r}")
+        if math.isnan(self.max_range) or self.max_range <= 0.0:
+            raise ValueError(
+                f"max_range must be > 0 metres (inf: no limit), got {self.max_range!r}"
+            )
+        _normalise(self, "max_range", float(self.max_range))
 
     @property
     def epsilon(self) -> float:
         """The bearing error bound, radians."""
         return math.radians(self.epsilon_deg)
+
+    @property
+    def half_fov(self) -> float:
+        """Half the field of view, radians (pi: panoramic)."""
+        return math.radians(0.5 * self.field_of_view_deg)
 
 
 @dataclass(frozen=True)
@@ -403,7 +450,10 @@ class ActionSettings(SettingsGroup):
 class ObservationSettings(SettingsGroup):
     """What the robot is given: the observation's landmark slots and kind (both fix the
     space), and whether its infos carry its own map (``info["robot_map"]``, which the
-    map-based planners read; training runs that never read it can turn it off)."""
+    map-based planners read; training runs that never read it can turn it off), and
+    whether they carry what the sensor did (``info["seen"]``, which landmarks the last
+    reading saw, and ``info["blocked"]``, whether a wall or an obstacle stopped the
+    move; off by default, which keeps the infos of the paper's settings as they were)."""
 
     max_landmarks: int = setting(
         DEFAULT_MAX_LANDMARKS,
@@ -413,6 +463,7 @@ class ObservationSettings(SettingsGroup):
     )
     observation: str = setting("flat", attribute="observation_kind", read_only=FIXES_THE_SPACES)
     robot_map_info: bool = setting(True)
+    sensor_info: bool = setting(False)
 
     @classmethod
     def from_keywords(
@@ -422,7 +473,12 @@ class ObservationSettings(SettingsGroup):
         max_landmarks = keywords["max_landmarks"]
         if max_landmarks is None:
             max_landmarks = max(DEFAULT_MAX_LANDMARKS, layout.landmark_counts[1])
-        return cls(max_landmarks, keywords["observation"], keywords["robot_map_info"])
+        return cls(
+            max_landmarks,
+            keywords["observation"],
+            keywords["robot_map_info"],
+            keywords["sensor_info"],
+        )
 
     def __post_init__(self) -> None:
         max_landmarks = int_at_least(self.max_landmarks, 3, "max_landmarks")
@@ -431,6 +487,7 @@ class ObservationSettings(SettingsGroup):
         )
         choice(self.observation, OBSERVATIONS, "observation")
         _normalise(self, "robot_map_info", flag(self.robot_map_info, "robot_map_info"))
+        _normalise(self, "sensor_info", flag(self.sensor_info, "sensor_info"))
 
 
 # ----------------------------------------------------------------------------------------

@@ -41,6 +41,7 @@ from bearing_env.envs.kernels import Settings
 from bearing_env.envs.observations import FL_COORD_LIMIT
 from bearing_env.envs.state import BatchState
 from bearing_env.numerics import wrap_angle
+from bearing_env.sensing import visible_rows
 from bearing_env.slam import MapSettings, PolygonSLAM
 from bearing_env.slam import kernels as slam_kernels
 from bearing_env.slam.batch import (
@@ -147,7 +148,8 @@ class Group(NamedTuple):
 
 def kernel_settings(n_landmarks: int, config: EnvConfig) -> Settings:
     """The kernels' settings of a group of ``config`` with ``n_landmarks`` landmarks."""
-    arena, task = config.layout.arena, config.task
+    arena, task, sensor = config.layout.arena, config.task, config.sensor
+    vertices, starts = config.layout.packed_obstacles
     return Settings(
         n=int(n_landmarks),
         n_slots=int(config.observations.max_landmarks),
@@ -164,6 +166,10 @@ def kernel_settings(n_landmarks: int, config: EnvConfig) -> Settings:
         move_cost=float(task.move_cost),
         coordinate_limit=FL_COORD_LIMIT,
         tolerance=CONTAINMENT_TOLERANCE,
+        half_fov=sensor.half_fov,
+        max_range=sensor.max_range,
+        obstacle_vertices=vertices,
+        obstacle_starts=starts,
     )
 
 
@@ -303,6 +309,7 @@ def reset_rows(
     layout, noise = config.layout, config.sensor.noise
     lo, hi = layout.landmark_counts
     fixed = layout.fixed_landmarks
+    obstacles = layout.packed_obstacles if layout.obstacles else None
     state.landmarks[rows] = 0.0
     state.landmarks_fl[rows] = 0.0
     for row, rng in zip(rows.tolist(), rngs, strict=True):
@@ -311,8 +318,11 @@ def reset_rows(
         release_noise(state, row)
         # Rejection sampling makes the draws per row: a layout's draw count varies.
         count = int(rng.integers(lo, hi + 1)) if hi > lo else hi
-        landmarks = fixed if fixed is not None else random_layout(rng, layout.arena, count)
-        position, heading = random_start(rng, layout.arena, landmarks)
+        if fixed is not None:
+            landmarks = fixed
+        else:
+            landmarks = random_layout(rng, layout.arena, count, obstacles=obstacles)
+        position, heading = random_start(rng, layout.arena, landmarks, obstacles=obstacles)
         state.n_landmarks[row] = count
         state.landmarks[row, :count] = landmarks
         state.positions[row] = position
@@ -339,12 +349,31 @@ def reset_rows(
         )
         group_rngs = [rng_of[i] for i in group.tolist()]
         readings = noise.corrupt_rows(group_rngs, truth, config.epsilon)
+        readings[~sees(state, group, n, config)] = np.nan
         state.latest_bearings[group] = 0.0
         state.latest_bearings[group, :n] = readings
         rows_group = maps.group(state, group, config)
         rows_group.batch.reset(group)
         state.potentials[group] = potentials(state, rows_group)
     fill_noise(state, rows, config)
+
+
+def sees(state: BatchState, rows: IntArray, n: int, config: EnvConfig) -> BoolArray:
+    """Which of their ``n`` landmarks the rows' sensors see from their poses (len(rows), n)."""
+    out = np.empty((rows.size, n), dtype=bool)
+    vertices, starts = config.layout.packed_obstacles
+    sensor = config.sensor
+    visible_rows(
+        state.landmarks[rows, :n],
+        state.positions[rows],
+        state.headings[rows],
+        sensor.half_fov,
+        sensor.max_range,
+        vertices,
+        starts,
+        out,
+    )
+    return out
 
 
 def group_rows(state: BatchState, rows: IntArray) -> list[tuple[int, IntArray]]:
@@ -495,9 +524,14 @@ def potentials(state: BatchState, group: Group) -> FloatArray:
     return out
 
 
-def infos(report: kernels.Report, robot_map_info: dict[str, Any] | None) -> dict[str, Any]:
+def infos(
+    report: kernels.Report,
+    robot_map_info: dict[str, Any] | None,
+    sensor: dict[str, Any] | None = None,
+) -> dict[str, Any]:
     """The group's infos, batched along a first axis (see the env's Info section): the
-    report's arrays themselves, and ``robot_map`` unless it is None (the setting off)."""
+    report's arrays themselves, ``robot_map`` unless it is None (the setting off), and
+    the :func:`sensor_info` entries unless they are None."""
     infos: dict[str, Any] = {
         "landmark_area": report.landmark_area,
         "landmark_error": report.landmark_error,
@@ -516,10 +550,29 @@ def infos(report: kernels.Report, robot_map_info: dict[str, Any] | None) -> dict
     }
     if robot_map_info is not None:
         infos[robot_map.KEY] = robot_map_info
+    if sensor is not None:
+        infos.update(sensor)
     return infos
 
 
-def single_info(report: kernels.Report, robot_map_info: dict[str, Any] | None) -> dict[str, Any]:
+def sensor_info(state: BatchState, group: Group) -> dict[str, Any] | None:
+    """The ``sensor_info`` setting's entries, batched: ``seen`` (len(rows), n), which
+    landmarks the last reading saw, and ``blocked``, whether a wall or an obstacle
+    stopped the last move; None with the setting off."""
+    if not group.config.observations.sensor_info:
+        return None
+    rows = group.rows
+    return {
+        "seen": ~np.isnan(state.latest_bearings[rows, : group.n]),
+        "blocked": state.blocked[rows].copy(),
+    }
+
+
+def single_info(
+    report: kernels.Report,
+    robot_map_info: dict[str, Any] | None,
+    sensor: dict[str, Any] | None = None,
+) -> dict[str, Any]:
     """The info of a group of one row (the single env): Python scalars and per-landmark
     arrays (views of the report's, which is made anew at every step and kept by no one)."""
     info: dict[str, Any] = {
@@ -543,4 +596,6 @@ def single_info(report: kernels.Report, robot_map_info: dict[str, Any] | None) -
             key: value[0] if value.ndim > 1 else value.item()
             for key, value in robot_map_info.items()
         }
+    if sensor is not None:
+        info["seen"], info["blocked"] = sensor["seen"][0], bool(sensor["blocked"][0])
     return info

@@ -30,12 +30,13 @@ from bearing_env.envs.observations import BEARING_FEATURES, LANDMARK_FEATURES, R
 from bearing_env.envs.robot_map import encode_map
 from bearing_env.numerics import JIT_OPTIONS as _JIT
 from bearing_env.numerics import wrap
+from bearing_env.sensing import visible
 from bearing_env.slam.batch import PARALLEL_MIN_MAPS
 from bearing_env.slam.kernels import FRAME_OK, contains_point, update_maps, update_maps_parallel
 from bearing_env.slam.kernels import Outputs as MapOutputs
 from bearing_env.slam.kernels import Params as MapParams
 from bearing_env.slam.kernels import State as MapState
-from bearing_env.world import bearing, straight_move
+from bearing_env.world import bearing, obstructed_move
 
 if TYPE_CHECKING:  # only for annotations: that module imports this one
     from bearing_env.envs.state import BatchState
@@ -69,6 +70,10 @@ class Settings(NamedTuple):
     move_cost: float  #: per move
     coordinate_limit: float  #: FL coordinates are clipped to +-this in the observation
     tolerance: float  #: relative tolerance of the info's containment test
+    half_fov: float  #: half the sensor's field of view, radians (pi: panoramic)
+    max_range: float  #: the sensor's range, metres (inf: no limit)
+    obstacle_vertices: FloatArray  #: the obstacles, packed (see bearing_env.sensing)
+    obstacle_starts: NDArray[np.int64]
 
 
 class Inputs(NamedTuple):
@@ -116,6 +121,27 @@ def _noisy(true_bearing: float, state: BatchState, row: int, value: int) -> floa
 
 
 @njit(**_JIT)
+def _read(
+    settings: Settings, x: float, y: float, heading: float, lx: float, ly: float, reading: float
+) -> float:
+    """The reading of the landmark at (lx, ly) from a pose: NaN (missed) unless the
+    sensor sees it (field of view, range, line of sight)."""
+    if visible(
+        x,
+        y,
+        heading,
+        lx,
+        ly,
+        settings.half_fov,
+        settings.max_range,
+        settings.obstacle_vertices,
+        settings.obstacle_starts,
+    ):
+        return reading
+    return math.nan
+
+
+@njit(**_JIT)
 def move_and_read(
     row: int,
     turn: float,
@@ -124,12 +150,14 @@ def move_and_read(
     reading_start: np.ndarray,
     reading_end: np.ndarray,
 ) -> float:
-    """Turn, read, move straight until the wall margin, read again: one row's movement;
-    returns the distance travelled.
+    """Turn, read, move straight until the wall margin or an obstacle's, read again: one
+    row's movement; returns the distance travelled.
 
     The readings (out in ``reading_start`` and ``reading_end``, (n,)) are the true
     bearings plus the row's next pre-drawn noise values (the first reading's ``n``, then
-    the second's), wrapped. In place: the row's pose, start position, readings, move
+    the second's), wrapped, or NaN for a landmark the sensor does not see (:func:`_read`;
+    the noise values are spent either way, so the stream does not depend on what is
+    seen). In place: the row's pose, start position, readings, move
     count, blocked flag and spent noise. A robot that could not move at least
     ``min_baseline`` does not move (see :func:`~bearing_env.world.straight_move`).
     """
@@ -137,22 +165,23 @@ def move_and_read(
     n = settings.n
     heading = wrap(state.headings[row] + turn)
     x, y = state.positions[row, 0], state.positions[row, 1]
-    new_x, new_y, distance, stopped = straight_move(
+    new_x, new_y, distance, stopped = obstructed_move(
         x,
         y,
         heading,
         length,
-        settings.width,
-        settings.height,
-        settings.margin,
-        settings.min_baseline,
+        (settings.width, settings.height, settings.margin, settings.min_baseline),
+        settings.obstacle_vertices,
+        settings.obstacle_starts,
     )
     first = state.noise_used[row]
     for j in range(n):
         lx, ly = state.landmarks[row, j, 0], state.landmarks[row, j, 1]
         reading = _noisy(bearing(lx, ly, x, y, heading), state, row, first + j)
+        reading = _read(settings, x, y, heading, lx, ly, reading)
         reading_start[j] = state.start_bearings[row, j] = reading
         reading = _noisy(bearing(lx, ly, new_x, new_y, heading), state, row, first + n + j)
+        reading = _read(settings, new_x, new_y, heading, lx, ly, reading)
         reading_end[j] = state.latest_bearings[row, j] = reading
     state.noise_used[row] = first + 2 * n
     state.start_positions[row, 0], state.start_positions[row, 1] = x, y

@@ -23,9 +23,11 @@ from tests.extras import needs
 
 TASK_IDS = [task.id for task in TASKS]
 NAME = re.compile(
-    r"^(?P<kind>BearingSLAM|BearingSLAMDiscrete)-(?P<setting>Khepera|Random(?P<n>\d+))"
-    r"(?:-(?P<fault>Outliers|Missed))?-v\d+$"
+    r"^(?P<kind>BearingSLAM|BearingSLAMDiscrete)"
+    r"-(?P<setting>Khepera|FurnishedRoom|Random(?P<n>\d+))"
+    r"(?:-Camera(?P<camera>\d+))?(?:-(?P<fault>Outliers|Missed))?-v\d+$"
 )
+SCENARIO_OF_SETTING = {"Khepera": "khepera", "FurnishedRoom": "furnished_room"}
 
 
 def test_the_table_and_the_registry_agree() -> None:
@@ -61,7 +63,7 @@ def test_the_id_follows_the_naming_rule(task: Task) -> None:
     )
     config = EnvConfig.create(**task.kwargs())
     if match["n"] is None:
-        assert config.scenario == "khepera"
+        assert config.scenario == SCENARIO_OF_SETTING[match["setting"]]
     else:
         assert config.scenario == "random"
         assert config.landmark_counts == (int(match["n"]), int(match["n"]))
@@ -69,6 +71,9 @@ def test_the_id_follows_the_naming_rule(task: Task) -> None:
     assert (config.noise.outlier_rate > 0) == (fault == "Outliers")
     assert (config.noise.detection_rate < 1) == (fault == "Missed")
     assert (config.fusion == "relaxed") == (fault is not None)
+    camera = match["camera"]
+    assert config.field_of_view_deg == (360.0 if camera is None else float(camera))
+    assert bool(config.obstacles) == (match["setting"] == "FurnishedRoom")
 
 
 @pytest.mark.parametrize("task_id", TASK_IDS)

@@ -77,8 +77,13 @@ def test_quick_single_and_vector(tmp_path: Path, capsys: pytest.CaptureFixture[s
         "random_64",
         "khepera_wrapped",
         "khepera_no_robot_map",
+        "furnished_room",
+        "furnished_room_empty",
+        "khepera_camera90",
     }
     assert single["khepera_no_robot_map"]["env_kwargs"]["robot_map_info"] is False
+    assert positive_finite(single["furnished_room"]["step_cost_ratio"])
+    assert single["furnished_room_empty"]["step_cost_ratio"] is None
     for row in single.values():
         check_figure(row, labels)
     assert single["random_4"]["ratio_to_4_landmarks"] == pytest.approx(1.0)
@@ -216,8 +221,12 @@ def test_cli_bench_runs_bench_env(
         "random_4",
         "khepera_wrapped",
         "khepera_no_robot_map",
+        "furnished_room",
+        "furnished_room_empty",
+        "khepera_camera90",
     ]
-    assert "Targets:" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "Targets:" in out and "furnished room, 4 obstacles" in out
 
 
 @pytest.mark.parametrize("argv", [["bench", "--slam"], ["bench-slam"]])

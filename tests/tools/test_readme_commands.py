@@ -76,6 +76,10 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env bench --sections throughput": ("parse", ()),
     "bearing-env bench --sections slam,planning --seconds 1": ("parse", ()),
     "bearing-env bench --profile vector": ("parse", ()),
+    "bearing-env bench --sections single": ("parse", ()),
+    "bearing-env compare --env bearing_env:BearingSLAM-Khepera-Camera90-v0 --policies random "
+    'parallax greedy "greedy:predict_visibility=False,label=greedy_blind" lookahead '
+    "--episodes 200": ("parse", ()),
     "bearing-env bench --sections single,vector --seconds 1 --num-envs 64 256 --landmarks 4": (
         "parse",
         (),

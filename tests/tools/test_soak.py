@@ -61,3 +61,14 @@ def test_the_soak_refuses_bad_values_in_one_line(argv, named, capsys, tmp_path):
         soak.main([arg.format(a_file=a_file) for arg in argv])
     assert exit_info.value.code == 2
     assert named in capsys.readouterr().err.strip().splitlines()[-1]
+
+
+def test_a_task_soak_runs_that_task_only(capsys):
+    import pytest
+
+    report = soak.run(120, seed=2, episodes=2, task="BearingSLAM-FurnishedRoom-v0")
+    assert report.steps >= 120 and report.defects == 0 and report.containment_checks > 0
+    soak.main(["--steps", "40", "--task", "BearingSLAM-Khepera-Camera90-v0", "--no-progress"])
+    assert "BearingSLAM-Khepera-Camera90-v0" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        soak.main(["--steps", "10", "--task", "Nope-v0"])
