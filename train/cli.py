@@ -14,6 +14,8 @@
     bearing-env suite [...]       the baselines on every registered task, with the task
                                   cards in docs/tasks/ (compare once per task)
     bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
+    bearing-env robust-eval [...]  the robust fusion against the strict one under outliers
+                                  and an underestimated noise bound
     bearing-env generalisation [...]  a policy trained on random layouts, across landmark
                                   counts (train/studies/generalisation.py)
     bearing-env play [...]        move the robot by hand in a pygame window (the render extra)
@@ -91,6 +93,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "figures": (
         "bearing_env.train.studies.figures",
         "reproduce the paper's Figs. 7, 10 and 11 in simulation",
+    ),
+    "robust-eval": (
+        "bearing_env.train.studies.robust_eval",
+        "the robust fusion against the strict one: containment, area and step time",
     ),
     "generalisation": (
         "bearing_env.train.studies.generalisation",

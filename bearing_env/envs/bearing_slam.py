@@ -309,7 +309,16 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
       (default; the paper's intersection) or `"relaxed"` (the q-relaxed intersection
       over a window of the last 8 movements: it leaves out up to `max_outliers` regions
       per landmark, and whole movements that are outliers for most landmarks, as a
-      misread L1 or L2 makes them; see `bearing_env.slam.PolygonSLAM`).
+      misread L1 or L2 makes them; see `bearing_env.slam.PolygonSLAM`), or `"robust"`
+      (the relaxed intersection of all of a landmark's regions, leaving out as many as
+      the contamination rate estimated from the contradictions seen asks for `risk`;
+      on clean data it is the intersection exactly; see docs/world_model.md).
+    - `risk`: with `"robust"`, the target chance that more of a landmark's regions are
+      contaminated than its reported set leaves out, in (0, 0.5]; default 0.05.
+    - `robust_set`: with `"robust"`, the set the map reports, and so the observation
+      and the reward use: `"guaranteed"` (default; leaves out enough regions for
+      `risk`) or `"likely"` (leaves out only the regions that contradict the others:
+      smaller, and more often wrong).
     - `max_outliers`: with `"relaxed"`, the most regions per landmark left out, 0..7;
       default 2.
     - `on_inconsistency`: `"restart"` (default: a landmark whose regions contradict

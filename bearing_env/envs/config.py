@@ -13,7 +13,7 @@ group           class                      fields
 ``layout``      :class:`LayoutSettings`    scenario, landmark_counts, landmarks, arena,
                                            obstacles
 ``sensor``      :class:`SensorSettings`    epsilon_deg, noise, field_of_view_deg, max_range
-``mapping``     :class:`MappingSettings`   transfer, fusion, max_outliers, on_inconsistency
+``mapping``     :class:`MappingSettings`   transfer, fusion, max_outliers, on_inconsistency, ...
 ``task``        :class:`TaskSettings`      reward, target_area, max_moves, path_cost, ...
 ``actions``     :class:`ActionSettings`    move_length, n_turns, n_move_lengths
 ``observations``:class:`ObservationSettings` max_landmarks, observation, robot_map_info,
@@ -68,7 +68,12 @@ from numpy.typing import ArrayLike, NDArray
 from bearing_env.obstacles import Obstacle, parse_obstacles
 from bearing_env.sensing import clearance, pack_polygons
 from bearing_env.slam import FUSIONS, INCONSISTENCY_POLICIES, TRANSFERS, MapSettings
-from bearing_env.slam.settings import DEFAULT_MAX_OUTLIERS, DEFAULT_WINDOW
+from bearing_env.slam.settings import (
+    DEFAULT_MAX_OUTLIERS,
+    DEFAULT_RISK,
+    DEFAULT_WINDOW,
+    ROBUST_SETS,
+)
 from bearing_env.validation import (
     EPSILON_RANGE,
     choice,
@@ -369,6 +374,8 @@ class MappingSettings(SettingsGroup):
     fusion: str = setting("intersect")
     max_outliers: int = setting(DEFAULT_MAX_OUTLIERS)
     on_inconsistency: str = setting("restart")
+    risk: float = setting(DEFAULT_RISK)
+    robust_set: str = setting("guaranteed")
 
     def __post_init__(self) -> None:
         choice(self.transfer, TRANSFERS, "transfer")
@@ -378,6 +385,8 @@ class MappingSettings(SettingsGroup):
             self, "max_outliers", int_at_most(max_outliers, DEFAULT_WINDOW - 1, "max_outliers")
         )
         choice(self.on_inconsistency, INCONSISTENCY_POLICIES, "on_inconsistency")
+        _normalise(self, "risk", float_in(self.risk, "risk", 0.0, 0.5, closed_low=False))
+        choice(self.robust_set, ROBUST_SETS, "robust_set")
 
     def map_settings(self, epsilon: float) -> MapSettings:
         """The world model's settings with the bound ``epsilon`` (radians)."""

@@ -47,7 +47,6 @@ from bearing_env.slam import kernels as slam_kernels
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
     PARALLEL_MIN_MAPS,
-    STATE_ARRAYS,
     BatchedPolygonSLAM,
 )
 from bearing_env.world import (
@@ -436,15 +435,19 @@ def report(state: BatchState, group: Group) -> tuple[kernels.Report, dict[str, A
 
 def _robot_map(group: Group, encoded: tuple[Any, ...] | None) -> dict[str, Any] | None:
     """The ``robot_map`` info from the kernel's encoded arrays, with the relaxed fusion's
-    window and bases (one more compiled call); None when the setting is off."""
+    window and bases or the robust fusion's levels (one more compiled call); None when
+    the setting is off."""
     if encoded is None or not group.config.observations.robot_map_info:
         return None
     batch = group.batch
-    if batch.fusion != "relaxed":
-        return robot_map.as_info(robot_map.MAP_ARRAYS, encoded)
     slots = max(group.config.observations.max_landmarks - 2, group.n - 2)
-    encoded += robot_map.encode_window(batch._kernel_state(), group.rows, slots)
-    return robot_map.as_info(STATE_ARRAYS, encoded)
+    if batch.fusion == "relaxed":
+        encoded += robot_map.encode_window(batch._kernel_state(), group.rows, slots)
+    elif batch.fusion == "robust":
+        encoded += robot_map.encode_levels(batch._kernel_state(), group.rows, slots)
+    else:
+        return robot_map.as_info(robot_map.MAP_ARRAYS, encoded)
+    return robot_map.as_info(batch.state_names, encoded)
 
 
 # ----------------------------------------------------------------------------------------

@@ -41,8 +41,9 @@ KEY = "robot_map"
 #: compiled encoding (:func:`encode_map`, :func:`encode_window`) writes them.
 PADDING: dict[str, Any] = {"areas": np.inf, "centroids": complex(np.inf, np.inf)}
 #: The arrays every fusion uses, as :func:`encode_map` gives them (the relaxed fusion's
-#: are these, then :data:`~bearing_env.slam.batch.RELAXED_STATE_ARRAYS`).
-MAP_ARRAYS: tuple[str, ...] = STATE_ARRAYS[: len(STATE_ARRAYS) - len(RELAXED_STATE_ARRAYS)]
+#: are these, then :data:`~bearing_env.slam.batch.RELAXED_STATE_ARRAYS`; the robust
+#: fusion's, these, then :data:`~bearing_env.slam.batch.ROBUST_STATE_ARRAYS`).
+MAP_ARRAYS: tuple[str, ...] = STATE_ARRAYS[: STATE_ARRAYS.index(RELAXED_STATE_ARRAYS[0])]
 #: The arrays whose unknown values (NaN in the map) are inf in an info.
 UNKNOWN_AS_INF: tuple[str, ...] = ("centroids", "robot_centroid", "robot_heading")
 
@@ -58,13 +59,16 @@ def encode(batch: BatchedPolygonSLAM, rows: NDArray[np.int64], slots: int) -> di
     arrays = encode_map(state, rows, slots)
     if batch.fusion == "relaxed":
         arrays += encode_window(state, rows, slots)
+    elif batch.fusion == "robust":
+        arrays += encode_levels(state, rows, slots)
     return as_info(batch.state_names, arrays)
 
 
 def as_info(names: tuple[str, ...], arrays: tuple[NDArray[Any], ...]) -> dict[str, Any]:
     """The info's dict of encoded ``arrays`` (:func:`encode_map`'s, then, for the relaxed
-    fusion, :func:`encode_window`'s), named ``names``: complex points become (x, y)
-    pairs on a last axis (views, not copies)."""
+    fusion, :func:`encode_window`'s, or for the robust fusion, :func:`encode_levels`'s),
+    named ``names``: complex points become (x, y) pairs on a last axis (views, not
+    copies)."""
     return {
         name: values.view(np.float64).reshape(*values.shape, 2)
         if values.dtype.kind == "c"
@@ -177,6 +181,29 @@ def encode_window(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover
         n_dropped,
         outliers,
     )
+
+
+@njit(**JIT_OPTIONS)
+def encode_levels(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
+    """The robust fusion's arrays (``ROBUST_STATE_ARRAYS``), as :func:`_encode_map`."""
+    size, mapped = rows.size, state.counts.shape[1]
+    levels, capacity = state.level_vertices.shape[2], state.level_vertices.shape[3]
+    outliers = np.zeros((size, slots), np.int64)
+    level_vertices = np.zeros((size, slots, levels, capacity), np.complex128)
+    level_counts = np.zeros((size, slots, levels), np.int64)
+    n_regions = np.zeros((size, slots), np.int64)
+    robot_fixed_at = np.empty(size, np.int64)
+    for i in range(size):
+        row = rows[i]
+        robot_fixed_at[i] = state.robot_fixed_at[row]
+        for j in range(mapped):
+            outliers[i, j] = state.outliers[row, j]
+            n_regions[i, j] = state.n_regions[row, j]
+            for k in range(levels):
+                count = state.level_counts[row, j, k]
+                level_counts[i, j, k] = count
+                level_vertices[i, j, k, :count] = state.level_vertices[row, j, k, :count]
+    return outliers, level_vertices, level_counts, n_regions, robot_fixed_at
 
 
 def decode(data: Mapping[str, Any], n_landmarks: int, settings: MapSettings) -> PolygonSLAM:

@@ -28,6 +28,7 @@ from bearing_env.slam import kernels
 from bearing_env.slam.compile_notice import announce_compile_once
 from bearing_env.slam.settings import (
     DEFAULT_MAX_OUTLIERS,
+    DEFAULT_RISK,
     DEFAULT_WINDOW,
     FUSIONS,
     INCONSISTENCY_POLICIES,
@@ -126,6 +127,8 @@ class BatchedPolygonSLAM(HasMapSettings):
         fusion: str = "intersect",
         max_outliers: int = DEFAULT_MAX_OUTLIERS,
         window: int = DEFAULT_WINDOW,
+        risk: float = DEFAULT_RISK,
+        robust_set: str = "guaranteed",
     ) -> None:
         self.num_maps = int_at_least(num_maps, 1, "num_maps")
         self.n_landmarks = int_at_least(n_landmarks, 3, "n_landmarks", "(L1, L2 and one more)")
@@ -138,6 +141,8 @@ class BatchedPolygonSLAM(HasMapSettings):
             fusion=fusion,
             max_outliers=max_outliers,
             window=window,
+            risk=risk,
+            robust_set=robust_set,
         )
         n, m, cap = self.num_maps, self.n_landmarks - 2, kernels.CAPACITY
         self.vertices = np.zeros((n, m, cap), dtype=np.complex128)
@@ -164,6 +169,12 @@ class BatchedPolygonSLAM(HasMapSettings):
         self.base_counts = np.zeros((n, m), dtype=np.int64)
         self.n_dropped = np.zeros((n, m), dtype=np.int64)
         self.outliers = np.zeros((n, m), dtype=np.int64)
+        # The robust fusion's nested levels (none unless "robust").
+        levels = kernels.ROBUST_LEVELS if self.fusion == "robust" else 0
+        self.level_vertices = np.zeros((n, m, levels, cap), dtype=np.complex128)
+        self.level_counts = np.zeros((n, m, levels), dtype=np.int64)
+        self.n_regions = np.zeros((n, m), dtype=np.int64)
+        self.robot_fixed_at = np.zeros(n, dtype=np.int64)
         self._state_ref: kernels.State | None = None
         announce_compile_once()
         self.reset()
@@ -210,6 +221,9 @@ class BatchedPolygonSLAM(HasMapSettings):
         self.base_counts[rows] = 0
         self.n_dropped[rows] = 0
         self.outliers[rows] = 0
+        self.level_counts[rows] = 0
+        self.n_regions[rows] = 0
+        self.robot_fixed_at[rows] = 0
 
     def update(
         self,
@@ -335,11 +349,20 @@ class BatchedPolygonSLAM(HasMapSettings):
 
     @property
     def state_names(self) -> tuple[str, ...]:
-        """The state arrays this batch's fusion uses: :data:`STATE_ARRAYS`, less the relaxed
-        fusion's window and bases under ``"intersect"`` (which never reads them)."""
+        """The state arrays this batch's fusion uses: those of every fusion, then the
+        relaxed fusion's window and bases (:data:`RELAXED_STATE_ARRAYS`) under
+        ``"relaxed"``, or the robust fusion's levels (:data:`ROBUST_STATE_ARRAYS`) under
+        ``"robust"``."""
+        common = tuple(
+            name
+            for name in STATE_ARRAYS
+            if name not in RELAXED_STATE_ARRAYS and name not in ROBUST_STATE_ARRAYS
+        )
         if self.fusion == "relaxed":
-            return STATE_ARRAYS
-        return tuple(name for name in STATE_ARRAYS if name not in RELAXED_STATE_ARRAYS)
+            return common + RELAXED_STATE_ARRAYS
+        if self.fusion == "robust":
+            return common + ROBUST_STATE_ARRAYS
+        return common
 
     def _kernel_state(self) -> kernels.State:
         """The state as the kernels take it: a :class:`kernels.StateRef` to this batch's
@@ -364,7 +387,11 @@ class BatchedPolygonSLAM(HasMapSettings):
                 FUSIONS.index(self.fusion),
                 self.max_outliers,
             )
-            both = (kernels.Params(*settings, False), kernels.Params(*settings, True))
+            robust = (self.risk, self.robust_set == "likely")
+            both = (
+                kernels.Params(*settings, False, *robust),
+                kernels.Params(*settings, True, *robust),
+            )
             self._params = both
         return both[with_robot]
 
@@ -421,7 +448,12 @@ STATE_ARRAYS: tuple[str, ...] = kernels.State._fields
 
 
 #: The part of the state only the relaxed fusion uses (its window and bases).
-RELAXED_STATE_ARRAYS = STATE_ARRAYS[STATE_ARRAYS.index("window_vertices") :]
+RELAXED_STATE_ARRAYS = STATE_ARRAYS[
+    STATE_ARRAYS.index("window_vertices") : STATE_ARRAYS.index("outliers") + 1
+]
+#: The part of the state the robust fusion uses besides every fusion's: the regions each
+#: landmark leaves out (``outliers``, shared with the relaxed fusion) and its levels.
+ROBUST_STATE_ARRAYS = ("outliers", *STATE_ARRAYS[STATE_ARRAYS.index("level_vertices") :])
 
 #: The state arrays with a landmark axis, and which axis it is (the map axis is 0): what
 #: pads or trims a map's state to a number of landmark slots.
@@ -437,6 +469,9 @@ LANDMARK_AXES: dict[str, int] = {
     "base_counts": 1,
     "n_dropped": 1,
     "outliers": 1,
+    "level_vertices": 1,
+    "level_counts": 1,
+    "n_regions": 1,
 }
 
 #: The vertex arrays of the state and the arrays counting their used vertices.
@@ -445,6 +480,7 @@ VERTEX_COUNTS: dict[str, str] = {
     "robot_vertices": "robot_counts",
     "window_vertices": "window_counts",
     "base_vertices": "base_counts",
+    "level_vertices": "level_counts",
 }
 
 

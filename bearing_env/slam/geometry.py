@@ -29,6 +29,7 @@ __all__ = [
     "intersect",
     "offset_outward",
     "relaxed_intersection",
+    "robust_levels",
     "wrap_angle",
 ]
 
@@ -107,6 +108,29 @@ def relaxed_intersection(
     scratch.slots[:k] = np.arange(k)
     n, q = kernels.relaxed_region(maps._kernel_state(), 0, 0, k, False, int(max_outliers), scratch)
     return scratch.acc[:n].copy(), int(q), maps.window_inlier[0, :, 0].copy()
+
+
+def robust_levels(polygons: list[ArrayLike]) -> list[ComplexArray]:
+    """The robust fusion's nested sets of one landmark's regions ``polygons`` (convex,
+    CCW), fused in order: level ``k`` is a convex superset of the points in all of them
+    but at most ``k`` (see :mod:`bearing_env.slam.kernels.robust`), for ``k`` below
+    ``min(len(polygons), ROBUST_LEVELS)``; an empty array where that set is empty."""
+    if not polygons:
+        raise ValueError("robust_levels needs at least one polygon, got none")
+    maps = BatchedPolygonSLAM(1, 3, 0.1, fusion="robust")
+    state, scratch = maps._kernel_state(), kernels.new_scratch()
+    for i, polygon in enumerate(polygons):
+        vertices = _polygon(polygon)
+        if not 3 <= vertices.size <= kernels.CAPACITY:
+            raise ValueError(
+                f"polygon {i} must have 3..{kernels.CAPACITY} vertices, got {vertices.size}"
+            )
+        scratch.fresh[: vertices.size] = vertices
+        kernels.update_levels(state, 0, 0, vertices.size, scratch)
+    levels = min(len(polygons), kernels.ROBUST_LEVELS)
+    return [
+        maps.level_vertices[0, 0, k, : maps.level_counts[0, 0, k]].copy() for k in range(levels)
+    ]
 
 
 def _polygon(points: ArrayLike) -> ComplexArray:

@@ -19,6 +19,7 @@ from bearing_env.slam.batch import (
 )
 from bearing_env.slam.settings import (
     DEFAULT_MAX_OUTLIERS,
+    DEFAULT_RISK,
     DEFAULT_WINDOW,
     FUSIONS,
     INCONSISTENCY_POLICIES,
@@ -151,10 +152,21 @@ class PolygonSLAM(HasMapSettings):
             last ``window`` movements (plus the intersection of the older regions it
             kept), which leaves out up to ``max_outliers`` regions per landmark, and
             whole movements that are outliers for most landmarks (a misread L1 or L2).
-            See :func:`bearing_env.slam.kernels.relaxed_movement`.
+            See :func:`bearing_env.slam.kernels.relaxed_movement`. Or ``"robust"``:
+            the relaxed intersection of all of a landmark's regions, leaving out as many
+            as a risk target asks (see ``risk``).
         max_outliers: with ``fusion="relaxed"``, the most regions per landmark that the
             window may leave out (0 <= max_outliers < window).
         window: with ``fusion="relaxed"``, the movements kept per map, 1..32.
+        risk: with ``fusion="robust"``, the target chance, under the map's estimated
+            contamination rate, that more of a landmark's regions are contaminated than
+            its guaranteed set leaves out, in (0, 0.5]. See
+            :mod:`bearing_env.slam.kernels.robust`; ``fusion="robust"`` ignores
+            ``max_outliers`` and ``window`` (it leaves out at most ``ROBUST_LEVELS - 1``
+            regions of the whole history).
+        robust_set: with ``fusion="robust"``, the set the map reports: ``"guaranteed"``
+            (leaves out enough regions for ``risk``) or ``"likely"`` (only those that
+            contradict the others).
 
     These are the fields of :class:`~bearing_env.slam.settings.MapSettings`, which
     validates them (the map's :attr:`settings`); :meth:`from_settings` takes one whole.
@@ -173,6 +185,8 @@ class PolygonSLAM(HasMapSettings):
         fusion: str = "intersect",
         max_outliers: int = DEFAULT_MAX_OUTLIERS,
         window: int = DEFAULT_WINDOW,
+        risk: float = DEFAULT_RISK,
+        robust_set: str = "guaranteed",
     ) -> None:
         self._batch = BatchedPolygonSLAM(
             1,
@@ -184,6 +198,8 @@ class PolygonSLAM(HasMapSettings):
             fusion=fusion,
             max_outliers=max_outliers,
             window=window,
+            risk=risk,
+            robust_set=robust_set,
         )
         self._attach(self._batch, 0)
 

@@ -14,14 +14,20 @@ from dataclasses import dataclass
 
 from bearing_env.slam import kernels
 from bearing_env.slam.transfer import TRANSFERS
-from bearing_env.validation import epsilon_radians, int_at_least
+from bearing_env.validation import epsilon_radians, float_in, int_at_least
 
 #: What a landmark's region becomes when a movement's region misses it.
 INCONSISTENCY_POLICIES = ("restart", "keep")
 
 #: How a landmark's regions from successive movements are combined: ``"intersect"``, the
-#: paper's intersection, or ``"relaxed"``, the q-relaxed intersection over a window.
-FUSIONS = ("intersect", "relaxed")
+#: paper's intersection, ``"relaxed"``, the q-relaxed intersection over a window, or
+#: ``"robust"``, nested relaxed sets with the number left out from a risk target.
+FUSIONS = ("intersect", "relaxed", "robust")
+
+#: Which of the robust fusion's two sets a map reports: the ``"guaranteed"`` one (enough
+#: regions left out for the risk target) or the ``"likely"`` one (only the
+#: contradicting regions left out).
+ROBUST_SETS = ("guaranteed", "likely")
 
 # The kernels take the transfer, the policy and the fusion as indices into these tuples.
 if (
@@ -31,6 +37,7 @@ if (
     or INCONSISTENCY_POLICIES.index("keep") != kernels.INCONSISTENCY_KEEP
     or FUSIONS.index("intersect") != kernels.FUSION_INTERSECT
     or FUSIONS.index("relaxed") != kernels.FUSION_RELAXED
+    or FUSIONS.index("robust") != kernels.FUSION_ROBUST
 ):
     raise ImportError("the kernels' transfer, policy or fusion codes disagree with the names")
 
@@ -38,6 +45,9 @@ if (
 #: landmark it may leave out of the window.
 DEFAULT_WINDOW = 8
 DEFAULT_MAX_OUTLIERS = 2
+#: The robust fusion's default risk: the chance, under the estimated contamination rate,
+#: that more of a landmark's regions are contaminated than its guaranteed set leaves out.
+DEFAULT_RISK = 0.05
 
 
 @dataclass(frozen=True)
@@ -56,6 +66,8 @@ class MapSettings:
     fusion: str = "intersect"
     max_outliers: int = DEFAULT_MAX_OUTLIERS
     window: int = DEFAULT_WINDOW
+    risk: float = DEFAULT_RISK
+    robust_set: str = "guaranteed"
 
     def __post_init__(self) -> None:
         def normalise(name: str, value: object) -> None:
@@ -85,6 +97,9 @@ class MapSettings:
         if max_outliers >= window:
             raise ValueError(f"max_outliers must be < window ({window}), got {self.max_outliers!r}")
         normalise("max_outliers", max_outliers)
+        normalise("risk", float_in(self.risk, "risk", 0.0, 0.5, closed_low=False))
+        if self.robust_set not in ROBUST_SETS:
+            raise ValueError(f"robust_set must be one of {ROBUST_SETS}, got {self.robust_set!r}")
 
 
 class HasMapSettings:
@@ -120,3 +135,11 @@ class HasMapSettings:
     @property
     def window(self) -> int:
         return self.settings.window
+
+    @property
+    def risk(self) -> float:
+        return self.settings.risk
+
+    @property
+    def robust_set(self) -> str:
+        return self.settings.robust_set

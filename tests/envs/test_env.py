@@ -30,7 +30,7 @@ from bearing_env.envs.bearing_slam import (
     observation_slices,
 )
 from bearing_env.registration import register_envs
-from bearing_env.slam.batch import RELAXED_STATE_ARRAYS, STATE_ARRAYS
+from bearing_env.slam.batch import RELAXED_STATE_ARRAYS, ROBUST_STATE_ARRAYS, STATE_ARRAYS
 from bearing_env.tasks import TASKS_BY_ID
 from tests.extras import needs
 
@@ -308,8 +308,10 @@ def test_info_keys_and_shapes() -> None:
         assert 0.0 <= info["path_length"] <= env.move_length[1]
         assert reward == pytest.approx(sum(info["rewards"].values()))
         assert info["robot_map"]["vertices"].shape[:-2] == info["robot_map"]["counts"].shape
-        # The strict map carries no relaxed-fusion window (its info has only what it uses).
-        assert set(info["robot_map"]) == set(STATE_ARRAYS) - set(RELAXED_STATE_ARRAYS)
+        # The strict map carries no relaxed-fusion window and no robust-fusion levels (its
+        # info has only what it uses).
+        fused_only = set(RELAXED_STATE_ARRAYS) | set(ROBUST_STATE_ARRAYS)
+        assert set(info["robot_map"]) == set(STATE_ARRAYS) - fused_only
         # Not initialised <=> infinite area <=> infinite error.
         assert np.array_equal(np.isinf(info["landmark_area"]), np.isinf(info["landmark_error"]))
 

@@ -153,6 +153,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env compare --policies greedy oracle lookahead lookahead_oracle --episodes 200 "
     "--workers 2 --out outputs/compare_lookahead": ("parse", ()),
     "bearing-env figures --only robust --out docs/figures": ("parse", ()),
+    "bearing-env robust-eval": ("parse", ()),
     "bearing-env compare --episodes 200 --executor ray": ("parse", ()),
     "bearing-env compare --episodes 2000 --executor ray --ray-address auto "
     "--out outputs/compare_2000": ("parse", ()),
@@ -267,6 +268,10 @@ def _parse(argv: list[str]) -> None:
         from bearing_env.train.studies import figures
 
         figures.build_parser().parse_args(arguments)
+    elif command == "robust-eval":
+        from bearing_env.train.studies import robust_eval
+
+        robust_eval.build_parser().parse_args(arguments)
     elif command == "bench":
         from bearing_env.benchmarks import bench_env
 

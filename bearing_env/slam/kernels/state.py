@@ -4,7 +4,7 @@
   Its field list is the only place the state is listed;
   ``bearing_env.slam.batch.STATE_ARRAYS`` is ``State._fields``. The kernels receive it
   as a :class:`StateRef` (a numba ``structref`` holding the same arrays): a batch builds
-  its reference once and passes it on every call. A namedtuple of the 22 arrays was
+  its reference once and passes it on every call. A namedtuple of the (then) 22 arrays was
   measured to cost about 4.5 us more per call than the structref (numba types each
   field of a namedtuple argument in Python on every call; a structref is typed once),
   about a sixth of a 4-landmark update.
@@ -36,6 +36,7 @@ INCONSISTENCY_KEEP = 1
 #: Fusion codes: indices into ``batch.FUSIONS``.
 FUSION_INTERSECT = 0
 FUSION_RELAXED = 1
+FUSION_ROBUST = 2
 
 ComplexArray = NDArray[np.complex128]
 IntArray = NDArray[np.int64]
@@ -69,6 +70,10 @@ class State(NamedTuple):
     base_counts: IntArray  #: (maps, m)
     n_dropped: IntArray  #: (maps, m) regions left out for good
     outliers: IntArray  #: (maps, m) regions left out, window included
+    level_vertices: ComplexArray  #: (maps, m, levels, CAPACITY) the robust fusion's levels
+    level_counts: IntArray  #: (maps, m, levels) (levels: 0 unless ``"robust"``)
+    n_regions: IntArray  #: (maps, m) regions fused into the robust levels
+    robot_fixed_at: IntArray  #: (maps,) the movement (``n_updates``) that set the robot region
 
 
 @structref.register
@@ -105,9 +110,11 @@ class Params(NamedTuple):
     transfer: int  #: TRANSFER_CONSERVATIVE or TRANSFER_PAPER
     edge_samples: int  #: samples per edge of A_L1 and A_L2 (conservative transfer)
     on_inconsistency: int  #: INCONSISTENCY_RESTART or INCONSISTENCY_KEEP
-    fusion: int  #: FUSION_INTERSECT or FUSION_RELAXED
+    fusion: int  #: FUSION_INTERSECT, FUSION_RELAXED or FUSION_ROBUST
     max_outliers: int  #: relaxed fusion: most regions left out per landmark
     with_robot: bool  #: also transfer the robot's position
+    risk: float  #: robust fusion: the binomial tail the reported level leaves
+    likely: bool  #: robust fusion: report the likely set, not the guaranteed one
 
 
 class Outputs(NamedTuple):

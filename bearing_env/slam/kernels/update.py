@@ -44,8 +44,14 @@ from bearing_env.slam.kernels.polygons import (
     area_centroid,
     contains_point,
 )
+from bearing_env.slam.kernels.robust import (
+    contamination,
+    frame_contradicts_robot,
+    robust_landmark,
+)
 from bearing_env.slam.kernels.state import (
     FUSION_RELAXED,
+    FUSION_ROBUST,
     INCONSISTENCY_KEEP,
     TRANSFER_CONSERVATIVE,
     Outputs,
@@ -165,6 +171,7 @@ def _update_rows(
     """:func:`update_maps` for bearings rows ``first`` to ``stop``, with scratch of its own."""
     n_landmarks = bearings_start.shape[1]
     relaxed = params.fusion == FUSION_RELAXED
+    robust = params.fusion == FUSION_ROBUST
     keep = params.on_inconsistency == INCONSISTENCY_KEEP
     frame_status, landmark_status = out.frame_status, out.landmark_status
     fresh_counts = np.zeros(n_landmarks, dtype=np.int64)
@@ -193,7 +200,12 @@ def _update_rows(
             continue
         if relaxed:
             newest = _open_window_slot(state, row, scratch)
-        for j in range(2, n_landmarks):
+        rate = contamination(state, row) if robust else 0.0
+        last = n_landmarks
+        if robust and params.with_robot and frame_contradicts_robot(state, row, frame, scratch):
+            frame_status[i] = FRAME_REJECTED  # a misread L1 or L2: no landmark is fused
+            last = 2
+        for j in range(2, last):
             slot = j - 2
             fresh_counts[slot] = 0
             if fr_status[j] == FR_MISSING:
@@ -216,6 +228,9 @@ def _update_rows(
                 _copy_polygon(scratch.fresh, n_new, state.window_vertices[row, newest, slot])
                 state.window_counts[row, newest, slot] = n_new
                 fresh_counts[slot] = n_new
+            elif robust:
+                if not robust_landmark(state, row, slot, n_new, rate, params, scratch):
+                    landmark_status[i, slot] = LANDMARK_INCONSISTENT
             elif not intersect_landmark(state, row, slot, n_new, keep, scratch):
                 landmark_status[i, slot] = LANDMARK_INCONSISTENT
         if relaxed and relaxed_movement(state, row, fresh_counts, params, out, i, scratch):
@@ -236,6 +251,7 @@ def _update_rows(
             state.robot_heading[row] = np.nan
             continue
         _transfer_robot(state, row, frame, scratch, robot_point)
+        state.robot_fixed_at[row] = state.n_updates[row]
 
 
 @njit(**_JIT)

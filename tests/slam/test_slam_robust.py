@@ -1,0 +1,234 @@
+"""The robust fusion (``fusion="robust"``): its nested levels against a brute force, its
+binomial rule against the exact tail, the strict intersection bit for bit on clean data,
+containment under outliers, and its settings' errors."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import pickle
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+from bearing_env.slam import MapSettings, PolygonSLAM, kernels
+from bearing_env.slam.geometry import robust_levels
+from tests.slam.test_slam_relaxed import (
+    EPS,
+    assert_same_result,
+    convex_polygon,
+    polygon_angles,
+    run_with_outlier,
+    shapely_polygon,
+)
+from tests.slam_sim import random_episode
+
+
+def exact_relaxed_set(polygons: list[np.ndarray], left_out: int) -> shapely.Geometry | None:
+    """The points in all of ``polygons`` but at most ``left_out``, by shapely: the
+    pieces with area (the kernels call an intersection with no area empty); None when
+    GEOS cannot union them (pieces within rounding of each other's edges)."""
+    shapes = [shapely_polygon(p) for p in polygons]
+    pieces = []
+    for kept in itertools.combinations(range(len(shapes)), len(shapes) - left_out):
+        piece = shapes[kept[0]]
+        for i in kept[1:]:
+            piece = piece.intersection(shapes[i])
+        if piece.area > 1e-9:
+            pieces.append(piece)
+    try:
+        return shapely.union_all(pieces) if pieces else shapely.Polygon()
+    except shapely.errors.GEOSException:
+        return None
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(
+    centers=st.lists(st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0)), min_size=1, max_size=7),
+    radii=st.lists(st.floats(0.3, 1.5), min_size=7, max_size=7),
+    angles=st.lists(polygon_angles, min_size=7, max_size=7),
+)
+def test_levels_are_nested_supersets_of_the_relaxed_sets(
+    centers: list[tuple[float, float]], radii: list[float], angles: list[list[float]]
+) -> None:
+    polygons = [
+        convex_polygon(complex(x, y), radii[i], angles[i]) for i, (x, y) in enumerate(centers)
+    ]
+    levels = robust_levels(polygons)
+    assert len(levels) == min(len(polygons), kernels.ROBUST_LEVELS)
+    previous = None
+    for k, level in enumerate(levels):
+        exact = exact_relaxed_set(polygons, k)
+        assume(exact is not None)
+        assert exact is not None
+        if level.size == 0:
+            assert exact.area < 1e-9
+            continue
+        hull = shapely_polygon(level).buffer(1e-8)
+        assert exact.is_empty or hull.contains(exact)  # shapely: nothing contains empty
+        if k == 0:  # the strict intersection itself
+            area = shapely_polygon(level).area
+            assert area == pytest.approx(exact.area, rel=1e-6, abs=1e-8)
+        if previous is not None:
+            assert hull.contains(previous)
+        previous = shapely_polygon(level)
+
+
+@settings(max_examples=200, deadline=None, derandomize=True)
+@given(
+    n=st.integers(0, 40),
+    p=st.floats(0.0, 0.9),
+    risk=st.floats(1e-4, 0.5),
+    q_cap=st.integers(0, 10),
+)
+def test_binomial_rule_is_the_smallest_q_under_the_risk(
+    n: int, p: float, risk: float, q_cap: int
+) -> None:
+    def tail(q: int) -> float:  # P(Bin(n, p) > q), exactly
+        return sum(math.comb(n, x) * p**x * (1 - p) ** (n - x) for x in range(q + 1, n + 1))
+
+    q = kernels.binomial_q(n, p, risk, q_cap)
+    assert 0 <= q <= q_cap
+    if q < q_cap:
+        assert tail(q) < risk + 1e-9
+    if q > 0:
+        assert tail(q - 1) >= risk - 1e-9
+
+
+def test_clean_data_gives_the_strict_intersection_exactly() -> None:
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        episode = random_episode(rng, 6, 14)
+        strict = PolygonSLAM(6, EPS)
+        robust = PolygonSLAM(6, EPS, fusion="robust")
+        for b1, b2 in episode.readings(EPS):
+            expected = strict.update(b1, b2)
+            assert_same_result(robust.update(b1, b2), expected)
+            np.testing.assert_array_equal(robust.areas, strict.areas)
+            for mine, theirs in zip(robust.polygons, strict.polygons, strict=True):
+                np.testing.assert_array_equal(mine, theirs)  # type: ignore[arg-type]
+        assert robust.outliers.tolist() == [0, 0, 0, 0]
+
+
+def test_noise_within_epsilon_is_always_contained() -> None:
+    rng = np.random.default_rng(6)
+    for _ in range(15):
+        episode = random_episode(rng, 5, 12, noise="extreme")
+        slam = PolygonSLAM(5, EPS, fusion="robust", robust_set="guaranteed")
+        for b1, b2 in episode.readings(EPS):
+            slam.update(b1, b2)
+        inside = slam.contains(episode.truth_fl())
+        assert inside[slam.initialised].all()
+
+
+def outlier_episode_contains(robust_set: str, seed: int) -> tuple[int, int]:
+    """Regions holding the truth and regions, over a few seeded episodes with 10% of the
+    readings replaced by random bearings."""
+    rng = np.random.default_rng(seed)
+    held = total = 0
+    for _ in range(12):
+        episode = random_episode(rng, 6, 16)
+        slam = PolygonSLAM(6, EPS, fusion="robust", robust_set=robust_set)
+        for b1, b2 in episode.readings(EPS):
+            for bearings in (b1, b2):
+                misread = rng.random(bearings.shape) < 0.1
+                bearings[misread] = rng.uniform(-np.pi, np.pi, misread.sum())
+            slam.update(b1, b2)
+        inside = slam.contains(episode.truth_fl())
+        total += int(slam.initialised.sum())
+        held += int(inside[slam.initialised].sum())
+    return held, total
+
+
+def test_the_guaranteed_set_holds_the_truth_more_often_than_the_likely_set() -> None:
+    guaranteed, total = outlier_episode_contains("guaranteed", 7)
+    likely, total_likely = outlier_episode_contains("likely", 7)
+    assert total == total_likely > 0
+    assert guaranteed > likely
+    assert guaranteed >= 0.9 * total
+
+
+def test_a_misread_frame_landmark_is_caught_by_the_robot_region() -> None:
+    robust, statuses, truth = run_with_outlier("robust", 1, 0.6)
+    assert statuses[6] == "rejected"  # its start misses where the last move ended
+    assert statuses.count("rejected") == 1
+    assert robust.contains(truth).all()
+    assert robust.outliers.tolist() == [0, 0, 0, 0]  # nothing of it was fused
+
+
+def test_a_misread_landmark_is_left_out_for_that_landmark_only() -> None:
+    robust, statuses, truth = run_with_outlier("robust", 3, 0.3)
+    assert "rejected" not in statuses
+    assert robust.contains(truth).all()
+    assert robust.outliers.tolist() == [0, 1, 0, 0]
+
+
+def test_the_robust_state_survives_copies_and_pickles() -> None:
+    episode = random_episode(np.random.default_rng(2), 5, 12)
+    readings = episode.readings(EPS)
+    readings[3][0][2] += 1.0  # one outlier, so that the levels differ
+    slam = PolygonSLAM(5, EPS, fusion="robust")
+    for b1, b2 in readings[:9]:
+        slam.update(b1, b2)
+    copies = [slam.copy(), pickle.loads(pickle.dumps(slam))]
+    for b1, b2 in readings[9:]:
+        expected = slam.update(b1, b2)
+        for other in copies:
+            assert_same_result(other.update(b1, b2), expected)
+            np.testing.assert_array_equal(other.areas, slam.areas)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "match"),
+    [
+        ({"fusion": "robust", "risk": 0.0}, ValueError, r"risk must be in \(0, 0.5\], got 0.0"),
+        ({"fusion": "robust", "risk": 0.7}, ValueError, r"risk must be in \(0, 0.5\], got 0.7"),
+        ({"fusion": "robust", "risk": "low"}, TypeError, "risk must be a number, got 'low'"),
+        ({"robust_set": "best"}, ValueError, "robust_set must be one of .* got 'best'"),
+    ],
+)
+def test_bad_robust_settings_are_named(kwargs: dict[str, object], error: type, match: str) -> None:
+    with pytest.raises(error, match=match):
+        PolygonSLAM(4, EPS, **kwargs)  # type: ignore[arg-type]
+    with pytest.raises(error, match=match):
+        MapSettings(EPS, **kwargs)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"fusion": "robust", "risk": 1.0}, r"risk must be in \(0, 0.5\], got 1.0"),
+        ({"fusion": "robust", "robust_set": "all"}, "unknown robust_set 'all'"),
+    ],
+)
+def test_env_rejects_bad_robust_settings(kwargs: dict[str, object], match: str) -> None:
+    from bearing_env.envs import BearingSLAMEnv
+
+    with pytest.raises(ValueError, match=match):
+        BearingSLAMEnv(**kwargs)  # type: ignore[arg-type]
+
+
+def test_env_robust_reports_its_levels_and_decodes_them() -> None:
+    from bearing_env.envs import BearingSLAMEnv
+    from bearing_env.envs.robot_map import decode
+
+    env = BearingSLAMEnv(
+        scenario="khepera", fusion="robust", noise={"kind": "uniform", "outlier_rate": 0.2}
+    )
+    env.reset(seed=4)
+    env.action_space.seed(4)
+    for _ in range(12):
+        _, _, terminated, truncated, info = env.step(env.action_space.sample())
+        if terminated or truncated:
+            break
+    data = info["robot_map"]
+    assert "level_vertices" in data and "window_vertices" not in data
+    slam = env.slam
+    assert slam is not None
+    copy = decode(data, slam.n_landmarks, env.config.map_settings)
+    np.testing.assert_array_equal(copy.areas, slam.areas)
+    np.testing.assert_array_equal(copy.outliers, slam.outliers)
+    env.close()
