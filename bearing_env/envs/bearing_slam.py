@@ -553,6 +553,13 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         state["_renderer"] = None
         return state
 
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        # Ray's object store hands arrays back read-only. The step kernels never get a
+        # read-only array: numba's cache could load a wrong specialisation for one (a
+        # segfault seen in a Ray worker), so the row indices are made writable again.
+        state["_rows"] = np.require(state["_rows"], requirements=["W"])
+        self.__dict__.update(state)
+
     # ------------------------------------------------------------------------------------
     # Actions
     # ------------------------------------------------------------------------------------

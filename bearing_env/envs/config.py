@@ -307,6 +307,14 @@ class LayoutSettings(SettingsGroup):
         """The obstacles as the compiled geometry takes them (:mod:`bearing_env.sensing`)."""
         return pack_polygons(self.obstacles)
 
+    def __getstate__(self) -> dict[str, Any]:
+        # The packed arrays are a cache, made again on first use. Pickled, they could come
+        # back as read-only buffers (Ray's object store), which the kernels must never get.
+        return {key: value for key, value in self.__dict__.items() if key != "packed_obstacles"}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)  # why: frozen; the fields are set as unpickling does
+
     @property
     def fixed_landmarks(self) -> NDArray[np.float64] | None:
         """The fixed landmark positions (n, 2) in metres (a new array), or None."""

@@ -8,6 +8,7 @@ import pickle
 import subprocess
 import sys
 import warnings
+from pathlib import Path
 from typing import Any
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
@@ -768,6 +769,45 @@ def test_the_envs_own_arrays_are_writable_after_a_read_only_unpickle(env_id: str
     assert "positions" in arrays and "noise_offsets" in arrays
     for name, value in arrays.items():
         assert value.flags.writeable, name
+    assert clone._rows.flags.writeable  # the step kernels' row indices
+
+
+def test_packed_obstacles_are_not_pickled_but_made_again() -> None:
+    env = gym.make("BearingSLAM-v0", scenario="furnished_room").unwrapped
+    env.reset(seed=0)
+    packed = env.config.layout.packed_obstacles
+    clone = _read_only_clone(env)
+    again = clone.config.layout.packed_obstacles
+    for before, after in zip(packed, again, strict=True):
+        np.testing.assert_array_equal(before, after)
+        assert after.flags.writeable
+
+
+def test_a_read_only_unpickle_steps_in_a_fresh_process(tmp_path: Path) -> None:
+    """Ray's case: the env arrives in a new process whose numba kernels load from the
+    cache, with read-only buffers (once a segfault in the step kernel)."""
+    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=5)
+    env.reset(seed=11)
+    env.action_space.seed(5)
+    actions = [env.action_space.sample() for _ in range(4)]
+    env.step(actions[0])
+    buffers: list[pickle.PickleBuffer] = []
+    data = pickle.dumps(env, protocol=5, buffer_callback=buffers.append)
+    (tmp_path / "env.pkl").write_bytes(pickle.dumps((data, [bytes(b.raw()) for b in buffers])))
+    expected = [float(env.step(action)[1]) for action in actions[1:]]
+    script = (
+        "import pickle, sys\n"
+        f"data, buffers = pickle.loads(open({str(tmp_path / 'env.pkl')!r}, 'rb').read())\n"
+        "env = pickle.loads(data, buffers=[memoryview(b) for b in buffers])\n"
+        f"for action in {[a.tolist() for a in actions[1:]]!r}:\n"
+        "    import numpy as np\n"
+        "    print(repr(float(env.step(np.array(action, dtype=np.float32))[1])))\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=300
+    )
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert [float(line) for line in result.stdout.split()] == expected
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
