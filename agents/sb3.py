@@ -218,8 +218,7 @@ def load_vecnormalize(path: str | Path, venv: Any = None) -> Any:
             normalizer = pickle.load(handle)
     except Exception as error:  # a truncated or foreign pickle raises many kinds
         raise ModelLoadError(
-            f"could not load VecNormalize statistics {stats_path}: "
-            f"{type(error).__name__}: {error}"
+            f"could not load VecNormalize statistics {stats_path}: {type(error).__name__}: {error}"
         ) from error
     if not isinstance(normalizer, vec_env.VecNormalize):
         raise ModelLoadError(
@@ -404,4 +403,3 @@ class SB3Policy:
 
     def __repr__(self) -> str:
         return f"SB3Policy(name={self.name!r}, path={str(self.model_path)!r})"
-

@@ -97,6 +97,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env region-search --movements 20000": ("run", ("--movements", "300", "--no-progress")),
     "bearing-env soak --steps 20000": ("run", ("--steps", "30", "--no-progress")),
     "bearing-env bench --sections slam,planning,startup": ("parse", ()),
+    "python -m tests.golden_traces": ("help", ()),
     "bearing-env soak": ("run", ("--steps", "30", "--no-progress")),
     "python -m bearing_env.train.studies.demo": ("run", ("--episodes", "1", "--moves", "3")),
     "bearing-env compare --episodes 200 --workers 2 --out outputs/compare_khepera": (
