@@ -119,7 +119,7 @@ def _camera(degrees: int) -> Task:
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "khepera", "field_of_view_deg": degrees},
         description=f"Khepera arena, a forward camera of {degrees} deg: landmarks outside it "
-        "are missed",
+        "are missed (`bearing-env observability` shows what it can map at all)",
     )
 
 

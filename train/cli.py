@@ -16,6 +16,8 @@
     bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
     bearing-env robust-eval [...]  the robust fusion against the strict one under outliers
                                   and an underestimated noise bound
+    bearing-env observability [...]  which movements can map a layout with a task's sensor,
+                                  whatever the policy (train/studies/observability.py)
     bearing-env generalisation [...]  a policy trained on random layouts, across landmark
                                   counts (train/studies/generalisation.py)
     bearing-env play [...]        move the robot by hand in a pygame window (the render extra)
@@ -97,6 +99,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "robust-eval": (
         "bearing_env.train.studies.robust_eval",
         "the robust fusion against the strict one: containment, area and step time",
+    ),
+    "observability": (
+        "bearing_env.train.studies.observability",
+        "which movements can map a layout at all with a task's sensor, whatever the policy",
     ),
     "generalisation": (
         "bearing_env.train.studies.generalisation",

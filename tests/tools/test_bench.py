@@ -176,12 +176,16 @@ def test_targets_from_results() -> None:
             fake_figure(400.0, name="random_4"),
             fake_figure(20.0, name="random_64"),
         ],
-        "vector": [fake_figure(1500.0, kind="batched", num_envs=64)],
+        "vector": [
+            fake_figure(1500.0, kind="batched", num_envs=64),
+            fake_figure(550.0, kind="batched", num_envs=256),
+        ],
         "ppo": [fake_figure(300.0, kind="batched"), fake_figure(100.0, kind="subproc")],
     }
     targets = {target["id"]: target for target in bench_report.evaluate_targets(results)}
     assert targets["a"]["met"] is True and targets["a"]["value"] == pytest.approx(0.2)
     assert targets["b"]["met"] is True and targets["b"]["note"] is None
+    assert targets["i"]["met"] is False and targets["i"]["value"] == pytest.approx(0.55)
     assert targets["c"]["met"] is False and targets["c"]["value"] == pytest.approx(0.05)
     assert targets["d"]["met"] is True and targets["d"]["value"] == pytest.approx(3.0)
     assert all(target["met"] is None for target in bench_report.evaluate_targets({}))
@@ -270,7 +274,9 @@ def test_quick_slam_and_startup(tmp_path: Path, capsys: pytest.CaptureFixture[st
     targets = {target["id"]: target for target in results["targets"]}
     assert targets["e"]["value"] == rows[("conservative", 4)]["ratio_to_cartpole"]
     assert targets["f"]["value"] == startup["warm_first_step_s"]
-    assert targets["f"]["met"] == (startup["warm_first_step_s"] <= 1.5)
+    assert targets["f"]["met"] == (startup["warm_first_step_s"] <= 1.0)
+    assert targets["j"]["value"] == startup["cold_first_step_s"]
+    assert targets["j"]["met"] == (startup["cold_first_step_s"] <= 20.0)
     out = capsys.readouterr().out
     assert "update(), conservative, 4 landmarks" in out and "Start-up" in out
 

@@ -99,6 +99,10 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env bench --sections slam,planning,startup": ("parse", ()),
     "python -m tests.golden_traces": ("help", ()),
     "bearing-env soak": ("run", ("--steps", "30", "--no-progress")),
+    "bearing-env soak --steps 100000 --task BearingSLAM-FurnishedRoom-v0": (
+        "run",
+        ("--steps", "30", "--no-progress"),
+    ),
     "python -m bearing_env.train.studies.demo": ("run", ("--episodes", "1", "--moves", "3")),
     "bearing-env compare --episodes 200 --workers 2 --out outputs/compare_khepera": (
         "parse",
@@ -158,6 +162,11 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--workers 2 --out outputs/compare_lookahead": ("parse", ()),
     "bearing-env figures --only robust --out docs/figures": ("parse", ()),
     "bearing-env robust-eval": ("parse", ()),
+    "bearing-env observability": ("parse", ()),
+    "bearing-env observability --env BearingSLAM-Khepera-v0 --fov 360 180 90 --plot "
+    "docs/figures/observability_khepera.png": ("parse", ()),
+    "bearing-env observability --env BearingSLAM-FurnishedRoom-v0 --fov 360 180 90 --plot "
+    "docs/figures/observability_furnished_room.png": ("parse", ()),
     "bearing-env compare --episodes 200 --executor ray": ("parse", ()),
     "bearing-env compare --episodes 2000 --executor ray --ray-address auto "
     "--out outputs/compare_2000": ("parse", ()),
@@ -272,6 +281,10 @@ def _parse(argv: list[str]) -> None:
         from bearing_env.train.studies import figures
 
         figures.build_parser().parse_args(arguments)
+    elif command == "observability":
+        from bearing_env.train.studies import observability
+
+        observability.build_parser().parse_args(arguments)
     elif command == "robust-eval":
         from bearing_env.train.studies import robust_eval
 
