@@ -554,9 +554,10 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
-        # Ray's object store hands arrays back read-only. The step kernels never get a
-        # read-only array: numba's cache could load a wrong specialisation for one (a
-        # segfault seen in a Ray worker), so the row indices are made writable again.
+        # Ray's object store hands arrays back read-only. The row indices are made
+        # writable again, so the step kernels get the one type they are compiled and
+        # cached for: read-only ones made each Ray worker compile a second step kernel.
+        # (That kernel once segfaulted from the cache: see bearing_env.slam.kernels.common.)
         state["_rows"] = np.require(state["_rows"], requirements=["W"])
         self.__dict__.update(state)
 

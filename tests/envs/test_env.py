@@ -785,7 +785,8 @@ def test_packed_obstacles_are_not_pickled_but_made_again() -> None:
 
 def test_a_read_only_unpickle_steps_in_a_fresh_process(tmp_path: Path) -> None:
     """Ray's case: the env arrives in a new process whose numba kernels load from the
-    cache, with read-only buffers (once a segfault in the step kernel)."""
+    cache, with read-only buffers (once a segfault in the step kernel: the parallel
+    runtime unstarted, see ``tests/slam/test_parallel_runtime.py``)."""
     env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=5)
     env.reset(seed=11)
     env.action_space.seed(5)
