@@ -104,9 +104,7 @@ def load_obstacles(path: str | os.PathLike[str]) -> list[Any]:
     unchecked: :func:`parse_obstacles` checks them against the arena."""
     file = Path(path)
     if file.suffix.lower() not in OBSTACLE_FILE_SUFFIXES:
-        raise ValueError(
-            f"obstacle file {str(file)!r} must end in one of {OBSTACLE_FILE_SUFFIXES}"
-        )
+        raise ValueError(f"obstacle file {str(file)!r} must end in one of {OBSTACLE_FILE_SUFFIXES}")
     try:
         text = file.read_text(encoding="utf-8")
     except OSError as error:

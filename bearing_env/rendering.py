@@ -405,9 +405,7 @@ class Renderer:
 
     def _draw_header(self, scene: Scene) -> None:
         n_mapped = len(scene.regions)
-        total = (
-            f"{scene.total_area:.4f} FL units²" if math.isfinite(scene.total_area) else "n/a"
-        )
+        total = f"{scene.total_area:.4f} FL units²" if math.isfinite(scene.total_area) else "n/a"
         status = "map updated" if scene.frame_changed else "no update"
         if scene.moves == 0:
             status = "start"

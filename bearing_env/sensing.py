@@ -49,7 +49,14 @@ def pack_polygons(polygons: tuple[tuple[tuple[float, float], ...], ...]) -> Pack
 
 @njit(**_JIT)
 def _edge_entry(
-    x: float, y: float, dx: float, dy: float, ax: float, ay: float, bx: float, by: float,
+    x: float,
+    y: float,
+    dx: float,
+    dy: float,
+    ax: float,
+    ay: float,
+    bx: float,
+    by: float,
     margin: float,
 ) -> float:
     """Distance along the ray (unit direction) to where it enters the band of half-width
@@ -153,8 +160,14 @@ def line_of_sight(
         for k in range(first, last):
             following = k + 1 if k + 1 < last else first
             if segments_cross(
-                x, y, target_x, target_y, vertices[k, 0], vertices[k, 1],
-                vertices[following, 0], vertices[following, 1],
+                x,
+                y,
+                target_x,
+                target_y,
+                vertices[k, 0],
+                vertices[k, 1],
+                vertices[following, 0],
+                vertices[following, 1],
             ):
                 return False
     return True
@@ -218,8 +231,12 @@ def clearance(x: float, y: float, vertices: FloatArray, starts: IntArray) -> flo
             best = min(
                 best,
                 _segment_distance(
-                    x, y, vertices[k, 0], vertices[k, 1],
-                    vertices[following, 0], vertices[following, 1],
+                    x,
+                    y,
+                    vertices[k, 0],
+                    vertices[k, 1],
+                    vertices[following, 0],
+                    vertices[following, 1],
                 ),
             )
     return best
@@ -240,6 +257,13 @@ def visible_rows(
     for i in range(landmarks.shape[0]):
         for j in range(landmarks.shape[1]):
             out[i, j] = visible(
-                positions[i, 0], positions[i, 1], headings[i], landmarks[i, j, 0],
-                landmarks[i, j, 1], half_fov, max_range, vertices, starts,
+                positions[i, 0],
+                positions[i, 1],
+                headings[i],
+                landmarks[i, j, 0],
+                landmarks[i, j, 1],
+                half_fov,
+                max_range,
+                vertices,
+                starts,
             )

@@ -217,40 +217,75 @@ class NoiseModel:
         is an outlier whose replacement is NaN.
         """
         rows = len(rngs)
+        extras = self.outlier_rate > 0.0 or self.detection_rate < 1.0
         offsets = np.zeros((rows, size))
-        outliers = self.outlier_rate > 0.0
-        misses = self.detection_rate < 1.0
-        is_outlier = np.zeros((rows, size), dtype=bool) if outliers or misses else None
-        replacement = np.zeros((rows, size)) if outliers or misses else None
-        bound = epsilon if self.bound_deg is None else math.radians(self.bound_deg)
-        sigma = 0.5 * epsilon if self.sigma_deg is None else math.radians(self.sigma_deg)
+        is_outlier = np.zeros((rows, size), dtype=bool) if extras else None
+        replacement = np.zeros((rows, size)) if extras else None
         for row, rng in enumerate(rngs):
-            if self.kind == "uniform":
-                offsets[row] = rng.uniform(-bound, bound, size)
-            elif self.kind == "gaussian":
-                offsets[row] = rng.normal(0.0, sigma, size)
-            if outliers and is_outlier is not None and replacement is not None:
-                is_outlier[row] = rng.random(size) < self.outlier_rate
-                replacement[row] = rng.uniform(-np.pi, np.pi, size)
-            if misses and is_outlier is not None and replacement is not None:
-                missed = rng.random(size) >= self.detection_rate
-                is_outlier[row] |= missed
-                replacement[row, missed] = np.nan
+            self._draw_reading(
+                rng,
+                epsilon,
+                offsets[row],
+                None if is_outlier is None else is_outlier[row],
+                None if replacement is None else replacement[row],
+            )
         return NoiseDraws(offsets, is_outlier, replacement)
 
+    @property
+    def draws_in_bulk(self) -> bool:
+        """Whether a reading draws its offsets alone (no outliers, no missed detections),
+        so that ``k`` readings of ``n`` bearings are one draw of ``k * n`` offsets: the
+        stream of draws is the same (both distributions draw element by element)."""
+        return self.outlier_rate == 0.0 and self.detection_rate == 1.0
 
-    def draw_movement_rows(
-        self, rngs: Sequence[np.random.Generator], size: int, epsilon: float
-    ) -> tuple[NoiseDraws, NoiseDraws]:
-        """The draws of a movement's two readings: :meth:`draw_rows` twice, in that order.
+    def draw_readings(
+        self,
+        rng: np.random.Generator,
+        epsilon: float,
+        offsets: FloatArray,
+        is_outlier: NDArray[np.bool_],
+        replacement: FloatArray,
+    ) -> None:
+        """The draws of ``len(offsets)`` successive readings of one robot, into the
+        arrays (readings, n) given, in the order :meth:`draw_rows` makes them one reading
+        at a time: the envs draw a block of an episode's readings at once. Without
+        outliers ``is_outlier`` is all False and ``replacement`` is left as it is."""
+        if self.draws_in_bulk:
+            is_outlier[:] = False
+            self._draw_reading(rng, epsilon, offsets.reshape(-1), None, None)
+            return
+        for k in range(offsets.shape[0]):
+            self._draw_reading(rng, epsilon, offsets[k], is_outlier[k], replacement[k])
 
-        Without outliers a robot's two readings take one call of its generator (the
-        stream is the same as two calls: both distributions draw element by element).
-        """
-        if self.outlier_rate > 0.0 or self.detection_rate < 1.0 or self.kind == "none":
-            return self.draw_rows(rngs, size, epsilon), self.draw_rows(rngs, size, epsilon)
-        both = self.draw_rows(rngs, 2 * size, epsilon).offsets
-        return NoiseDraws(both[:, :size], None, None), NoiseDraws(both[:, size:], None, None)
+    def _draw_reading(
+        self,
+        rng: np.random.Generator,
+        epsilon: float,
+        offsets: FloatArray,
+        is_outlier: NDArray[np.bool_] | None,
+        replacement: FloatArray | None,
+    ) -> None:
+        """One robot's draws into its arrays: the offsets, then (with outliers) both
+        outlier arrays in full, then (with missed detections) which landmarks it misses."""
+        size = offsets.shape[0]
+        if self.kind == "uniform":
+            bound = epsilon if self.bound_deg is None else math.radians(self.bound_deg)
+            offsets[:] = rng.uniform(-bound, bound, size)
+        elif self.kind == "gaussian":
+            sigma = 0.5 * epsilon if self.sigma_deg is None else math.radians(self.sigma_deg)
+            offsets[:] = rng.normal(0.0, sigma, size)
+        else:
+            offsets[:] = 0.0
+        if is_outlier is None or replacement is None:
+            return
+        is_outlier[:] = False
+        if self.outlier_rate > 0.0:
+            is_outlier[:] = rng.random(size) < self.outlier_rate
+            replacement[:] = rng.uniform(-np.pi, np.pi, size)
+        if self.detection_rate < 1.0:
+            missed = rng.random(size) >= self.detection_rate
+            is_outlier |= missed
+            replacement[missed] = np.nan
 
 
 @dataclass(frozen=True)
@@ -332,8 +367,7 @@ SCENARIOS: dict[str, Scenario] = {
         name="paper_sim",
         arena_size=(2.0, 2.0),
         landmarks=((0.75, 0.60), (1.25, 0.60), (1.35, 1.30), (0.65, 1.40)),
-        description="the paper's simulation: 4 landmarks around the centre of a 2 x 2 m "
-        "square",
+        description="the paper's simulation: 4 landmarks around the centre of a 2 x 2 m square",
     ),
     # A living room of 2 x 1.5 m with a table in the middle, a sofa along the top wall,
     # a shelf against the right wall and an armchair: each hides some landmarks from
@@ -639,7 +673,10 @@ def _true_bearings_into(
     for i in range(landmarks.shape[0]):
         for j in range(landmarks.shape[1]):
             out[i, j] = bearing(
-                landmarks[i, j, 0], landmarks[i, j, 1], positions[i, 0], positions[i, 1],
+                landmarks[i, j, 0],
+                landmarks[i, j, 1],
+                positions[i, 0],
+                positions[i, 1],
                 headings[i],
             )
 
@@ -669,7 +706,13 @@ def straight_moves(
     moved = np.empty((len(positions), 2))
     for i, ((x, y), heading, length) in enumerate(zip(positions, headings, lengths, strict=True)):
         moved[i, 0], moved[i, 1], travelled[i], blocked[i] = straight_move(
-            float(x), float(y), float(heading), float(length), arena.width, arena.height,
-            arena.wall_margin, min_baseline,
+            float(x),
+            float(y),
+            float(heading),
+            float(length),
+            arena.width,
+            arena.height,
+            arena.wall_margin,
+            min_baseline,
         )
     return travelled, blocked, moved

@@ -447,6 +447,20 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         """
         return self._world
 
+    @property
+    def np_random(self) -> np.random.Generator:
+        """The env's generator (as ``gym.Env``'s). The env draws its movement noise ahead
+        in blocks; reading the generator first hands the unspent draws back to it, so it
+        is where drawing move by move would have left it (the next move draws again)."""
+        core.release_noise(self._state, 0)
+        return super().np_random
+
+    @np_random.setter
+    def np_random(self, value: np.random.Generator) -> None:
+        # why: mypy does not follow a property's setter through super()
+        gym.Env.np_random.fset(self, value)  # type: ignore[attr-defined]
+        core.bind_noise(self._state, 0, value)
+
     # ------------------------------------------------------------------------------------
     # Gymnasium API
     # ------------------------------------------------------------------------------------
@@ -461,11 +475,11 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         if self._world is None:
             self._world = WorldView(self._state, 0, config)
         group = self._maps.group(self._state, rows, config)
-        observation = core.observations(self._state, group)[0]
-        infos = core.infos(self._state, group, core.reset_outcome(1))
+        report, robot_map_info = core.report(self._state, group)
         if self.render_mode == "human":
             self.render()
-        return self._observation(observation), core.row_info(infos, 0)
+        info = core.single_info(report, robot_map_info, core.sensor_info(self._state, group))
+        return self._observation(report.observations[0]), info
 
     def step(
         self, action: NDArray[np.float32] | ArrayLike
@@ -477,19 +491,16 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
                 "the episode has ended (terminated or truncated): call reset() before step() again"
             )
         turns, lengths = self._decode_batch(self._checked_action(action)[None])
-        rows, config = self._rows, self.config
-        group = self._maps.group(self._state, rows, config)
-        outcome = core.step(self._state, group, turns, lengths, [self.np_random])
-        observation = core.observations(self._state, group)[0]
-        info = core.row_info(core.infos(self._state, group, outcome), 0)
+        group = self._maps.group(self._state, self._rows, self._config)
+        report, robot_map_info = core.step(self._state, group, turns, lengths)
         if self.render_mode == "human":
             self.render()
         return (
-            self._observation(observation),
-            float(outcome.rewards[0]),
-            bool(outcome.terminated[0]),
-            bool(outcome.truncated[0]),
-            info,
+            self._observation(report.observations[0]),
+            report.rewards.item(),
+            report.terminated.item(),
+            report.truncated.item(),
+            core.single_info(report, robot_map_info, core.sensor_info(self._state, group)),
         )
 
     def _observation(self, flat: NDArray[np.float32]) -> Any:
@@ -543,9 +554,10 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
-        # Ray's object store hands arrays back read-only. The step kernels never get a
-        # read-only array: numba's cache could load a wrong specialisation for one (a
-        # segfault seen in a Ray worker), so the row indices are made writable again.
+        # Ray's object store hands arrays back read-only. The row indices are made
+        # writable again, so the step kernels get the one type they are compiled and
+        # cached for: read-only ones made each Ray worker compile a second step kernel.
+        # (That kernel once segfaulted from the cache: see bearing_env.slam.kernels.common.)
         state["_rows"] = np.require(state["_rows"], requirements=["W"])
         self.__dict__.update(state)
 

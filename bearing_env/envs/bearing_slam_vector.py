@@ -48,14 +48,15 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
     `num_envs` copies of :class:`~bearing_env.envs.bearing_slam.BearingSLAMEnv` stepped
     together. The sub-envs are rows of one structure of arrays
-    (:class:`~bearing_env.envs.state.BatchState`), and each step is a few compiled kernel
-    calls per group of rows with the same settings (`EnvConfig`) and landmark count: all
-    robots move at once, all maps fuse their movement in one
-    :class:`BatchedPolygonSLAM` update (most of the work), and observations, rewards and
-    infos are built for the whole group. Only the random draws loop over sub-envs in
-    Python, because each owns its random generator. The functions are
-    :mod:`bearing_env.envs.core`'s, which the single env runs with a batch of one, so the
-    two cannot drift apart.
+    (:class:`~bearing_env.envs.state.BatchState`), and each step is one compiled call per
+    group of rows with the same settings (`EnvConfig`) and landmark count: all robots
+    move at once, all maps fuse their movement in one batched update (most of the work),
+    and observations, rewards, episode ends and infos are written for the whole group
+    (the relaxed fusion's window in the infos takes one more call). The readings' noise
+    is drawn ahead, a block of moves at a time, by each sub-env's own generator, so no
+    Python runs per sub-env on a step; resets (new layouts) run in Python for the
+    sub-envs that ended. The functions are :mod:`bearing_env.envs.core`'s, which the
+    single env runs with a batch of one, so the two cannot drift apart.
 
     For the same per-env seeds and actions it reproduces
     `gym.make_vec(id, num_envs, vectorization_mode="sync")` exactly: observations,
@@ -251,35 +252,53 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             for config, rows in self._groups(np.flatnonzero(~resetting))
         ]
 
-        observations = np.zeros(self._flat_shape, dtype=np.float32)
-        rewards = np.zeros(n, dtype=np.float64)
-        terminations = np.zeros(n, dtype=bool)
-        truncations = np.zeros(n, dtype=bool)
-        infos: dict[str, Any] = {}
+        if len(groups) == 1 and groups[0][1].size == n:  # the common case: one group, every row
+            config, rows, turns, lengths = groups[0]
+            report, group_infos = self._step_group(config, rows, turns, lengths)
+            observations, rewards = report.observations, report.rewards
+            terminations, truncations = report.terminated, report.truncated
+            infos = _as_vector_infos(group_infos, n)
+        else:
+            observations = np.zeros(self._flat_shape, dtype=np.float32)
+            rewards = np.zeros(n, dtype=np.float64)
+            terminations = np.zeros(n, dtype=bool)
+            truncations = np.zeros(n, dtype=bool)
+            infos = {}
+            for config, rows, turns, lengths in groups:
+                report, group_infos = self._step_group(config, rows, turns, lengths)
+                observations[rows] = report.observations
+                rewards[rows] = report.rewards
+                terminations[rows] = report.terminated
+                truncations[rows] = report.truncated
+                infos = self._merge_rows(infos, group_infos, rows)
         finished: list[IntArray] = []
-        for config, rows, turns, lengths in groups:
-            rngs = [self._rng(row) for row in rows.tolist()]
-            group = self._maps.group(self._state, rows, config)
-            outcome = core.step(self._state, group, turns, lengths, rngs)
-            observations[rows] = core.observations(self._state, group)
-            rewards[rows] = outcome.rewards
-            terminations[rows] = outcome.terminated
-            truncations[rows] = outcome.truncated
-            self._elapsed_steps[rows] += 1
-            if self.max_episode_steps is not None:
-                truncations[rows] |= self._elapsed_steps[rows] >= self.max_episode_steps
-            group_infos = self._padded(core.infos(self._state, group, outcome))
-            infos = self._merge_rows(infos, group_infos, rows)
-            if self.autoreset_mode == AutoresetMode.SAME_STEP:
-                ended = np.flatnonzero(terminations[rows] | truncations[rows])
-                if ended.size:
-                    infos = self._merge_final(infos, rows[ended], observations, group_infos, ended)
-                    finished.append(rows[ended])
+        if self.autoreset_mode == AutoresetMode.SAME_STEP:
+            ended = np.flatnonzero(terminations | truncations)
+            if ended.size:
+                infos = self._merge_final(infos, ended, observations)
+                finished.append(ended)
         if finished:  # SAME_STEP: reset at once, the reset's observation and info returned
             infos = self._reset_rows(np.concatenate(finished), observations, infos)
         infos = self._reset_rows(np.flatnonzero(resetting), observations, infos)
         self._autoreset_envs = terminations | truncations
         return self._returned(observations), rewards, terminations, truncations, infos
+
+    def _step_group(
+        self,
+        config: EnvConfig,
+        rows: IntArray,
+        turns: NDArray[np.float64],
+        lengths: NDArray[np.float64],
+    ) -> tuple[Any, dict[str, Any]]:
+        """One step of a group (one config and landmark count): its report, with the
+        ``max_episode_steps`` cap applied, and its batched infos (padded)."""
+        group = self._maps.group(self._state, rows, config)
+        report, robot_map_info = core.step(self._state, group, turns, lengths)
+        self._elapsed_steps[rows] += 1
+        if self.max_episode_steps is not None:
+            report.truncated[:] |= self._elapsed_steps[rows] >= self.max_episode_steps
+        infos = core.infos(report, robot_map_info, core.sensor_info(self._state, group))
+        return report, self._padded(infos)
 
     def _returned(self, flat: NDArray[np.float32]) -> Any:
         """The observations ``reset`` or ``step`` returns, kept as the latest ones."""
@@ -347,6 +366,8 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             ]
         elif name == "np_random":
             self._rngs = list(values)
+            for row, rng in enumerate(self._rngs):  # the next moves draw from the new ones
+                core.bind_noise(self._state, row, rng)
             return
         elif attribute is not None or name in _ROW_ATTRIBUTES:
             raise AttributeError(f"the sub-envs' {name!r} cannot be set")
@@ -413,6 +434,8 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         if name == "world":
             return self._worlds[row] if self._has_reset else None
         if name == "np_random":
+            # The unspent noise drawn ahead goes back first (see BearingSLAMEnv.np_random).
+            core.release_noise(self._state, row)
             return self._rng(row)
         if name in ("observation_space", "action_space"):
             return getattr(self, f"single_{name}")
@@ -477,9 +500,12 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             core.reset_rows(self._state, group, config, rngs, self._maps)
         for config, group in self._groups(rows):
             rows_group = self._maps.group(self._state, group, config)
-            observations[group] = core.observations(self._state, rows_group)
-            reset_infos = core.infos(self._state, rows_group, core.reset_outcome(group.size))
-            infos = self._merge_rows(infos, self._padded(reset_infos), group)
+            report, robot_map_info = core.report(self._state, rows_group)
+            observations[group] = report.observations
+            group_infos = core.infos(
+                report, robot_map_info, core.sensor_info(self._state, rows_group)
+            )
+            infos = self._merge_rows(infos, self._padded(group_infos), group)
         self._elapsed_steps[rows] = 0
         return infos
 
@@ -511,28 +537,25 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
             values = info[key]
             padded[key] = np.full((*values.shape[:-1], self._info_slots), fill, values.dtype)
             padded[key][..., : values.shape[-1]] = values
+        if "seen" in info:  # every landmark, L1 and L2 included: two more slots
+            seen = info["seen"]
+            padded["seen"] = np.zeros((seen.shape[0], self._info_slots + 2), dtype=bool)
+            padded["seen"][:, : seen.shape[1]] = seen
         return padded
 
     def _merge_final(
-        self,
-        infos: dict[str, Any],
-        rows: IntArray,
-        observations: NDArray[np.float32],
-        group_infos: dict[str, Any],
-        group_rows: IntArray,
+        self, infos: dict[str, Any], rows: IntArray, observations: NDArray[np.float32]
     ) -> dict[str, Any]:
         """What ``_add_info`` builds from ``{"final_obs": ..., "final_info": ...}`` of each
-        finished sub-env (``rows``; ``group_rows`` are their positions in ``group_infos``)."""
+        finished sub-env (``rows``), from the step's vector ``infos``."""
         # Gymnasium keeps final observations in an object array, one array per sub-env.
-        final_obs = infos.get("final_obs")
-        if final_obs is None:
-            final_obs = np.full(self.num_envs, None, dtype=object)
+        final_obs = np.full(self.num_envs, None, dtype=object)
         for row in rows.tolist():
             final_obs[row] = self._observation(observations[row].copy())
-        mask = infos.get("_final_obs", np.zeros(self.num_envs, dtype=np.bool_))
+        mask = np.zeros(self.num_envs, dtype=np.bool_)
         mask[rows] = True
-        infos["final_obs"], infos["_final_obs"] = final_obs, mask
-        finals = _select_rows(group_infos, group_rows)
+        finals = _select_rows(_without_masks(infos), rows)
+        infos = {**infos, "final_obs": final_obs, "_final_obs": mask}
         return self._merge_rows(infos, {"final_info": finals}, rows)
 
     def _merge_rows(
@@ -579,6 +602,15 @@ def _as_vector_infos(batched: dict[str, Any], num_envs: int) -> dict[str, Any]:
         infos[key] = _as_vector_infos(value, num_envs) if isinstance(value, dict) else value
         infos[f"_{key}"] = np.ones(num_envs, dtype=np.bool_)
     return infos
+
+
+def _without_masks(infos: dict[str, Any]) -> dict[str, Any]:
+    """Vector infos without their ``_key`` masks (nested dicts included)."""
+    return {
+        key: _without_masks(value) if isinstance(value, dict) else value
+        for key, value in infos.items()
+        if not key.startswith("_")
+    }
 
 
 def _select_rows(batched: dict[str, Any], rows: IntArray) -> dict[str, Any]:

@@ -249,7 +249,8 @@ class LayoutSettings(SettingsGroup):
         accepts="tuple[float, float] | Arena | None", keyword_default=None
     )
     obstacles: tuple[Obstacle, ...] = setting(
-        (), accepts="Sequence[ArrayLike] | str | os.PathLike[str] | Mapping[str, int] | None",
+        (),
+        accepts="Sequence[ArrayLike] | str | os.PathLike[str] | Mapping[str, int] | None",
         keyword_default=None,
     )
 

@@ -5,15 +5,20 @@ In the spirit of Gymnasium's ``phys2d/cartpole.py``: one
 state of ``N`` envs as a structure of arrays (one row per env), and plain functions
 compute on a group of rows at once:
 
-- :func:`reset_rows` starts new episodes;
+- :func:`reset_rows` starts new episodes (in Python: a layout's rejection sampling
+  draws from the row's generator), and draws each row's first block of movement noise
+  ahead (:func:`fill_noise`);
 - :func:`step` moves the robots, reads the sensors, updates the maps and computes the
-  rewards (:func:`rewards`), terminations and truncations;
-- :func:`observations` and :func:`infos` build the observations and infos.
+  rewards, terminations, truncations, observations and infos, in one compiled call
+  (``kernels.step_rows``); :func:`report` gives the observations and infos alone;
+- :func:`infos` and :func:`single_info` make the info dicts of the step's arrays.
 
 ``BearingSLAMEnv`` is a batch of one; ``BearingSLAMVectorEnv`` steps the whole batch.
 Both call exactly these functions, so they agree bit for bit: every computation is
 row-wise (a row's result does not depend on the other rows of its batch), and every
-random draw comes from the row's own generator, in the same order as in a batch of one.
+random draw comes from the row's own generator, in the same order as in a batch of one
+(and as drawing move by move: the noise drawn ahead that an episode does not spend is
+handed back, :func:`release_noise`).
 
 A *group* is a set of rows that share one :class:`~bearing_env.envs.config.EnvConfig`
 and one landmark count ``n`` (so one map batch, and arrays ``[:, :n]`` without padding).
@@ -33,19 +38,20 @@ from numpy.typing import NDArray
 from bearing_env.envs import kernels, robot_map
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig
 from bearing_env.envs.kernels import Settings
-from bearing_env.envs.observations import FL_COORD_LIMIT, observation_size
+from bearing_env.envs.observations import FL_COORD_LIMIT
 from bearing_env.envs.state import BatchState
 from bearing_env.numerics import wrap_angle
 from bearing_env.obstacles import Obstacle
 from bearing_env.sensing import visible_rows
 from bearing_env.slam import MapSettings, PolygonSLAM
+from bearing_env.slam import kernels as slam_kernels
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
+    PARALLEL_MIN_MAPS,
     BatchedPolygonSLAM,
 )
 from bearing_env.world import (
     Arena,
-    NoiseDraws,
     NoiseModel,
     World,
     random_layout,
@@ -102,8 +108,8 @@ class MapBank:
         maps_ref = batch._kernel_state()
         kept = self._inputs.get((n, config))
         if kept is None or kept[0] is not state_ref or kept[1] is not maps_ref:
-            settings = kernel_settings(n, config)
-            inputs = kernels.inputs_ref(kernels.Inputs(settings, maps_ref, state_ref))
+            settings, params = kernel_settings(n, config), batch._kernel_params(True)
+            inputs = kernels.inputs_ref(kernels.Inputs(settings, params, maps_ref, state_ref))
             kept = self._inputs[n, config] = (state_ref, maps_ref, inputs)
         return batch, kept[2]
 
@@ -196,9 +202,12 @@ def check_config_switch(old: EnvConfig, new: EnvConfig, action_grid_fixed: bool)
 def switch_maps(state: BatchState, maps: MapBank, row: int, old: EnvConfig, new: EnvConfig) -> None:
     """After a config change of row ``row``: an empty map if the map's settings (epsilon,
     transfer, fusion, ...) changed, since the row may have stale state in that other map
-    batch."""
+    batch; the noise drawn ahead is handed back (the next move draws with the new
+    settings)."""
     if new.map_settings != old.map_settings:
         maps.batch(int(state.n_landmarks[row]), new).reset([row])
+    # The noise drawn ahead was drawn with the old settings (noise model, max_moves).
+    release_noise(state, row)
 
 
 # ----------------------------------------------------------------------------------------
@@ -309,7 +318,9 @@ def reset_rows(
     ``rows[j]``'s generator.
 
     Each row draws, from its own generator and in this order: its landmark count (for a
-    count range), its layout (``"random"``), its start pose, then its first reading.
+    count range), its layout (``"random"``), its start pose, its first reading, then its
+    first block of movement noise (:func:`fill_noise`); the generator becomes the row's
+    noise generator.
     Afterwards the rows may have different landmark counts (see :func:`group_rows`).
     """
     layout, noise = config.layout, config.sensor.noise
@@ -319,6 +330,9 @@ def reset_rows(
     state.landmarks[rows] = 0.0
     state.landmarks_fl[rows] = 0.0
     for row, rng in zip(rows.tolist(), rngs, strict=True):
+        # The last episode's unspent noise goes back to its generator first.
+        bind_noise(state, row, rng)
+        release_noise(state, row)
         # Rejection sampling makes the draws per row: a layout's draw count varies.
         count = int(rng.integers(lo, hi + 1)) if hi > lo else hi
         if fixed is not None:
@@ -358,6 +372,7 @@ def reset_rows(
         rows_group = maps.group(state, group, config)
         rows_group.batch.reset(group)
         state.potentials[group] = potentials(state, rows_group)
+    fill_noise(state, rows, config)
 
 
 def sees(state: BatchState, rows: IntArray, n: int, config: EnvConfig) -> BoolArray:
@@ -366,8 +381,14 @@ def sees(state: BatchState, rows: IntArray, n: int, config: EnvConfig) -> BoolAr
     vertices, starts = config.layout.packed_obstacles
     sensor = config.sensor
     visible_rows(
-        state.landmarks[rows, :n], state.positions[rows], state.headings[rows],
-        sensor.half_fov, sensor.max_range, vertices, starts, out,
+        state.landmarks[rows, :n],
+        state.positions[rows],
+        state.headings[rows],
+        sensor.half_fov,
+        sensor.max_range,
+        vertices,
+        starts,
+        out,
     )
     return out
 
@@ -386,108 +407,130 @@ def group_rows(state: BatchState, rows: IntArray) -> list[tuple[int, IntArray]]:
 # ----------------------------------------------------------------------------------------
 
 
-class StepOutcome(NamedTuple):
-    """What one step of a group did, per row (arrays of the group's length)."""
-
-    rewards: FloatArray
-    terminated: BoolArray
-    truncated: BoolArray
-    frame_changed: BoolArray
-    inconsistent: IntArray
-    travelled: FloatArray
-    #: The named reward parts; the reward is their sum.
-    uncertainty: FloatArray
-    path_cost: FloatArray
-    move_cost: FloatArray
-
-
 def step(
-    state: BatchState,
-    group: Group,
-    turns: FloatArray,
-    lengths: FloatArray,
-    rngs: Sequence[np.random.Generator],
-) -> StepOutcome:
+    state: BatchState, group: Group, turns: FloatArray, lengths: FloatArray
+) -> tuple[kernels.Report, dict[str, Any] | None]:
     """One movement of every row of a group (same config, same landmark count ``n``):
-    turn, read, move straight (stopped at the wall), read, update the map.
+    turn, read, move straight (stopped at the wall), read, update the map; the rewards,
+    episode ends, observations and infos of :func:`report`, in one compiled call.
 
-    ``turns`` and ``lengths`` are decoded actions (radians, metres); ``rngs[j]`` is row
-    ``rows[j]``'s generator.
+    ``turns`` and ``lengths`` are decoded actions (radians, metres). The readings' noise
+    comes from the rows' noise buffers, which the rows' generators fill ahead
+    (:func:`fill_noise`, called at reset and whenever a block is spent).
     """
-    rows, config, n = group.rows, group.config, group.n
-    size = rows.size
-    # Each row draws its first reading's noise, then its second's, from its generator.
-    first, second = config.sensor.noise.draw_movement_rows(rngs, n, config.epsilon)
-    travelled, start, end = np.empty(size), np.empty((size, n)), np.empty((size, n))
-    kernels.move_and_read(
-        rows,
-        np.ascontiguousarray(turns, dtype=np.float64),
-        np.ascontiguousarray(lengths, dtype=np.float64),
-        group.inputs,
-        _draws_for_kernel(first),
-        _draws_for_kernel(second),
-        travelled,
-        start,
-        end,
-    )
-    state.append_positions(rows)
+    rows, config, inputs = group.rows, group.config, group.inputs
+    turns = np.ascontiguousarray(turns, dtype=np.float64)
+    lengths = np.ascontiguousarray(lengths, dtype=np.float64)
+    # Small batches stay on one thread (see PARALLEL_MIN_MAPS): asking numba costs ~2 us.
+    threads = slam_kernels.threads() if rows.size >= PARALLEL_MIN_MAPS else 1
+    map_slots = config.observations.max_landmarks - 2
+    while True:
+        if config.observations.robot_map_info:
+            status, report, encoded = kernels.step_rows(
+                rows, turns, lengths, inputs, state.trajectory, threads, map_slots
+            )
+        else:
+            status, report = kernels.step_rows_bare(
+                rows, turns, lengths, inputs, state.trajectory, threads
+            )
+            encoded = None
+        if status == kernels.STEP_DONE:
+            return report, _robot_map(group, encoded)
+        if status == kernels.STEP_NEEDS_NOISE:
+            spent = state.noise_used[rows] + 2 * group.n > state.noise_filled[rows]
+            fill_noise(state, rows[spent], config)
+        else:
+            state.grow_trajectory()
 
-    # A move that could not start took both readings from the same place: there is no
-    # robot frame (R1 = R2), so the SLAM must not see it. The robot knows it did not move
-    # (it is stuck against the wall).
-    changes_map = travelled >= config.layout.arena.min_baseline
-    frame_changed = np.zeros(size, dtype=bool)
-    inconsistent = np.zeros(size, dtype=np.int64)
+
+def report(state: BatchState, group: Group) -> tuple[kernels.Report, dict[str, Any] | None]:
+    """The group's observations and infos as they stand (after a reset: nothing moved,
+    nothing earned), with the ``robot_map`` info (None with ``robot_map_info`` off)."""
+    slots = group.config.observations.max_landmarks - 2
+    report, encoded = kernels.report_rows(group.rows, group.inputs, slots)
+    return report, _robot_map(group, encoded)
+
+
+def _robot_map(group: Group, encoded: tuple[Any, ...] | None) -> dict[str, Any] | None:
+    """The ``robot_map`` info from the kernel's encoded arrays, with the relaxed fusion's
+    window and bases or the robust fusion's levels (one more compiled call); None when
+    the setting is off."""
+    if encoded is None or not group.config.observations.robot_map_info:
+        return None
     batch = group.batch
-    # The readings are the kernel's own float arrays and the rows distinct: the map's
-    # unchecked update is enough.
-    if changes_map.all():
-        result = batch._update_checked(start, end, rows)
-        frame_changed, inconsistent = result.frame_changed, result.n_inconsistent
-    elif changes_map.any():
-        moving = np.flatnonzero(changes_map)
-        result = batch._update_checked(start[moving], end[moving], rows[moving])
-        frame_changed[moving] = result.frame_changed
-        inconsistent[moving] = result.n_inconsistent
-    state.frame_changed[rows] = frame_changed
+    slots = max(group.config.observations.max_landmarks - 2, group.n - 2)
+    if batch.fusion == "relaxed":
+        encoded += robot_map.encode_window(batch._kernel_state(), group.rows, slots)
+    elif batch.fusion == "robust":
+        encoded += robot_map.encode_levels(batch._kernel_state(), group.rows, slots)
+    else:
+        return robot_map.as_info(robot_map.MAP_ARRAYS, encoded)
+    return robot_map.as_info(batch.state_names, encoded)
 
-    outcome = StepOutcome(
-        rewards=np.empty(size),
-        terminated=np.empty(size, dtype=bool),
-        truncated=np.empty(size, dtype=bool),
-        frame_changed=frame_changed,
-        inconsistent=inconsistent,
-        travelled=travelled,
-        uncertainty=np.empty(size),
-        path_cost=np.empty(size),
-        move_cost=np.empty(size),
+
+# ----------------------------------------------------------------------------------------
+# Movement noise, drawn ahead
+# ----------------------------------------------------------------------------------------
+
+
+def fill_noise(state: BatchState, rows: IntArray, config: EnvConfig) -> None:
+    """Draw the next block of each row's movement noise into its noise buffer, from its
+    generator (the one its last :func:`bind_noise` gave), as many whole moves as fit, up to
+    ``max_moves``: the very draws, in the same order, that the moves would make one at a
+    time, so the readings do not depend on how the draws are blocked.
+
+    The generator's state before the block is kept, so that :func:`release_noise` can
+    hand back the draws the episode did not spend (it ends early, the generator is read,
+    the settings change): then the generator is exactly where drawing move by move
+    would have left it.
+    """
+    noise, epsilon = config.sensor.noise, config.epsilon
+    capacity = state.noise_offsets.shape[1]
+    for row in rows.tolist():
+        release_noise(state, row)
+        rng = state.noise_generators[row]
+        n = int(state.n_landmarks[row])
+        moves = max(1, min(config.task.max_moves, capacity // (2 * n)))
+        values = 2 * n * moves
+        state.noise_marks[row] = (rng.bit_generator.state, noise, epsilon, n)
+        noise.draw_readings(
+            rng,
+            epsilon,
+            state.noise_offsets[row, :values].reshape(2 * moves, n),
+            state.noise_is_outlier[row, :values].reshape(2 * moves, n),
+            state.noise_replacement[row, :values].reshape(2 * moves, n),
+        )
+        state.noise_used[row], state.noise_filled[row] = 0, values
+
+
+def bind_noise(state: BatchState, row: int, rng: np.random.Generator | None) -> None:
+    """Make ``rng`` row ``row``'s noise generator; the draws its old one made ahead and
+    did not spend are handed back to it first (:func:`release_noise`)."""
+    if state.noise_generators[row] is not rng:
+        release_noise(state, row)
+        state.noise_generators[row] = rng
+
+
+def release_noise(state: BatchState, row: int) -> None:
+    """Empty row ``row``'s noise buffer, handing the unspent draws back to its generator:
+    it is rewound to the block's start and the spent draws are made again (once per early
+    episode end: cheap), so it ends where drawing move by move would have left it."""
+    mark = state.noise_marks[row]
+    if mark is None:
+        return
+    state.noise_marks[row] = None
+    used, filled = int(state.noise_used[row]), int(state.noise_filled[row])
+    state.noise_used[row] = state.noise_filled[row] = 0
+    if used == filled:  # every draw was spent: the generator is where it should be
+        return
+    saved, noise, epsilon, n = mark
+    rng = state.noise_generators[row]
+    rng.bit_generator.state = saved
+    readings = used // n
+    offsets = np.empty((readings, n))
+    noise.draw_readings(
+        rng, epsilon, offsets, np.empty(offsets.shape, bool), np.empty(offsets.shape)
     )
-    kernels.finish_steps(
-        rows,
-        group.inputs,
-        travelled,
-        outcome.rewards,
-        outcome.uncertainty,
-        outcome.path_cost,
-        outcome.move_cost,
-        outcome.terminated,
-        outcome.truncated,
-    )
-    return outcome
-
-
-def _draws_for_kernel(draws: NoiseDraws) -> kernels.Draws:
-    """The draws as the kernel takes them; no outliers: an all-False mask."""
-    if draws.is_outlier is None or draws.replacement is None:
-        return draws.offsets, np.zeros(draws.offsets.shape, dtype=bool), draws.offsets
-    return draws.offsets, draws.is_outlier, draws.replacement
-
-
-def reset_outcome(size: int) -> StepOutcome:
-    """The outcome fields a reset reports in its info: nothing moved, nothing earned."""
-    zeros = np.zeros(size)
-    no = np.zeros(size, dtype=bool)
-    return StepOutcome(zeros, no, no, no, np.zeros(size, np.int64), zeros, zeros, zeros, zeros)
 
 
 # ----------------------------------------------------------------------------------------
@@ -502,61 +545,78 @@ def potentials(state: BatchState, group: Group) -> FloatArray:
     return out
 
 
-def observations(state: BatchState, group: Group) -> NDArray[np.float32]:
-    """Observations (len(rows), observation_size) of a group (see the env's Observation
-    Space section)."""
-    size = observation_size(group.config.observations.max_landmarks)
-    out = np.zeros((group.rows.size, size), dtype=np.float32)
-    kernels.write_observations(group.rows, group.inputs, out)
-    return out
-
-
-def infos(state: BatchState, group: Group, outcome: StepOutcome) -> dict[str, Any]:
-    """The group's infos, batched along a first axis (see the env's Info section);
-    ``robot_map`` only with the ``robot_map_info`` setting on."""
-    rows, batch = group.rows, group.batch
-    size, n_mapped = rows.size, group.n - 2
-    areas = np.empty((size, n_mapped))
-    errors = np.empty((size, n_mapped))
-    contains = np.empty((size, n_mapped), dtype=bool)
-    total_area = np.empty(size)
-    robot_error = np.empty(size)
-    kernels.write_infos(rows, group.inputs, areas, errors, contains, total_area, robot_error)
+def infos(
+    report: kernels.Report,
+    robot_map_info: dict[str, Any] | None,
+    sensor: dict[str, Any] | None = None,
+) -> dict[str, Any]:
+    """The group's infos, batched along a first axis (see the env's Info section): the
+    report's arrays themselves, ``robot_map`` unless it is None (the setting off), and
+    the :func:`sensor_info` entries unless they are None."""
     infos: dict[str, Any] = {
-        "landmark_area": areas,
-        "landmark_error": errors,
-        "landmark_contains_truth": contains,
-        "total_area": total_area,
-        "robot_error": robot_error,
-        "frame_changed": outcome.frame_changed,
-        "inconsistent": outcome.inconsistent,
-        "outliers": batch.outliers[rows],
-        "path_length": outcome.travelled,
+        "landmark_area": report.landmark_area,
+        "landmark_error": report.landmark_error,
+        "landmark_contains_truth": report.landmark_contains_truth,
+        "total_area": report.total_area,
+        "robot_error": report.robot_error,
+        "frame_changed": report.frame_changed,
+        "inconsistent": report.inconsistent,
+        "outliers": report.outliers,
+        "path_length": report.path_length,
         "rewards": {
-            "uncertainty": outcome.uncertainty,
-            "path_cost": outcome.path_cost,
-            "move_cost": outcome.move_cost,
+            "uncertainty": report.uncertainty,
+            "path_cost": report.path_cost,
+            "move_cost": report.move_cost,
         },
     }
-    observations = group.config.observations
-    if observations.robot_map_info:
-        infos[robot_map.KEY] = robot_map.encode(batch, rows, observations.max_landmarks - 2)
-    if observations.sensor_info:
-        infos["seen"] = ~np.isnan(state.latest_bearings[rows, : group.n])
-        infos["blocked"] = state.blocked[rows].copy()
+    if robot_map_info is not None:
+        infos[robot_map.KEY] = robot_map_info
+    if sensor is not None:
+        infos.update(sensor)
     return infos
 
 
-def row_info(batched: dict[str, Any], row: int) -> dict[str, Any]:
-    """One env's info dict (Python scalars, per-landmark arrays) from batched infos.
-    The arrays are views of the batched ones: :func:`infos` makes them anew at every
-    call and keeps none, so a view is as private as a copy, and cheaper."""
-    info: dict[str, Any] = {}
-    for key, value in batched.items():
-        if type(value) is dict:
-            info[key] = row_info(value, row)
-        elif value.ndim > 1:
-            info[key] = value[row]
-        else:
-            info[key] = value[row].item()
+def sensor_info(state: BatchState, group: Group) -> dict[str, Any] | None:
+    """The ``sensor_info`` setting's entries, batched: ``seen`` (len(rows), n), which
+    landmarks the last reading saw, and ``blocked``, whether a wall or an obstacle
+    stopped the last move; None with the setting off."""
+    if not group.config.observations.sensor_info:
+        return None
+    rows = group.rows
+    return {
+        "seen": ~np.isnan(state.latest_bearings[rows, : group.n]),
+        "blocked": state.blocked[rows].copy(),
+    }
+
+
+def single_info(
+    report: kernels.Report,
+    robot_map_info: dict[str, Any] | None,
+    sensor: dict[str, Any] | None = None,
+) -> dict[str, Any]:
+    """The info of a group of one row (the single env): Python scalars and per-landmark
+    arrays (views of the report's, which is made anew at every step and kept by no one)."""
+    info: dict[str, Any] = {
+        "landmark_area": report.landmark_area[0],
+        "landmark_error": report.landmark_error[0],
+        "landmark_contains_truth": report.landmark_contains_truth[0],
+        "total_area": report.total_area.item(),
+        "robot_error": report.robot_error.item(),
+        "frame_changed": report.frame_changed.item(),
+        "inconsistent": report.inconsistent.item(),
+        "outliers": report.outliers[0],
+        "path_length": report.path_length.item(),
+        "rewards": {
+            "uncertainty": report.uncertainty.item(),
+            "path_cost": report.path_cost.item(),
+            "move_cost": report.move_cost.item(),
+        },
+    }
+    if robot_map_info is not None:
+        info[robot_map.KEY] = {
+            key: value[0] if value.ndim > 1 else value.item()
+            for key, value in robot_map_info.items()
+        }
+    if sensor is not None:
+        info["seen"], info["blocked"] = sensor["seen"][0], bool(sensor["blocked"][0])
     return info

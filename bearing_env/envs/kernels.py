@@ -1,16 +1,18 @@
-"""Compiled halves of the envs' step (numba): the move, the rewards, the observation and
-the info, for a group of rows at once.
+"""The envs' compiled step (numba): a group of rows moves, reads, updates its maps,
+and gets its rewards, terminations, observations and infos in one call.
 
-These do in one call what would otherwise be dozens of small numpy operations per step;
-:mod:`bearing_env.envs.core` calls them for the single env (a group of one row) and the
-vector env alike, so both compute every number with the same code. Random draws stay
-in Python, where each row's own generator makes them (see ``core.step``).
+:func:`step_rows` is the whole step; :func:`report_rows` the observations and infos
+alone (after a reset). :mod:`bearing_env.envs.core` calls them for the single env (a
+group of one row) and the vector env alike, so both compute every number with the same
+code. The noise of the readings is drawn ahead, in blocks, by each row's own generator
+(``core.fill_noise``) into the rows' noise buffers, which the step reads by index.
 
 Each kernel takes the group's rows, one :class:`InputsRef` (the group's
-:class:`Settings`, its map batch's state and the envs' ``BatchState``: long-lived, so
-made once and typed by numba in about 1 us per call) and its per-call arrays
-positionally (fresh each step; positional arrays are typed fastest: 5 arrays cost 0.6 us
-positionally, 2.2 us as a namedtuple).
+:class:`Settings`, its maps' update settings, its map batch's state and the envs'
+``BatchState``: long-lived, so made once and typed by numba in about 1 us per call) and
+its per-call arrays positionally (positional arrays are typed fastest: 5 arrays cost
+0.6 us positionally, 2.2 us as a namedtuple). Outputs are made in the kernel and
+returned as one tuple: the arrays the infos hand out are new at every step.
 """
 
 from __future__ import annotations
@@ -25,11 +27,15 @@ from numba.experimental import structref
 from numpy.typing import NDArray
 
 from bearing_env.envs.observations import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
+from bearing_env.envs.robot_map import encode_map
 from bearing_env.numerics import JIT_OPTIONS as _JIT
 from bearing_env.numerics import wrap
 from bearing_env.sensing import visible
+from bearing_env.slam.batch import PARALLEL_MIN_MAPS
+from bearing_env.slam.kernels import FRAME_OK, contains_point, update_maps, update_maps_parallel
+from bearing_env.slam.kernels import Outputs as MapOutputs
+from bearing_env.slam.kernels import Params as MapParams
 from bearing_env.slam.kernels import State as MapState
-from bearing_env.slam.kernels import contains_point
 from bearing_env.world import bearing, obstructed_move
 
 if TYPE_CHECKING:  # only for annotations: that module imports this one
@@ -39,7 +45,7 @@ FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
 #: The flat observation's block sizes (numba compile-time constants), from the feature
-#: tuples of :mod:`bearing_env.envs.observations`; :func:`write_observations` writes the
+#: tuples of :mod:`bearing_env.envs.observations`; :func:`_write_observation` writes the
 #: blocks in that module's order.
 _ROBOT_FEATURES = len(ROBOT_FEATURES)
 _LANDMARK_FEATURES = len(LANDMARK_FEATURES)
@@ -74,6 +80,7 @@ class Inputs(NamedTuple):
     """What a group's kernels read and write besides their per-call arrays."""
 
     settings: Settings
+    params: MapParams  #: the group's map update settings (the robot transferred)
     maps: MapState  #: the group's map batch (its slam kernels ``StateRef``)
     state: BatchState  #: the envs' state (its ``BatchStateRef``)
 
@@ -105,15 +112,12 @@ def inputs_ref(inputs: Inputs) -> Inputs:
     return InputsRef(*inputs)  # type: ignore[no-untyped-call, return-value]
 
 
-#: One reading's pre-drawn noise per row, as :func:`move_and_read` takes it: a plain
-#: tuple (offsets, is-outlier mask (all False without outliers), replacements), each
-#: (len(rows), n); numba types a plain tuple of arrays faster than a namedtuple.
-Draws = tuple[FloatArray, BoolArray, FloatArray]
-
-
 @njit(**_JIT)
-def _noisy(true_bearing: float, offset: float, is_outlier: bool, replacement: float) -> float:
-    return wrap(replacement if is_outlier else true_bearing + offset)
+def _noisy(true_bearing: float, state: BatchState, row: int, value: int) -> float:
+    """A reading of ``true_bearing`` with the row's pre-drawn noise value ``value``."""
+    if state.noise_is_outlier[row, value]:
+        return wrap(state.noise_replacement[row, value])
+    return wrap(true_bearing + state.noise_offsets[row, value])
 
 
 @njit(**_JIT)
@@ -123,8 +127,15 @@ def _read(
     """The reading of the landmark at (lx, ly) from a pose: NaN (missed) unless the
     sensor sees it (field of view, range, line of sight)."""
     if visible(
-        x, y, heading, lx, ly, settings.half_fov, settings.max_range,
-        settings.obstacle_vertices, settings.obstacle_starts,
+        x,
+        y,
+        heading,
+        lx,
+        ly,
+        settings.half_fov,
+        settings.max_range,
+        settings.obstacle_vertices,
+        settings.obstacle_starts,
     ):
         return reading
     return math.nan
@@ -132,67 +143,53 @@ def _read(
 
 @njit(**_JIT)
 def move_and_read(
-    rows: np.ndarray,
-    turns: np.ndarray,
-    lengths: np.ndarray,
+    row: int,
+    turn: float,
+    length: float,
     inputs: Inputs,
-    first: Draws,
-    second: Draws,
-    travelled: np.ndarray,
     reading_start: np.ndarray,
     reading_end: np.ndarray,
-) -> None:
-    """Turn, read, move straight until the wall margin or an obstacle's, read again; for
-    each row.
+) -> float:
+    """Turn, read, move straight until the wall margin or an obstacle's, read again: one
+    row's movement; returns the distance travelled.
 
-    The readings are the true bearings plus the rows' pre-drawn noise (``first``,
-    ``second``; see :meth:`~bearing_env.world.NoiseModel.draw_rows`), wrapped, or NaN
-    for a landmark the sensor does not see (:func:`_read`); out in
-    ``reading_start`` and ``reading_end`` (len(rows), n) and ``travelled``. In place:
-    the rows' pose, start position, readings, move count and blocked flag. A robot that
-    could not move at least ``min_baseline`` does not move (see
-    :func:`~bearing_env.world.straight_move`).
+    The readings (out in ``reading_start`` and ``reading_end``, (n,)) are the true
+    bearings plus the row's next pre-drawn noise values (the first reading's ``n``, then
+    the second's), wrapped, or NaN for a landmark the sensor does not see (:func:`_read`;
+    the noise values are spent either way, so the stream does not depend on what is
+    seen). In place: the row's pose, start position, readings, move
+    count, blocked flag and spent noise. A robot that could not move at least
+    ``min_baseline`` does not move (see :func:`~bearing_env.world.straight_move`).
     """
     settings, state = inputs.settings, inputs.state
-    offsets_start, outlier_start, replacement_start = first
-    offsets_end, outlier_end, replacement_end = second
-    for i in range(rows.shape[0]):
-        row = rows[i]
-        heading = wrap(state.headings[row] + turns[i])
-        x, y = state.positions[row, 0], state.positions[row, 1]
-        new_x, new_y, distance, stopped = obstructed_move(
-            x,
-            y,
-            heading,
-            lengths[i],
-            (settings.width, settings.height, settings.margin, settings.min_baseline),
-            settings.obstacle_vertices,
-            settings.obstacle_starts,
-        )
-        for j in range(settings.n):
-            lx, ly = state.landmarks[row, j, 0], state.landmarks[row, j, 1]
-            reading = _noisy(
-                bearing(lx, ly, x, y, heading),
-                offsets_start[i, j],
-                outlier_start[i, j],
-                replacement_start[i, j],
-            )
-            reading = _read(settings, x, y, heading, lx, ly, reading)
-            reading_start[i, j] = state.start_bearings[row, j] = reading
-            reading = _noisy(
-                bearing(lx, ly, new_x, new_y, heading),
-                offsets_end[i, j],
-                outlier_end[i, j],
-                replacement_end[i, j],
-            )
-            reading = _read(settings, new_x, new_y, heading, lx, ly, reading)
-            reading_end[i, j] = state.latest_bearings[row, j] = reading
-        state.start_positions[row, 0], state.start_positions[row, 1] = x, y
-        state.positions[row, 0], state.positions[row, 1] = new_x, new_y
-        state.headings[row] = heading
-        state.blocked[row] = stopped
-        state.moves[row] += 1
-        travelled[i] = distance
+    n = settings.n
+    heading = wrap(state.headings[row] + turn)
+    x, y = state.positions[row, 0], state.positions[row, 1]
+    new_x, new_y, distance, stopped = obstructed_move(
+        x,
+        y,
+        heading,
+        length,
+        (settings.width, settings.height, settings.margin, settings.min_baseline),
+        settings.obstacle_vertices,
+        settings.obstacle_starts,
+    )
+    first = state.noise_used[row]
+    for j in range(n):
+        lx, ly = state.landmarks[row, j, 0], state.landmarks[row, j, 1]
+        reading = _noisy(bearing(lx, ly, x, y, heading), state, row, first + j)
+        reading = _read(settings, x, y, heading, lx, ly, reading)
+        reading_start[j] = state.start_bearings[row, j] = reading
+        reading = _noisy(bearing(lx, ly, new_x, new_y, heading), state, row, first + n + j)
+        reading = _read(settings, new_x, new_y, heading, lx, ly, reading)
+        reading_end[j] = state.latest_bearings[row, j] = reading
+    state.noise_used[row] = first + 2 * n
+    state.start_positions[row, 0], state.start_positions[row, 1] = x, y
+    state.positions[row, 0], state.positions[row, 1] = new_x, new_y
+    state.headings[row] = heading
+    state.blocked[row] = stopped
+    state.moves[row] += 1
+    return distance
 
 
 @njit(**_JIT)
@@ -240,38 +237,79 @@ def potentials(rows: np.ndarray, inputs: Inputs, out: np.ndarray) -> None:
         out[i] = _potential(inputs.settings, inputs.maps.areas[rows[i]])
 
 
+#: Outcomes of :func:`step_rows`: done, or nothing done because some row needs more
+#: pre-drawn noise (``core.fill_noise``) or a longer trajectory array.
+STEP_DONE = 0
+STEP_NEEDS_NOISE = 1
+STEP_NEEDS_TRAJECTORY = 2
+
+
+class Report(NamedTuple):
+    """What a step (or a reset) of a group gives, per row (arrays of the group's length):
+    the observations, the rewards and episode ends, and the infos' arrays (see the env's
+    Info section; the reward parts sum to the reward)."""
+
+    observations: NDArray[np.float32]
+    rewards: FloatArray
+    terminated: BoolArray
+    truncated: BoolArray
+    frame_changed: BoolArray
+    inconsistent: NDArray[np.int64]
+    path_length: FloatArray
+    uncertainty: FloatArray
+    path_cost: FloatArray
+    move_cost: FloatArray
+    landmark_area: FloatArray
+    landmark_error: FloatArray
+    landmark_contains_truth: BoolArray
+    total_area: FloatArray
+    robot_error: FloatArray
+    outliers: NDArray[np.int64]
+
+
 @njit(**_JIT)
-def finish_steps(
-    rows: np.ndarray,
-    inputs: Inputs,
-    travelled: np.ndarray,
-    reward: np.ndarray,
-    uncertainty: np.ndarray,
-    path: np.ndarray,
-    move: np.ndarray,
-    terminated: np.ndarray,
-    truncated: np.ndarray,
-) -> None:
-    """Rewards (with their named parts), terminations and truncations after the map
-    update; the rows' potentials and done flags are updated in place."""
+def _new_report(size: int, n_mapped: int, observation_size: int) -> Report:
+    """A report of ``size`` rows: zero observations and reward parts, no episode end."""
+    return Report(
+        np.zeros((size, observation_size), np.float32),
+        np.zeros(size),
+        np.zeros(size, np.bool_),
+        np.zeros(size, np.bool_),
+        np.zeros(size, np.bool_),
+        np.zeros(size, np.int64),
+        np.zeros(size),
+        np.zeros(size),
+        np.zeros(size),
+        np.zeros(size),
+        np.empty((size, n_mapped)),
+        np.empty((size, n_mapped)),
+        np.empty((size, n_mapped), np.bool_),
+        np.empty(size),
+        np.empty(size),
+        np.empty((size, n_mapped), np.int64),
+    )
+
+
+@njit(**_JIT)
+def _finish_row(i: int, row: int, inputs: Inputs, report: Report) -> None:
+    """Row ``row``'s reward (with its named parts), termination and truncation after its
+    map update; its potential and done flag are updated in place."""
     settings, maps, state = inputs.settings, inputs.maps, inputs.state
-    for i in range(rows.shape[0]):
-        row = rows[i]
-        potential = _potential(settings, maps.areas[row])
-        uncertainty[i] = state.potentials[row] - potential
-        path[i] = -settings.path_cost * travelled[i]
-        move[i] = -settings.move_cost
-        # 0.0 + turns an uncertainty of -0.0 into 0.0; the order of the sum is fixed.
-        reward[i] = ((0.0 + uncertainty[i]) + path[i]) + move[i]
-        state.potentials[row] = potential
-        success = True
-        for j in range(settings.n - 2):
-            if maps.counts[row, j] == 0 or not maps.areas[row, j] <= settings.target_area:
-                success = False
-                break
-        terminated[i] = success
-        truncated[i] = not success and state.moves[row] >= settings.max_moves
-        state.done[row] = terminated[i] or truncated[i]
+    potential = _potential(settings, maps.areas[row])
+    report.uncertainty[i] = state.potentials[row] - potential
+    report.path_cost[i] = -settings.path_cost * report.path_length[i]
+    report.move_cost[i] = -settings.move_cost
+    # 0.0 + turns an uncertainty of -0.0 into 0.0; the order of the sum is fixed.
+    report.rewards[i] = ((0.0 + report.uncertainty[i]) + report.path_cost[i]) + report.move_cost[i]
+    state.potentials[row] = potential
+    success = True
+    for j in range(settings.n - 2):
+        if maps.counts[row, j] == 0 or not maps.areas[row, j] <= settings.target_area:
+            success = False
+            break
+    report.terminated[i] = success
+    report.truncated[i] = not success and state.moves[row] >= settings.max_moves
+    state.done[row] = report.terminated[i] or report.truncated[i]
 
 
 @njit(**_JIT)
@@ -280,88 +318,203 @@ def _coordinate(value: float, limit: float) -> float:
 
 
 @njit(**_JIT)
-def write_observations(rows: np.ndarray, inputs: Inputs, out: np.ndarray) -> None:
-    """The observations (len(rows), size) of a group, float32 (the env's Observation
-    Space section documents every element); ``out`` must be zeros."""
+def _write_observation(row: int, inputs: Inputs, out: np.ndarray) -> None:
+    """Row ``row``'s observation, float32, into ``out`` (zeros); the env's Observation
+    Space section documents every element."""
     settings, maps, state = inputs.settings, inputs.maps, inputs.state
     floor, cap, limit = settings.floor, settings.cap, settings.coordinate_limit
     bearings_at = _ROBOT_FEATURES + _LANDMARK_FEATURES * (settings.n_slots - 2)
-    log_cap = math.log(cap)
-    for i in range(rows.shape[0]):
-        row = rows[i]
-        centroid = maps.robot_centroid[row]
-        known = (
-            maps.robot_counts[row] > 0 and np.isfinite(centroid.real) and np.isfinite(centroid.imag)
-        )
-        if known:
-            out[i, 0] = _coordinate(centroid.real, limit)
-            out[i, 1] = _coordinate(centroid.imag, limit)
-            out[i, 2] = math.log(capped(maps.robot_area[row], floor, cap))
+    centroid = maps.robot_centroid[row]
+    known = maps.robot_counts[row] > 0 and np.isfinite(centroid.real) and np.isfinite(centroid.imag)
+    if known:
+        out[0] = _coordinate(centroid.real, limit)
+        out[1] = _coordinate(centroid.imag, limit)
+        out[2] = math.log(capped(maps.robot_area[row], floor, cap))
+    else:
+        out[2] = math.log(cap)
+        out[3] = 1.0
+    heading = maps.robot_heading[row]
+    if np.isfinite(heading):
+        out[4] = math.cos(heading)
+        out[5] = math.sin(heading)
+    out[6] = min(state.moves[row] / settings.max_moves, 1.0)
+    out[7] = 1.0 if state.frame_changed[row] else 0.0
+    out[8] = 1.0 if state.blocked[row] else 0.0
+    for j in range(settings.n - 2):
+        at = _ROBOT_FEATURES + _LANDMARK_FEATURES * j
+        out[at] = 1.0
+        if maps.counts[row, j] > 0:
+            out[at + 2] = _coordinate(maps.centroids[row, j].real, limit)
+            out[at + 3] = _coordinate(maps.centroids[row, j].imag, limit)
         else:
-            out[i, 2] = log_cap
-            out[i, 3] = 1.0
-        heading = maps.robot_heading[row]
-        if np.isfinite(heading):
-            out[i, 4] = math.cos(heading)
-            out[i, 5] = math.sin(heading)
-        out[i, 6] = min(state.moves[row] / settings.max_moves, 1.0)
-        out[i, 7] = 1.0 if state.frame_changed[row] else 0.0
-        out[i, 8] = 1.0 if state.blocked[row] else 0.0
-        for j in range(settings.n - 2):
-            at = _ROBOT_FEATURES + _LANDMARK_FEATURES * j
-            out[i, at] = 1.0
-            if maps.counts[row, j] > 0:
-                out[i, at + 2] = _coordinate(maps.centroids[row, j].real, limit)
-                out[i, at + 3] = _coordinate(maps.centroids[row, j].imag, limit)
-            else:
-                out[i, at + 1] = 1.0
-            out[i, at + 4] = math.log(capped(maps.areas[row, j], floor, cap))
-        latest = state.latest_bearings
-        for k in range(settings.n):
-            at = bearings_at + _BEARING_FEATURES * k
-            out[i, at] = 1.0
-            if not math.isnan(latest[row, k]):  # a missed reading reads (0, 0)
-                out[i, at + 1] = math.cos(latest[row, k])
-                out[i, at + 2] = math.sin(latest[row, k])
+            out[at + 1] = 1.0
+        out[at + 4] = math.log(capped(maps.areas[row, j], floor, cap))
+    latest = state.latest_bearings
+    for k in range(settings.n):
+        at = bearings_at + _BEARING_FEATURES * k
+        out[at] = 1.0
+        if not math.isnan(latest[row, k]):  # a missed reading reads (0, 0)
+            out[at + 1] = math.cos(latest[row, k])
+            out[at + 2] = math.sin(latest[row, k])
 
 
 @njit(**_JIT)
-def write_infos(
+def _write_info(i: int, row: int, inputs: Inputs, report: Report) -> None:
+    """The ground-truth parts of row ``row``'s info (see the env's Info section)."""
+    settings, maps, state = inputs.settings, inputs.maps, inputs.state
+    total = 0.0
+    for j in range(settings.n - 2):
+        area = maps.areas[row, j]
+        report.landmark_area[i, j] = area
+        total += area
+        report.outliers[i, j] = maps.outliers[row, j]
+        count = maps.counts[row, j]
+        if count > 0:
+            truth = state.landmarks_fl[row, j]
+            report.landmark_error[i, j] = abs(maps.centroids[row, j] - truth)
+            report.landmark_contains_truth[i, j] = contains_point(
+                maps.vertices[row, j], count, truth, settings.tolerance
+            )
+        else:
+            report.landmark_error[i, j] = np.inf
+            report.landmark_contains_truth[i, j] = False
+    report.total_area[i] = total
+    centroid = maps.robot_centroid[row]
+    if np.isfinite(centroid.real) and np.isfinite(centroid.imag):
+        position = complex(state.positions[row, 0], state.positions[row, 1])
+        truth = (position - state.frame_origin[row]) / state.frame_unit[row]
+        report.robot_error[i] = abs(centroid - truth)
+    else:
+        report.robot_error[i] = np.inf
+
+
+@njit(**_JIT)
+def _observe(rows: np.ndarray, inputs: Inputs, report: Report) -> None:
+    """Observations and infos of ``rows`` into ``report``."""
+    for i in range(rows.shape[0]):
+        _write_observation(rows[i], inputs, report.observations[i])
+        _write_info(i, rows[i], inputs, report)
+
+
+@njit(**_JIT)
+def _observation_size(settings: Settings) -> int:
+    slots = settings.n_slots
+    return _ROBOT_FEATURES + _LANDMARK_FEATURES * (slots - 2) + _BEARING_FEATURES * slots
+
+
+@njit(**_JIT)
+def report_rows(rows: np.ndarray, inputs: Inputs, map_slots: int) -> Any:
+    """The report of ``rows`` as they stand (after a reset: nothing moved, nothing
+    earned), with their robot map's encoded arrays (``robot_map.encode``'s, with
+    ``map_slots`` landmark slots, the relaxed fusion's window aside)."""
+    settings = inputs.settings
+    report = _new_report(rows.shape[0], settings.n - 2, _observation_size(settings))
+    _observe(rows, inputs, report)
+    return report, encode_map(inputs.maps, rows, max(map_slots, settings.n - 2))
+
+
+@njit(**_JIT)
+def _room_for_step(
+    rows: np.ndarray, inputs: Inputs, trajectory_length: np.ndarray, capacity: int
+) -> int:
+    """:data:`STEP_DONE` if every row has the noise and trajectory room for one more move,
+    else what is missing."""
+    state, n = inputs.state, inputs.settings.n
+    for row in rows:
+        if state.noise_used[row] + 2 * n > state.noise_filled[row]:
+            return STEP_NEEDS_NOISE
+    for row in rows:
+        if trajectory_length[row] >= capacity:
+            return STEP_NEEDS_TRAJECTORY
+    return STEP_DONE
+
+
+@njit(**_JIT)
+def _update_maps(
+    start: np.ndarray,
+    end: np.ndarray,
     rows: np.ndarray,
     inputs: Inputs,
-    landmark_area: np.ndarray,
-    landmark_error: np.ndarray,
-    contains_truth: np.ndarray,
-    total_area: np.ndarray,
-    robot_error: np.ndarray,
+    threads: int,
+    report: Report,
 ) -> None:
-    """The ground-truth parts of a group's infos (see the env's Info section)."""
-    settings, maps, state = inputs.settings, inputs.maps, inputs.state
-    for i in range(rows.shape[0]):
+    """Fuse the movements of ``rows`` that changed frames (travelled at least
+    ``min_baseline``: a move that could not start took both readings from the same place,
+    so there is no robot frame and the map must not see it) into their maps, on
+    ``threads`` threads for batches of at least ``PARALLEL_MIN_MAPS`` maps."""
+    moving = np.flatnonzero(report.path_length >= inputs.settings.min_baseline)
+    size, n = moving.shape[0], start.shape[1]
+    if size == 0:
+        return
+    out = MapOutputs(
+        np.empty(size, np.int8), np.empty((size, n - 2), np.int8), np.empty(size, np.int64)
+    )
+    if size < rows.shape[0]:
+        start, end = start[moving], end[moving]
+    if threads > 1 and size >= PARALLEL_MIN_MAPS:
+        update_maps_parallel(
+            min(size, threads), start, end, rows[moving], inputs.params, inputs.maps, out
+        )
+    else:
+        update_maps(start, end, rows[moving], inputs.params, inputs.maps, out)
+    for k in range(size):
+        report.frame_changed[moving[k]] = out.frame_status[k] == FRAME_OK
+        report.inconsistent[moving[k]] = out.n_bad[k]
+
+
+@njit(**_JIT)
+def step_rows_bare(
+    rows: np.ndarray,
+    turns: np.ndarray,
+    lengths: np.ndarray,
+    inputs: Inputs,
+    trajectory: np.ndarray,
+    threads: int,
+) -> tuple[int, Report]:
+    """One movement of every row of a group: turn, read, move straight (stopped at the
+    wall), read, update the map; then rewards, terminations, truncations, observations
+    and infos. Returns ``(status, report)``; unless the status is :data:`STEP_DONE`,
+    nothing was done (and the report is of no row). ``turns`` and ``lengths`` are the
+    decoded actions (radians, metres); ``trajectory`` is the state's (replaced when it
+    grows). Maps of at least ``PARALLEL_MIN_MAPS`` rows are updated on ``threads``
+    threads."""
+    settings, state = inputs.settings, inputs.state
+    size, n = rows.shape[0], settings.n
+    status = _room_for_step(rows, inputs, state.trajectory_length, trajectory.shape[1])
+    report = _new_report(size if status == STEP_DONE else 0, n - 2, _observation_size(settings))
+    if status != STEP_DONE:
+        return status, report
+    start, end = np.empty((size, n)), np.empty((size, n))
+    for i in range(size):
         row = rows[i]
-        total = 0.0
-        for j in range(settings.n - 2):
-            area = maps.areas[row, j]
-            landmark_area[i, j] = area
-            total += area
-            count = maps.counts[row, j]
-            if count > 0:
-                truth = state.landmarks_fl[row, j]
-                landmark_error[i, j] = abs(maps.centroids[row, j] - truth)
-                contains_truth[i, j] = contains_point(
-                    maps.vertices[row, j], count, truth, settings.tolerance
-                )
-            else:
-                landmark_error[i, j] = np.inf
-                contains_truth[i, j] = False
-        total_area[i] = total
-        centroid = maps.robot_centroid[row]
-        if np.isfinite(centroid.real) and np.isfinite(centroid.imag):
-            position = complex(state.positions[row, 0], state.positions[row, 1])
-            truth = (position - state.frame_origin[row]) / state.frame_unit[row]
-            robot_error[i] = abs(centroid - truth)
-        else:
-            robot_error[i] = np.inf
+        report.path_length[i] = move_and_read(row, turns[i], lengths[i], inputs, start[i], end[i])
+        at = state.trajectory_length[row]
+        trajectory[row, at, 0] = state.positions[row, 0]
+        trajectory[row, at, 1] = state.positions[row, 1]
+        state.trajectory_length[row] = at + 1
+    _update_maps(start, end, rows, inputs, threads, report)
+    for i in range(size):
+        state.frame_changed[rows[i]] = report.frame_changed[i]
+        _finish_row(i, rows[i], inputs, report)
+    _observe(rows, inputs, report)
+    return STEP_DONE, report
+
+
+@njit(**_JIT)
+def step_rows(
+    rows: np.ndarray,
+    turns: np.ndarray,
+    lengths: np.ndarray,
+    inputs: Inputs,
+    trajectory: np.ndarray,
+    threads: int,
+    map_slots: int,
+) -> Any:
+    """:func:`step_rows_bare`, with the robot map's encoded arrays after the report (as
+    :func:`report_rows`; of no row unless the status is :data:`STEP_DONE`)."""
+    status, report = step_rows_bare(rows, turns, lengths, inputs, trajectory, threads)
+    done = rows if status == STEP_DONE else rows[:0]
+    return status, report, encode_map(inputs.maps, done, max(map_slots, inputs.settings.n - 2))
 
 
 #: Outcomes of :func:`decode_continuous`.

@@ -2,7 +2,7 @@
 space and its conversion from the flat vector the kernels write.
 
 Every observation starts as the flat vector (float32) that
-:func:`bearing_env.envs.kernels.write_observations` writes: the robot block
+``bearing_env.envs.kernels._write_observation`` writes: the robot block
 (:data:`ROBOT_FEATURES`), one block per mapped landmark slot L3, L4, ...
 (:data:`LANDMARK_FEATURES`), then one block per bearing slot L1, L2, ...
 (:data:`BEARING_FEATURES`). The kernels' block sizes are the lengths of these tuples.

@@ -28,13 +28,22 @@ from numpy.typing import NDArray
 
 from bearing_env.numerics import JIT_OPTIONS
 from bearing_env.slam import MapSettings, PolygonSLAM
-from bearing_env.slam.batch import LANDMARK_AXES, BatchedPolygonSLAM
+from bearing_env.slam.batch import (
+    LANDMARK_AXES,
+    RELAXED_STATE_ARRAYS,
+    STATE_ARRAYS,
+    BatchedPolygonSLAM,
+)
 
 #: The info key of the robot's own map: the one key of an info robot policies read.
 KEY = "robot_map"
 #: Fill of the empty landmark slots (default 0: count 0 is an empty region), as the
-#: compiled encoding (:func:`_encode_map`, :func:`_encode_window`) writes them.
+#: compiled encoding (:func:`encode_map`, :func:`encode_window`) writes them.
 PADDING: dict[str, Any] = {"areas": np.inf, "centroids": complex(np.inf, np.inf)}
+#: The arrays every fusion uses, as :func:`encode_map` gives them (the relaxed fusion's
+#: are these, then :data:`~bearing_env.slam.batch.RELAXED_STATE_ARRAYS`; the robust
+#: fusion's, these, then :data:`~bearing_env.slam.batch.ROBUST_STATE_ARRAYS`).
+MAP_ARRAYS: tuple[str, ...] = STATE_ARRAYS[: STATE_ARRAYS.index(RELAXED_STATE_ARRAYS[0])]
 #: The arrays whose unknown values (NaN in the map) are inf in an info.
 UNKNOWN_AS_INF: tuple[str, ...] = ("centroids", "robot_centroid", "robot_heading")
 
@@ -44,19 +53,27 @@ def encode(batch: BatchedPolygonSLAM, rows: NDArray[np.int64], slots: int) -> di
     first), per-landmark arrays padded to ``slots`` landmark slots.
 
     One compiled call gathers every array at once, already in the canonical form, into
-    arrays it makes (:func:`_encode_map`, and :func:`_encode_window` for the relaxed
+    arrays it makes (:func:`encode_map`, and :func:`encode_window` for the relaxed
     fusion's window and bases): a Python loop over the arrays costs several times more."""
     state, slots = batch._kernel_state(), max(int(slots), batch.n_landmarks - 2)
-    arrays = _encode_map(state, rows, slots)
+    arrays = encode_map(state, rows, slots)
     if batch.fusion == "relaxed":
-        arrays += _encode_window(state, rows, slots)
+        arrays += encode_window(state, rows, slots)
     elif batch.fusion == "robust":
-        arrays += _encode_levels(state, rows, slots)
+        arrays += encode_levels(state, rows, slots)
+    return as_info(batch.state_names, arrays)
+
+
+def as_info(names: tuple[str, ...], arrays: tuple[NDArray[Any], ...]) -> dict[str, Any]:
+    """The info's dict of encoded ``arrays`` (:func:`encode_map`'s, then, for the relaxed
+    fusion, :func:`encode_window`'s, or for the robust fusion, :func:`encode_levels`'s),
+    named ``names``: complex points become (x, y) pairs on a last axis (views, not
+    copies)."""
     return {
         name: values.view(np.float64).reshape(*values.shape, 2)
         if values.dtype.kind == "c"
         else values
-        for name, values in zip(batch.state_names, arrays, strict=True)
+        for name, values in zip(names, arrays, strict=True)
     }
 
 
@@ -69,7 +86,7 @@ def _known(value: complex) -> complex:  # pragma: no cover  (compiled)
 
 
 @njit(**JIT_OPTIONS)
-def _encode_map(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
+def encode_map(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
     """The arrays every fusion uses (``STATE_ARRAYS`` up to ``n_inconsistent``), in
     their order, for ``rows``: landmark slots padded to ``slots`` (see the module doc)."""
     size, mapped, capacity = rows.size, state.counts.shape[1], state.vertices.shape[2]
@@ -120,8 +137,8 @@ def _encode_map(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  
 
 
 @njit(**JIT_OPTIONS)
-def _encode_window(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
-    """The relaxed fusion's arrays (``RELAXED_STATE_ARRAYS``), as :func:`_encode_map`."""
+def encode_window(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
+    """The relaxed fusion's arrays (``RELAXED_STATE_ARRAYS``), as :func:`encode_map`."""
     size, mapped = rows.size, state.counts.shape[1]
     window, capacity = state.window_vertices.shape[1], state.window_vertices.shape[3]
     base_capacity = state.base_vertices.shape[2]
@@ -167,7 +184,7 @@ def _encode_window(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cove
 
 
 @njit(**JIT_OPTIONS)
-def _encode_levels(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
+def encode_levels(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
     """The robust fusion's arrays (``ROBUST_STATE_ARRAYS``), as :func:`_encode_map`."""
     size, mapped = rows.size, state.counts.shape[1]
     levels, capacity = state.level_vertices.shape[2], state.level_vertices.shape[3]

@@ -4,11 +4,10 @@
 (a structure of arrays); its field list is the only place these arrays are listed
 (:data:`STATE_ARRAYS`). The kernels of :mod:`bearing_env.envs.kernels` reach it through
 a :class:`BatchStateRef`, a numba ``structref`` of the same arrays (all but the
-trajectory, :data:`KERNEL_ARRAYS`) that the state makes once
-(:meth:`BatchState.kernel_ref`) and that goes into the group's ``kernels.InputsRef``.
-A namedtuple would be typed field by field on every call (3.5 us for 14 arrays against
-1.3 us for a structref, measured here), in each of the single env's four kernel calls
-per step.
+trajectory and the noise generators and marks, :data:`KERNEL_ARRAYS`) that the state
+makes once (:meth:`BatchState.kernel_ref`) and that goes into the group's
+``kernels.InputsRef``. A namedtuple would be typed field by field on every call (3.5 us
+for 14 arrays against 1.3 us for a structref, measured here).
 """
 
 from __future__ import annotations
@@ -32,6 +31,10 @@ ComplexArray = NDArray[np.complex128]
 
 #: Trajectory slots allocated per row at first; the array doubles when a row fills it.
 INITIAL_TRAJECTORY_SLOTS = 32
+#: Noise values (one per bearing of a reading) a row's noise buffer holds, at least: a
+#: block of whole moves (two readings of ``n`` bearings each), up to ``max_moves`` of
+#: them, is drawn at once (see ``core.fill_noise``). 512 holds 64 moves of 4 landmarks.
+NOISE_BLOCK_VALUES = 512
 
 
 @dataclass
@@ -71,6 +74,20 @@ class BatchState:
     #: ``trajectory_length[i]`` entries of row ``i`` are used.
     trajectory: FloatArray
     trajectory_length: IntArray
+    #: Each row's movement noise, drawn ahead in blocks from its generator (see
+    #: ``core.fill_noise``): per value, the offset, whether it is an outlier (or a miss)
+    #: and its replacement bearing. Reading ``k`` of the block, bearing ``j``, is value
+    #: ``k * n + j``; ``noise_used`` values of the ``noise_filled`` ones are spent.
+    noise_offsets: FloatArray
+    noise_is_outlier: BoolArray
+    noise_replacement: FloatArray
+    noise_used: IntArray
+    noise_filled: IntArray
+    #: Per row, its generator (the env's ``np_random``; None before the first reset), and
+    #: what rewinds it to just after the draws spent (None without a block): its state
+    #: before the block, the noise model, epsilon and the landmark count.
+    noise_generators: list[Any]
+    noise_marks: list[Any]
 
     @classmethod
     def empty(cls, num_rows: int, slots: int) -> BatchState:
@@ -94,6 +111,13 @@ class BatchState:
             done=np.zeros(n, dtype=bool),
             trajectory=np.zeros((n, INITIAL_TRAJECTORY_SLOTS, 2)),
             trajectory_length=np.zeros(n, dtype=np.int64),
+            noise_offsets=np.zeros((n, max(NOISE_BLOCK_VALUES, 2 * slots))),
+            noise_is_outlier=np.zeros((n, max(NOISE_BLOCK_VALUES, 2 * slots)), dtype=bool),
+            noise_replacement=np.zeros((n, max(NOISE_BLOCK_VALUES, 2 * slots))),
+            noise_used=np.zeros(n, dtype=np.int64),
+            noise_filled=np.zeros(n, dtype=np.int64),
+            noise_generators=[None] * n,
+            noise_marks=[None] * n,
         )
 
     @property
@@ -105,12 +129,15 @@ class BatchState:
         if not kernels.append_positions(
             rows, self.positions, self.trajectory, self.trajectory_length
         ):
-            # Some row is full: double the capacity (for every row) and record again.
-            capacity = self.trajectory.shape[1]
-            grown = np.zeros((self.num_rows, 2 * capacity, 2))
-            grown[:, :capacity] = self.trajectory
-            self.trajectory = grown
+            self.grow_trajectory()
             kernels.append_positions(rows, self.positions, self.trajectory, self.trajectory_length)
+
+    def grow_trajectory(self) -> None:
+        """Double the trajectory's capacity (for every row): some row has filled it."""
+        capacity = self.trajectory.shape[1]
+        grown = np.zeros((self.num_rows, 2 * capacity, 2))
+        grown[:, :capacity] = self.trajectory
+        self.trajectory = grown
 
     def kernel_ref(self) -> BatchState:
         """This state as the kernels take it: a :class:`BatchStateRef` to the same arrays
@@ -145,8 +172,11 @@ class BatchState:
 #: The state's arrays, in field order.
 STATE_ARRAYS: tuple[str, ...] = tuple(f.name for f in fields(BatchState))
 #: The fields of a :class:`BatchStateRef`: all but the trajectory, the one array that is
-#: replaced (when it grows), so that a reference, once made, stays valid.
-KERNEL_ARRAYS: tuple[str, ...] = tuple(name for name in STATE_ARRAYS if name != "trajectory")
+#: replaced (when it grows; the step kernel takes it as an argument), so that a
+#: reference, once made, stays valid, and the noise marks (Python objects).
+KERNEL_ARRAYS: tuple[str, ...] = tuple(
+    name for name in STATE_ARRAYS if name not in ("trajectory", "noise_generators", "noise_marks")
+)
 
 
 @structref.register

@@ -142,14 +142,23 @@ class SearchReport:
     @property
     def defects(self) -> int:
         return (
-            self.not_simple_convex + self.shapely_invalid + self.area_mismatches
-            + self.misses + self.nonfinite
+            self.not_simple_convex
+            + self.shapely_invalid
+            + self.area_mismatches
+            + self.misses
+            + self.nonfinite
         )
 
     def add(self, other: SearchReport, max_examples: int = 10) -> None:
         for name in (
-            "movements", "regions", "not_simple_convex", "shapely_invalid",
-            "area_mismatches", "containment_checks", "misses", "nonfinite",
+            "movements",
+            "regions",
+            "not_simple_convex",
+            "shapely_invalid",
+            "area_mismatches",
+            "containment_checks",
+            "misses",
+            "nonfinite",
         ):
             setattr(self, name, getattr(self, name) + getattr(other, name))
         self.examples.extend(other.examples[: max_examples - len(self.examples)])

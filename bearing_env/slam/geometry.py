@@ -106,9 +106,7 @@ def relaxed_intersection(
         maps.window_counts[0, i, 0] = vertices.size
     scratch = kernels.new_scratch()
     scratch.slots[:k] = np.arange(k)
-    n, q = kernels.relaxed_region(
-        maps._kernel_state(), 0, 0, k, False, int(max_outliers), scratch
-    )
+    n, q = kernels.relaxed_region(maps._kernel_state(), 0, 0, k, False, int(max_outliers), scratch)
     return scratch.acc[:n].copy(), int(q), maps.window_inlier[0, :, 0].copy()
 
 

@@ -95,8 +95,17 @@ def transfer_vertices(
     hull = np.empty(cloud.size + 1, dtype=np.complex128)
     out = np.empty(max(cloud.size + 1, kernels.SCRATCH), dtype=np.complex128)
     frame = kernels.FrameChange(
-        p1, int(p1.size), p2, int(p2.size), h1, inv_d, int(n_pairs), conservative,
-        float(distance), float(delta1), float(delta2),
+        p1,
+        int(p1.size),
+        p2,
+        int(p2.size),
+        h1,
+        inv_d,
+        int(n_pairs),
+        conservative,
+        float(distance),
+        float(delta1),
+        float(delta2),
     )
     n = kernels.transfer_region(target, target.size, frame, cloud, hull, out)
     return out[:n].copy()

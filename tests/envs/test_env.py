@@ -765,7 +765,9 @@ def test_the_envs_own_arrays_are_writable_after_a_read_only_unpickle(env_id: str
     env.reset(seed=0)
     clone = _read_only_clone(env)
     state = clone._state
-    for name, value in vars(state).items():
+    arrays = {name: value for name, value in vars(state).items() if isinstance(value, np.ndarray)}
+    assert "positions" in arrays and "noise_offsets" in arrays
+    for name, value in arrays.items():
         assert value.flags.writeable, name
     assert clone._rows.flags.writeable  # the step kernels' row indices
 
@@ -783,7 +785,8 @@ def test_packed_obstacles_are_not_pickled_but_made_again() -> None:
 
 def test_a_read_only_unpickle_steps_in_a_fresh_process(tmp_path: Path) -> None:
     """Ray's case: the env arrives in a new process whose numba kernels load from the
-    cache, with read-only buffers (once a segfault in the step kernel)."""
+    cache, with read-only buffers (once a segfault in the step kernel: the parallel
+    runtime unstarted, see ``tests/slam/test_parallel_runtime.py``)."""
     env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=5)
     env.reset(seed=11)
     env.action_space.seed(5)
@@ -896,3 +899,21 @@ def test_observation_kind_is_validated_and_fixed() -> None:
         env.observation_kind = "flat"
     with pytest.raises(ValueError, match="observation cannot change"):
         env.config = env.config.replace(observation="flat")
+
+
+def test_reading_the_generator_mid_episode_changes_nothing_but_the_draws_it_makes() -> None:
+    """The env draws its moves' noise ahead; reading ``np_random`` hands the unspent draws
+    back, so a draw from it is the one it would be had the env drawn move by move, and the
+    episode goes on the same when nothing is drawn."""
+    actions = np.random.default_rng(3).uniform(-1, 1, (8, 2)).astype(np.float32)
+    read, plain = (gym.make("BearingSLAM-v0", scenario="khepera").unwrapped for _ in range(2))
+    read.reset(seed=5)
+    plain.reset(seed=5)
+    for k, action in enumerate(actions):
+        if k == 4:
+            assert isinstance(read.np_random, np.random.Generator)
+        got, want = read.step(action), plain.step(action)
+        np.testing.assert_array_equal(got[0], want[0])
+        assert got[1] == want[1]
+    # Both generators are now where eight moves' draws left them.
+    assert read.np_random.random() == plain.np_random.random()

@@ -25,35 +25,35 @@ def started_batch(
 def test_a_batch_steps_as_its_rows_one_at_a_time() -> None:
     config = EnvConfig.create(n_landmarks=6, noise={"kind": "gaussian", "outlier_rate": 0.1})
     n = 5
-    batch, batch_maps, batch_rngs = started_batch(config, n, seed=10)
+    batch, batch_maps, _batch_rngs = started_batch(config, n, seed=10)
     singles = [started_batch(config, 1, seed=10 + row) for row in range(n)]
     actions = np.random.default_rng(0).uniform(-1, 1, (6, n, 2))
     all_rows, one = np.arange(n), np.array([0])
     for step_actions in actions:
         turns, lengths = CONTINUOUS.decode(config, step_actions)
         group = batch_maps.group(batch, all_rows, config)
-        outcome = core.step(batch, group, turns, lengths, batch_rngs)
-        observations = core.observations(batch, group)
-        for row, (state, maps, rngs) in enumerate(singles):
+        outcome, _ = core.step(batch, group, turns, lengths)
+        for row, (state, maps, _rngs) in enumerate(singles):
             alone = maps.group(state, one, config)
-            single = core.step(state, alone, turns[row : row + 1], lengths[row : row + 1], rngs)
+            single, _ = core.step(state, alone, turns[row : row + 1], lengths[row : row + 1])
             assert single.rewards[0] == outcome.rewards[row]
             assert single.frame_changed[0] == outcome.frame_changed[row]
-            assert np.array_equal(core.observations(state, alone)[0], observations[row])
+            assert np.array_equal(single.observations[0], outcome.observations[row])
             assert np.array_equal(state.positions[0], batch.positions[row])
     assert np.any(batch.frame_changed)  # the maps really fused movements
 
 
 def test_a_group_step_leaves_the_other_rows_untouched() -> None:
     config = EnvConfig.create(scenario="khepera")
-    state, maps, rngs = started_batch(config, 4, seed=3)
-    before = {name: np.copy(getattr(state, name)) for name in STATE_ARRAYS}
+    state, maps, _rngs = started_batch(config, 4, seed=3)
+    arrays = [name for name in STATE_ARRAYS if isinstance(getattr(state, name), np.ndarray)]
+    before = {name: np.copy(getattr(state, name)) for name in arrays}
     areas_before = maps.batch(4, config).areas.copy()
     group = np.array([1, 3])
     turns, lengths = CONTINUOUS.decode(config, np.array([[0.3, 1.0], [-0.2, 1.0]]))
-    core.step(state, maps.group(state, group, config), turns, lengths, [rngs[1], rngs[3]])
+    core.step(state, maps.group(state, group, config), turns, lengths)
     others = np.array([0, 2])
-    for name in STATE_ARRAYS:
+    for name in arrays:
         value = getattr(state, name)
         if name == "trajectory":
             continue  # may have grown; the used entries are compared below
@@ -65,16 +65,43 @@ def test_a_group_step_leaves_the_other_rows_untouched() -> None:
 
 def test_the_trajectory_grows_past_its_first_capacity() -> None:
     config = EnvConfig.create(scenario="khepera", max_moves=200, target_area=1e-12)
-    state, maps, rngs = started_batch(config, 2, seed=0)
+    state, maps, _rngs = started_batch(config, 2, seed=0)
     rows = np.arange(2)
     visited = [state.positions.copy()]
     steps = 2 * INITIAL_TRAJECTORY_SLOTS + 3
     for action in np.random.default_rng(1).uniform(-1, 1, (steps, 2, 2)):
         turns, lengths = CONTINUOUS.decode(config, action)
-        core.step(state, maps.group(state, rows, config), turns, lengths, rngs)
+        core.step(state, maps.group(state, rows, config), turns, lengths)
         visited.append(state.positions.copy())
     assert np.all(state.trajectory_length == steps + 1)
     assert np.array_equal(state.trajectory[:, : steps + 1], np.stack(visited, axis=1))
+
+
+@pytest.mark.parametrize(
+    "noise", [{"kind": "uniform"}, {"kind": "gaussian", "outlier_rate": 0.2, "detection_rate": 0.9}]
+)
+@pytest.mark.parametrize("moves", [0, 3, 20])
+def test_the_noise_drawn_ahead_is_handed_back_unspent(noise: dict[str, object], moves: int) -> None:
+    """A row draws its moves' noise ahead, in a block; when the episode ends early (or the
+    generator is read), the generator is rewound to where drawing move by move, as the
+    readings need it, would have left it: its next draw is the same either way."""
+    config = EnvConfig.create(scenario="khepera", noise=noise, max_moves=20, target_area=1e-12)
+    state, maps, rngs = started_batch(config, 1, seed=4)
+    for action in np.random.default_rng(5).uniform(-1, 1, (moves, 1, 2)):
+        turns, lengths = CONTINUOUS.decode(config, action)
+        core.step(state, maps.group(state, np.array([0]), config), turns, lengths)
+    core.release_noise(state, 0)
+    # By hand: the same reset (rewound to the episode's start: nothing spent), then the
+    # two readings of 4 bearings of each move, one at a time.
+    fresh = BatchState.empty(1, config.max_landmarks)
+    by_hand = np.random.default_rng(4)
+    core.reset_rows(fresh, np.array([0]), config, [by_hand], MapBank(1))
+    fresh.noise_used[0] = 0
+    core.release_noise(fresh, 0)
+    model = config.sensor.noise
+    for _ in range(2 * moves):
+        model.draw_rows([by_hand], 4, config.epsilon)
+    assert rngs[0].random() == by_hand.random()
 
 
 @pytest.mark.parametrize("fusion", ["intersect", "relaxed"])

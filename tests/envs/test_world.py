@@ -248,20 +248,27 @@ def test_default_lengths_scale_with_the_arena() -> None:
         {"kind": "none"},
     ],
 )
-def test_a_movements_draws_are_two_readings_draws_in_order(noise):
-    model = NoiseModel.parse(noise)
-    rngs = [np.random.default_rng(seed) for seed in (1, 2, 3)]
-    again = [np.random.default_rng(seed) for seed in (1, 2, 3)]
-    first, second = model.draw_movement_rows(rngs, 5, 0.03)
-    expected = (model.draw_rows(again, 5, 0.03), model.draw_rows(again, 5, 0.03))
-    for got, want in zip((first, second), expected, strict=True):
-        np.testing.assert_array_equal(got.offsets, want.offsets)
-        assert (got.is_outlier is None) == (want.is_outlier is None)
-        if want.is_outlier is not None:
-            np.testing.assert_array_equal(got.is_outlier, want.is_outlier)
-            np.testing.assert_array_equal(got.replacement, want.replacement)
+def test_a_block_of_readings_draws_as_the_readings_one_at_a_time(noise):
+    # The envs draw a block of an episode's readings at once (into their noise buffer):
+    # the block must be the very draws, in order, of that many single readings.
+    model = NoiseModel.parse({**noise, "detection_rate": 0.8} if noise["kind"] == "none" else noise)
+    rng, again = np.random.default_rng(7), np.random.default_rng(7)
+    readings, size = 4, 5
+    offsets = np.full((readings, size), -1.0)
+    is_outlier = np.ones((readings, size), dtype=bool)
+    replacement = np.zeros((readings, size))
+    model.draw_readings(rng, 0.03, offsets, is_outlier, replacement)
+    for k in range(readings):
+        want = model.draw_rows([again], size, 0.03)
+        np.testing.assert_array_equal(offsets[k], want.offsets[0])
+        if want.is_outlier is None:
+            assert not is_outlier[k].any()
+        else:
+            np.testing.assert_array_equal(is_outlier[k], want.is_outlier[0])
+            chosen = want.is_outlier[0]
+            np.testing.assert_array_equal(replacement[k][chosen], want.replacement[0][chosen])
     # And the generators end in the same state.
-    assert [r.random() for r in rngs] == [r.random() for r in again]
+    assert rng.random() == again.random()
 
 
 def test_a_world_copy_keeps_the_camera_and_the_obstacles() -> None:

@@ -76,6 +76,15 @@ if "NUMBA_THREADING_LAYER" not in os.environ:
     # why: numba.config defines its settings at import through globals(), unseen by mypy
     numba.config.THREADING_LAYER = "workqueue"  # type: ignore[attr-defined]
 
+# numba's parallel runtime starts here, before any kernel is loaded from the cache (about
+# 20 ms). A cached kernel that calls the parallel update (the env's step) holds a copy of
+# it, and its cache entry starts the runtime on loading only if the parallel update was
+# compiled in the process that compiled the kernel: compiled where it came from the cache
+# (another process, or an edit that emptied one module's cache), the entry is saved
+# without, and loading it in a fresh process left the runtime's symbols unresolved, so
+# the step called address 0 (a segfault; see the performance page's compile notes).
+numba.get_num_threads()
+
 
 def entry_point(dispatcher: Any, args: tuple[Any, ...]) -> Callable[..., Any]:
     """The compiled function ``dispatcher`` runs for the types of ``args`` (compiled, or

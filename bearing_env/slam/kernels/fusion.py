@@ -84,7 +84,11 @@ def intersect_landmark(
 
 @njit(**_JIT)
 def _merge_hull(
-    acc: np.ndarray, n_acc: int, poly: np.ndarray, n_poly: int, cloud: np.ndarray,
+    acc: np.ndarray,
+    n_acc: int,
+    poly: np.ndarray,
+    n_poly: int,
+    cloud: np.ndarray,
     hull: np.ndarray,
 ) -> int:
     """The convex hull of ``acc[:n_acc]`` and ``poly[:n_poly]`` into ``acc``."""
@@ -116,7 +120,12 @@ def _window_slots(state: State, row: int, j: int, out: np.ndarray) -> int:
 
 @njit(**_JIT)
 def _intersect_kept(
-    state: State, row: int, j: int, k: int, discarded: np.ndarray, use_base: bool,
+    state: State,
+    row: int,
+    j: int,
+    k: int,
+    discarded: np.ndarray,
+    use_base: bool,
     scratch: Scratch,
 ) -> tuple[int, bool]:
     """The intersection of the base (if used) and the kept regions of
@@ -198,7 +207,12 @@ def _relaxed_union(
 
 @njit(**_JIT)
 def relaxed_region(
-    state: State, row: int, j: int, k: int, use_base: bool, max_outliers: int,
+    state: State,
+    row: int,
+    j: int,
+    k: int,
+    use_base: bool,
+    max_outliers: int,
     scratch: Scratch,
 ) -> tuple[int, int]:
     """The hull of the q-relaxed intersection of the base and the window slots
@@ -221,9 +235,7 @@ def relaxed_region(
 
 
 @njit(**_JIT)
-def _solve_landmark(
-    state: State, row: int, j: int, params: Params, scratch: Scratch
-) -> None:
+def _solve_landmark(state: State, row: int, j: int, params: Params, scratch: Scratch) -> None:
     """Landmark ``j``'s region from its base and window, from scratch (see
     :func:`relaxed_movement`)."""
     window_inlier, base_counts, slots = state.window_inlier, state.base_counts, scratch.slots
@@ -312,9 +324,7 @@ def _keeps_every_region(state: State, row: int, j: int) -> bool:
 
 
 @njit(**_JIT)
-def _reject_outlier_movements(
-    state: State, row: int, params: Params, scratch: Scratch
-) -> None:
+def _reject_outlier_movements(state: State, row: int, params: Params, scratch: Scratch) -> None:
     """Reject every window movement that is an outlier for more than half of the
     landmarks it has regions for, and solve again the landmarks it was kept by; repeat
     until no more are rejected (a rejection can make another movement an outlier)."""
@@ -347,8 +357,13 @@ def _reject_outlier_movements(
 
 @njit(**_JIT)
 def relaxed_movement(
-    state: State, row: int, fresh_counts: np.ndarray, params: Params, out: Outputs,
-    i: int, scratch: Scratch,
+    state: State,
+    row: int,
+    fresh_counts: np.ndarray,
+    params: Params,
+    out: Outputs,
+    i: int,
+    scratch: Scratch,
 ) -> bool:
     """Fuse the movement just written into window slot ``window_next[row] - 1`` (its
     regions' vertex counts are ``fresh_counts``; 0 where it has none) into map ``row``
@@ -377,15 +392,17 @@ def relaxed_movement(
         n_old = counts[row, j]
         if n_old > 0 and _keeps_every_region(state, row, j):
             n = clip_convex(
-                vertices[row, j], n_old, state.window_vertices[row, newest, j], n_new,
-                scratch.fused, scratch.work,
+                vertices[row, j],
+                n_old,
+                state.window_vertices[row, newest, j],
+                n_new,
+                scratch.fused,
+                scratch.work,
             )
             if n > 0:
                 _copy_polygon(scratch.fused, n, vertices[row, j])
                 counts[row, j] = n
-                state.areas[row, j], state.centroids[row, j] = area_centroid(
-                    vertices[row, j], n
-                )
+                state.areas[row, j], state.centroids[row, j] = area_centroid(vertices[row, j], n)
                 continue
         _solve_landmark(state, row, j, params, scratch)
     _reject_outlier_movements(state, row, params, scratch)

@@ -137,11 +137,17 @@ def convex_hull(points: np.ndarray, n_points: int, out: np.ndarray) -> int:
                 n_right += 1
         mid = start + n_left
         task_start[top], task_end[top], chain_from[top], chain_to[top] = (
-            mid, mid + n_right, i_far, i_to
+            mid,
+            mid + n_right,
+            i_far,
+            i_to,
         )
         task_start[top + 1], chain_from[top + 1] = -1, i_far
         task_start[top + 2], task_end[top + 2], chain_from[top + 2], chain_to[top + 2] = (
-            start, mid, i_from, i_far
+            start,
+            mid,
+            i_from,
+            i_far,
         )
         top += 3
     candidates = out[:k].copy()
@@ -350,8 +356,10 @@ def simplify(poly: np.ndarray, n: int, tol: float) -> int:
             chord = nxt - prev
             length = abs(chord)
             if abs(v - prev) <= tol or (
-                length > 0.0 and abs(cross(chord, v - prev)) <= tol * length
-                and dot(v - prev, chord) >= 0.0 and dot(nxt - v, chord) >= 0.0
+                length > 0.0
+                and abs(cross(chord, v - prev)) <= tol * length
+                and dot(v - prev, chord) >= 0.0
+                and dot(nxt - v, chord) >= 0.0
             ):
                 changed = True
                 continue

@@ -80,9 +80,7 @@ def _frame_of(
     n_pairs = 0
     if status == FRAME_OK:
         n_pairs = sample_hypotheses(a1, n1, a2, n2, per_edge, h1, inv_d)
-    frame = FrameChange(
-        a1, n1, a2, n2, h1, inv_d, n_pairs, conservative, distance, delta1, delta2
-    )
+    frame = FrameChange(a1, n1, a2, n2, h1, inv_d, n_pairs, conservative, distance, delta1, delta2)
     return status, frame
 
 
@@ -131,8 +129,13 @@ def _transfer_robot(
 
 @njit(**_JIT)
 def _cone_regions(
-    bearings_start: np.ndarray, bearings_end: np.ndarray, i: int, epsilon: float,
-    fr: np.ndarray, fr_count: np.ndarray, fr_status: np.ndarray,
+    bearings_start: np.ndarray,
+    bearings_end: np.ndarray,
+    i: int,
+    epsilon: float,
+    fr: np.ndarray,
+    fr_count: np.ndarray,
+    fr_status: np.ndarray,
 ) -> int:
     """Every landmark's FR region from bearings row ``i``; returns the frame code the
     regions of L1 and L2 allow (:data:`FRAME_OK` if both are bounded)."""
@@ -334,8 +337,12 @@ def none_infinite(values: np.ndarray) -> bool:
 
 @njit(**_JIT)
 def contains_points(
-    vertices: np.ndarray, counts: np.ndarray, rows: np.ndarray, points: np.ndarray,
-    relative: float, out: np.ndarray,
+    vertices: np.ndarray,
+    counts: np.ndarray,
+    rows: np.ndarray,
+    points: np.ndarray,
+    relative: float,
+    out: np.ndarray,
 ) -> None:
     """``out[i, j]``: region ``j`` of map ``rows[i]`` contains ``points[i, j]``."""
     for i in range(rows.shape[0]):
