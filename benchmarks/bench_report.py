@@ -433,11 +433,11 @@ def format_target(target: dict[str, Any]) -> str:
     value = target["value"]
     if value is None:
         shown = "-"
-    elif target["id"] in ("a", "b", "e"):
+    elif target["id"] in ("a", "b", "e", "i"):
         shown = f"{value:.2%} (need {target['threshold']:.0%})"
     elif target["id"] == "c":
         shown = f"{value:.3f} (need {target['threshold']:.4f})"
-    elif target["id"] == "f":
+    elif target["id"] in ("f", "j"):
         shown = f"{value:.2f} s (need <= {target['threshold']:g} s)"
     elif target["id"] == "g":
         shown = f"{value * 1e3:.3f} ms (need <= {target['threshold'] * 1e3:g} ms)"

@@ -332,3 +332,17 @@ def test_bench_slam_warms_everything_it_times_before_timing(
     warm_up_updates = updates[: len(measured) * 20]
     assert sorted(set(warm_up_updates)) == sorted(measured)
     assert "update()" in capsys.readouterr().out
+
+
+def test_targets_print_in_their_own_units() -> None:
+    results = {
+        "vector": [fake_figure(550.0, kind="batched", num_envs=256)],
+        "startup": {"warm_first_step_s": 0.8, "cold_first_step_s": 92.15},
+    }
+    shown = {
+        target["id"]: bench_report.format_target(target)
+        for target in bench_report.evaluate_targets(results)
+    }
+    assert "55.00% (need 60%) -> NOT MET" in shown["i"]
+    assert "92.15 s (need <= 20 s) -> NOT MET" in shown["j"]
+    assert "0.80 s (need <= 1 s) -> MET" in shown["f"]
