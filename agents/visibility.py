@@ -27,8 +27,8 @@ from numpy.typing import NDArray
 
 from bearing_env.envs.core import WorldView
 from bearing_env.numerics import wrap_angle
-from bearing_env.sensing import pack_polygons, visible_rows
-from bearing_env.world import World, obstructed_move
+from bearing_env.sensing import landmarks_seen, pack_polygons
+from bearing_env.world import World, obstructed_moves
 
 from .env_access import bearing_env_of
 
@@ -226,7 +226,8 @@ class TrueSensor:
         self.max_range = world.max_range
         self.arena = world.arena
         self.obstacles = bool(world.obstacles)
-        self.vertices, self.starts = pack_polygons(world.obstacles)
+        #: The obstacles, packed (see :mod:`bearing_env.sensing`).
+        self.obstacle_polygons = pack_polygons(world.obstacles)
         self.landmarks = np.array(world.landmarks, dtype=np.float64)
         l1, l2 = complex(*self.landmarks[0]), complex(*self.landmarks[1])
         #: FL -> world: z_world = origin + unit * z_fl.
@@ -250,13 +251,9 @@ class TrueSensor:
         world_headings = np.broadcast_to(headings, bearings.shape[:-1]).ravel() + np.angle(
             self.unit
         )
-        count, n = flat.shape
-        landmarks = np.ascontiguousarray(np.broadcast_to(self.landmarks[:n], (count, n, 2)))
-        seen = np.empty((count, n), dtype=bool)
-        visible_rows(
-            landmarks, np.ascontiguousarray(np.column_stack([at.real, at.imag])),
-            np.ascontiguousarray(world_headings, dtype=np.float64), self.half_fov,
-            self.max_range, self.vertices, self.starts, seen,
+        seen = landmarks_seen(
+            self.landmarks[: flat.shape[1]], np.column_stack([at.real, at.imag]),
+            world_headings, self.half_fov, self.max_range, self.obstacle_polygons,
         )  # fmt: skip
         return np.where(seen, flat, np.nan).reshape(bearings.shape)
 
@@ -264,15 +261,8 @@ class TrueSensor:
         """How far (metres) a move from ``position`` (world, metres) along ``heading``
         (world) really goes: stopped by the walls and the obstacles, 0 when it could not
         go the shortest move that changes frames."""
-        if not self.obstacles:
-            free = self.arena.free_distance(position, heading, self.arena.wall_margin)
-            travelled = min(length, free)
-            return 0.0 if travelled < self.arena.min_baseline else travelled
-        settings = (
-            self.arena.width, self.arena.height, self.arena.wall_margin, self.arena.min_baseline
+        travelled, _, _ = obstructed_moves(
+            self.arena, np.asarray(position)[None], np.array([heading]), np.array([length]),
+            self.obstacle_polygons,
         )  # fmt: skip
-        _, _, travelled, _ = obstructed_move(
-            float(position[0]), float(position[1]), float(heading), float(length), settings,
-            self.vertices, self.starts,
-        )  # fmt: skip
-        return float(travelled)
+        return float(travelled[0])

@@ -267,3 +267,24 @@ def visible_rows(
                 vertices,
                 starts,
             )
+
+
+def landmarks_seen(
+    landmarks: FloatArray,
+    positions: FloatArray,
+    headings: FloatArray,
+    half_fov: float,
+    max_range: float,
+    obstacles: Packed,
+) -> NDArray[np.bool_]:
+    """:func:`visible_rows` of one set of landmarks (n, 2) from many poses (N, 2), (N,):
+    which landmarks each pose sees, (N, n)."""
+    count = len(positions)
+    out = np.empty((count, len(landmarks)), dtype=bool)
+    visible_rows(
+        np.ascontiguousarray(np.broadcast_to(landmarks, (count, *np.shape(landmarks)))),
+        np.ascontiguousarray(positions, dtype=np.float64),
+        np.ascontiguousarray(headings, dtype=np.float64),
+        half_fov, max_range, obstacles[0], obstacles[1], out,
+    )  # fmt: skip
+    return out

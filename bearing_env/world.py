@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.numerics import JIT_OPTIONS, wrap, wrap_angle
 from bearing_env.obstacles import Obstacle, box
-from bearing_env.sensing import Packed, clearance, free_length, pack_polygons, visible_rows
+from bearing_env.sensing import Packed, clearance, free_length, landmarks_seen, pack_polygons
 from bearing_env.validation import float_in, non_negative_float, positive_float
 
 FloatArray = NDArray[np.float64]
@@ -560,20 +560,12 @@ class World:
     def move(self, length: float) -> MoveResult:
         """Move straight ahead by ``length`` metres, stopping at the wall margin or an
         obstacle's."""
-        if self.obstacles:
-            arena = self.arena
-            x, y, travelled_, blocked_ = obstructed_move(
-                float(self.position[0]), float(self.position[1]), self.heading, float(length),
-                (arena.width, arena.height, arena.wall_margin, self.min_baseline), *self._packed,
-            )  # fmt: skip
-            self.position = np.array([x, y])
-            return MoveResult(float(length), float(travelled_), bool(blocked_))
-        travelled, blocked, position = straight_moves(
+        travelled, blocked, position = obstructed_moves(
             self.arena,
             self.position[None],
             np.array([self.heading]),
             np.array([float(length)]),
-            self.min_baseline,
+            self._packed,
         )
         self.position = position[0]
         return MoveResult(float(length), float(travelled[0]), bool(blocked[0]))
@@ -585,12 +577,10 @@ class World:
     def seen(self) -> NDArray[np.bool_]:
         """Which landmarks (n,) the camera sees from the pose: within the field of view
         and the range, in line of sight."""
-        out = np.empty((1, self.n_landmarks), dtype=bool)
-        visible_rows(
-            self.landmarks[None], self.position[None], np.array([self.heading]), self.half_fov,
-            self.max_range, *self._packed, out,
-        )  # fmt: skip
-        return out[0]
+        return landmarks_seen(
+            self.landmarks, self.position[None], np.array([self.heading]), self.half_fov,
+            self.max_range, self._packed,
+        )[0]  # fmt: skip
 
     def read_bearings(self, rng: np.random.Generator) -> FloatArray:
         """A reading: noisy bearings (n,) relative to the heading, [-pi, pi); NaN for a
@@ -714,5 +704,26 @@ def straight_moves(
             arena.height,
             arena.wall_margin,
             min_baseline,
+        )
+    return travelled, blocked, moved
+
+
+def obstructed_moves(
+    arena: Arena,
+    positions: FloatArray,
+    headings: FloatArray,
+    lengths: FloatArray,
+    obstacles: Packed,
+) -> tuple[FloatArray, NDArray[np.bool_], FloatArray]:
+    """:func:`obstructed_move` for many robots, stopped by the walls and ``obstacles``
+    (packed): ``(travelled, blocked, new positions)``; without obstacles it is
+    :func:`straight_moves`, bit for bit."""
+    settings = (arena.width, arena.height, arena.wall_margin, arena.min_baseline)
+    travelled = np.empty(len(positions))
+    blocked = np.empty(len(positions), dtype=bool)
+    moved = np.empty((len(positions), 2))
+    for i, ((x, y), heading, length) in enumerate(zip(positions, headings, lengths, strict=True)):
+        moved[i, 0], moved[i, 1], travelled[i], blocked[i] = obstructed_move(
+            float(x), float(y), float(heading), float(length), settings, *obstacles
         )
     return travelled, blocked, moved

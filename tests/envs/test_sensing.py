@@ -117,3 +117,22 @@ def test_visibility_field_of_view_range_and_occlusion() -> None:
     assert visible(0.0, 0.0, 0.0, -1.0, 0.0, math.pi, math.inf, *empty)
     assert visible(0.0, 0.0, 0.0, 0.9, 0.0, math.pi, 0.9, *empty)
     assert not visible(0.0, 0.0, 0.0, 0.91, 0.0, math.pi, 0.9, *empty)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed)
+def test_landmarks_seen_is_visible_for_every_pose_and_landmark(rng_seed: int) -> None:
+    from bearing_env.sensing import landmarks_seen
+
+    rng = np.random.default_rng(rng_seed)
+    obstacles = pack_polygons(_obstacles(rng_seed))
+    landmarks = rng.uniform(0.0, 1.0, (5, 2))
+    positions = rng.uniform(0.0, 1.0, (7, 2))
+    headings = rng.uniform(-math.pi, math.pi, 7)
+    half_fov, max_range = float(rng.uniform(0.3, math.pi)), float(rng.uniform(0.3, 1.5))
+    seen = landmarks_seen(landmarks, positions, headings, half_fov, max_range, obstacles)
+    expected = [
+        [visible(*p, h, *q, half_fov, max_range, *obstacles) for q in landmarks]
+        for p, h in zip(positions, headings, strict=True)
+    ]
+    np.testing.assert_array_equal(seen, expected)

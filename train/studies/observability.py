@@ -35,7 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env.envs.config import EnvConfig
-from bearing_env.sensing import clearance, visible_rows
+from bearing_env.sensing import clearance, landmarks_seen
 from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
 from bearing_env.slam.batch import LANDMARK_CODE
 from bearing_env.train.common.cli_parser import add_no_progress, command_parser, doc_summary
@@ -44,7 +44,7 @@ from bearing_env.train.common.files import write_json_atomically
 from bearing_env.train.common.progress import progress_bar
 from bearing_env.train.common.seeds import EVAL_SEED_START
 from bearing_env.train.common.tables import print_table
-from bearing_env.world import obstructed_move, true_bearings
+from bearing_env.world import obstructed_moves, true_bearings
 
 FloatArray = NDArray[np.float64]
 
@@ -124,16 +124,12 @@ def candidate_movements(layout: Layout, per_side: int, headings: int, lengths: i
 def _readings(layout: Layout, positions: FloatArray, headings: FloatArray) -> FloatArray:
     """Noise-free bearings (N, n) from poses, NaN where the env's sensor misses."""
     count = len(positions)
-    landmarks = np.ascontiguousarray(
-        np.broadcast_to(layout.landmarks, (count, *layout.landmarks.shape))
-    )
+    landmarks = np.broadcast_to(layout.landmarks, (count, *layout.landmarks.shape))
     bearings = true_bearings(landmarks, positions, headings)
-    seen = np.empty(bearings.shape, dtype=bool)
     sensor = layout.config.sensor
-    vertices, starts = layout.config.layout.packed_obstacles
-    visible_rows(
-        landmarks, np.ascontiguousarray(positions), np.ascontiguousarray(headings),
-        sensor.half_fov, sensor.max_range, vertices, starts, seen,
+    seen = landmarks_seen(
+        layout.landmarks, positions, headings, sensor.half_fov, sensor.max_range,
+        layout.config.layout.packed_obstacles,
     )  # fmt: skip
     return np.where(seen, bearings, np.nan)
 
@@ -142,16 +138,8 @@ def _moved(
     layout: Layout, begin: FloatArray, headings: FloatArray, lengths: FloatArray
 ) -> FloatArray:
     """Where the env's moves from ``begin`` (N, 2) end: walls and obstacles stop them."""
-    arena = layout.config.layout.arena
-    settings = (arena.width, arena.height, arena.wall_margin, arena.min_baseline)
-    vertices, starts = layout.config.layout.packed_obstacles
-    end = np.empty_like(begin)
-    for i, (x, y) in enumerate(begin):
-        moved = obstructed_move(
-            float(x), float(y), float(headings[i]), float(lengths[i]), settings, vertices, starts
-        )
-        end[i] = moved[0], moved[1]
-    return end
+    config = layout.config.layout
+    return obstructed_moves(config.arena, begin, headings, lengths, config.packed_obstacles)[2]
 
 
 def movement_outcomes(layout: Layout, movements: Movements) -> Outcomes:
