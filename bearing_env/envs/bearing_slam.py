@@ -312,13 +312,18 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
       misread L1 or L2 makes them; see `bearing_env.slam.PolygonSLAM`), or `"robust"`
       (the relaxed intersection of all of a landmark's regions, leaving out as many as
       the contamination rate estimated from the contradictions seen asks for `risk`;
-      on clean data it is the intersection exactly; see docs/world_model.md).
+      on clean data it is almost always the intersection exactly; see
+      docs/world_model.md).
     - `risk`: with `"robust"`, the target chance that more of a landmark's regions are
       contaminated than its reported set leaves out, in (0, 0.5]; default 0.05.
     - `robust_set`: with `"robust"`, the set the map reports, and so the observation
       and the reward use: `"guaranteed"` (default; leaves out enough regions for
       `risk`) or `"likely"` (leaves out only the regions that contradict the others:
       smaller, and more often wrong).
+    - `noise_bound`: with `"robust"`, the bound the map reads bearings with:
+      `"estimate"` (default; `epsilon_deg`, grown when a probe map fused at 0.8 of the
+      bound contradicts what the map fused consistently, the regions then rebuilt from
+      the last 16 movements) or `"nominal"` (`epsilon_deg` throughout).
     - `max_outliers`: with `"relaxed"`, the most regions per landmark left out, 0..7;
       default 2.
     - `on_inconsistency`: `"restart"` (default: a landmark whose regions contradict

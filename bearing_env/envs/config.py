@@ -72,6 +72,7 @@ from bearing_env.slam.settings import (
     DEFAULT_MAX_OUTLIERS,
     DEFAULT_RISK,
     DEFAULT_WINDOW,
+    NOISE_BOUNDS,
     ROBUST_SETS,
 )
 from bearing_env.validation import (
@@ -384,6 +385,7 @@ class MappingSettings(SettingsGroup):
     on_inconsistency: str = setting("restart")
     risk: float = setting(DEFAULT_RISK)
     robust_set: str = setting("guaranteed")
+    noise_bound: str = setting("estimate")
 
     def __post_init__(self) -> None:
         choice(self.transfer, TRANSFERS, "transfer")
@@ -395,6 +397,7 @@ class MappingSettings(SettingsGroup):
         choice(self.on_inconsistency, INCONSISTENCY_POLICIES, "on_inconsistency")
         _normalise(self, "risk", float_in(self.risk, "risk", 0.0, 0.5, closed_low=False))
         choice(self.robust_set, ROBUST_SETS, "robust_set")
+        choice(self.noise_bound, NOISE_BOUNDS, "noise_bound")
 
     def map_settings(self, epsilon: float) -> MapSettings:
         """The world model's settings with the bound ``epsilon`` (radians)."""

@@ -188,14 +188,28 @@ def encode_levels(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover
     """The robust fusion's arrays (``ROBUST_STATE_ARRAYS``), as :func:`_encode_map`."""
     size, mapped = rows.size, state.counts.shape[1]
     levels, capacity = state.level_vertices.shape[2], state.level_vertices.shape[3]
+    history = state.history_bearings.shape[1]
     outliers = np.zeros((size, slots), np.int64)
     level_vertices = np.zeros((size, slots, levels, capacity), np.complex128)
     level_counts = np.zeros((size, slots, levels), np.int64)
     n_regions = np.zeros((size, slots), np.int64)
     robot_fixed_at = np.empty(size, np.int64)
+    noise_scale = np.empty(size)
+    bound_events = np.empty(size, np.int64)
+    probe_vertices = np.zeros((size, slots, state.probe_vertices.shape[2]), np.complex128)
+    probe_counts = np.zeros((size, slots), np.int64)
+    history_frame_bearings = np.empty((size, history, 2, 2))
+    history_bearings = np.zeros((size, history, 2, slots))
+    history_length = np.empty(size, np.int64)
+    history_next = np.empty(size, np.int64)
     for i in range(size):
         row = rows[i]
         robot_fixed_at[i] = state.robot_fixed_at[row]
+        noise_scale[i] = state.noise_scale[row]
+        bound_events[i] = state.bound_events[row]
+        history_frame_bearings[i] = state.history_frame_bearings[row]
+        history_length[i] = state.history_length[row]
+        history_next[i] = state.history_next[row]
         for j in range(mapped):
             outliers[i, j] = state.outliers[row, j]
             n_regions[i, j] = state.n_regions[row, j]
@@ -203,7 +217,25 @@ def encode_levels(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover
                 count = state.level_counts[row, j, k]
                 level_counts[i, j, k] = count
                 level_vertices[i, j, k, :count] = state.level_vertices[row, j, k, :count]
-    return outliers, level_vertices, level_counts, n_regions, robot_fixed_at
+            count = state.probe_counts[row, j]
+            probe_counts[i, j] = count
+            probe_vertices[i, j, :count] = state.probe_vertices[row, j, :count]
+            history_bearings[i, :, :, j] = state.history_bearings[row, :, :, j]
+    return (
+        outliers,
+        level_vertices,
+        level_counts,
+        n_regions,
+        robot_fixed_at,
+        noise_scale,
+        bound_events,
+        probe_vertices,
+        probe_counts,
+        history_frame_bearings,
+        history_bearings,
+        history_length,
+        history_next,
+    )
 
 
 def decode(data: Mapping[str, Any], n_landmarks: int, settings: MapSettings) -> PolygonSLAM:

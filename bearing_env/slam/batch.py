@@ -129,6 +129,7 @@ class BatchedPolygonSLAM(HasMapSettings):
         window: int = DEFAULT_WINDOW,
         risk: float = DEFAULT_RISK,
         robust_set: str = "guaranteed",
+        noise_bound: str = "estimate",
     ) -> None:
         self.num_maps = int_at_least(num_maps, 1, "num_maps")
         self.n_landmarks = int_at_least(n_landmarks, 3, "n_landmarks", "(L1, L2 and one more)")
@@ -143,6 +144,7 @@ class BatchedPolygonSLAM(HasMapSettings):
             window=window,
             risk=risk,
             robust_set=robust_set,
+            noise_bound=noise_bound,
         )
         n, m, cap = self.num_maps, self.n_landmarks - 2, kernels.CAPACITY
         self.vertices = np.zeros((n, m, cap), dtype=np.complex128)
@@ -175,6 +177,17 @@ class BatchedPolygonSLAM(HasMapSettings):
         self.level_counts = np.zeros((n, m, levels), dtype=np.int64)
         self.n_regions = np.zeros((n, m), dtype=np.int64)
         self.robot_fixed_at = np.zeros(n, dtype=np.int64)
+        # The robust fusion's noise-bound estimate: its probe and bearing history.
+        robust = self.fusion == "robust"
+        h = kernels.HISTORY if robust else 0
+        self.noise_scale = np.ones(n)
+        self.bound_events = np.zeros(n, dtype=np.int64)
+        self.probe_vertices = np.zeros((n, m, cap if robust else 0), dtype=np.complex128)
+        self.probe_counts = np.zeros((n, m), dtype=np.int64)
+        self.history_frame_bearings = np.zeros((n, h, 2, 2))
+        self.history_bearings = np.zeros((n, h, 2, m))
+        self.history_length = np.zeros(n, dtype=np.int64)
+        self.history_next = np.zeros(n, dtype=np.int64)
         self._state_ref: kernels.State | None = None
         announce_compile_once()
         self.reset()
@@ -224,6 +237,11 @@ class BatchedPolygonSLAM(HasMapSettings):
         self.level_counts[rows] = 0
         self.n_regions[rows] = 0
         self.robot_fixed_at[rows] = 0
+        self.noise_scale[rows] = 1.0
+        self.bound_events[rows] = 0
+        self.probe_counts[rows] = 0
+        self.history_length[rows] = 0
+        self.history_next[rows] = 0
 
     def update(
         self,
@@ -387,7 +405,7 @@ class BatchedPolygonSLAM(HasMapSettings):
                 FUSIONS.index(self.fusion),
                 self.max_outliers,
             )
-            robust = (self.risk, self.robust_set == "likely")
+            robust = (self.risk, self.robust_set == "likely", self.noise_bound == "estimate")
             both = (
                 kernels.Params(*settings, False, *robust),
                 kernels.Params(*settings, True, *robust),
@@ -452,7 +470,8 @@ RELAXED_STATE_ARRAYS = STATE_ARRAYS[
     STATE_ARRAYS.index("window_vertices") : STATE_ARRAYS.index("outliers") + 1
 ]
 #: The part of the state the robust fusion uses besides every fusion's: the regions each
-#: landmark leaves out (``outliers``, shared with the relaxed fusion) and its levels.
+#: landmark leaves out (``outliers``, shared with the relaxed fusion), its levels and its
+#: noise-bound estimate (bound, probe and bearing history).
 ROBUST_STATE_ARRAYS = ("outliers", *STATE_ARRAYS[STATE_ARRAYS.index("level_vertices") :])
 
 #: The state arrays with a landmark axis, and which axis it is (the map axis is 0): what
@@ -472,6 +491,9 @@ LANDMARK_AXES: dict[str, int] = {
     "level_vertices": 1,
     "level_counts": 1,
     "n_regions": 1,
+    "probe_vertices": 1,
+    "probe_counts": 1,
+    "history_bearings": 3,
 }
 
 #: The vertex arrays of the state and the arrays counting their used vertices.
@@ -481,6 +503,7 @@ VERTEX_COUNTS: dict[str, str] = {
     "window_vertices": "window_counts",
     "base_vertices": "base_counts",
     "level_vertices": "level_counts",
+    "probe_vertices": "probe_counts",
 }
 
 

@@ -167,6 +167,11 @@ class PolygonSLAM(HasMapSettings):
         robust_set: with ``fusion="robust"``, the set the map reports: ``"guaranteed"``
             (leaves out enough regions for ``risk``) or ``"likely"`` (only those that
             contradict the others).
+        noise_bound: with ``fusion="robust"``, the bound bearings are read with:
+            ``"estimate"`` (``epsilon``, grown when a probe map shows it too small, and
+            the regions then rebuilt from the last movements; see :attr:`bound` and
+            :mod:`bearing_env.slam.kernels.robust`) or ``"nominal"`` (``epsilon``
+            throughout).
 
     These are the fields of :class:`~bearing_env.slam.settings.MapSettings`, which
     validates them (the map's :attr:`settings`); :meth:`from_settings` takes one whole.
@@ -187,6 +192,7 @@ class PolygonSLAM(HasMapSettings):
         window: int = DEFAULT_WINDOW,
         risk: float = DEFAULT_RISK,
         robust_set: str = "guaranteed",
+        noise_bound: str = "estimate",
     ) -> None:
         self._batch = BatchedPolygonSLAM(
             1,
@@ -200,6 +206,7 @@ class PolygonSLAM(HasMapSettings):
             window=window,
             risk=risk,
             robust_set=robust_set,
+            noise_bound=noise_bound,
         )
         self._attach(self._batch, 0)
 
@@ -281,6 +288,12 @@ class PolygonSLAM(HasMapSettings):
     def n_frame_changes(self) -> int:
         """Movements that could change frames and update the map."""
         return int(self._batch.n_frame_changes[self._index])
+
+    @property
+    def bound(self) -> float:
+        """The bearing error bound the map reads bearings with now, radians: ``epsilon``,
+        or larger once the robust fusion's estimate has grown it (``noise_bound``)."""
+        return float(self.epsilon * self._batch.noise_scale[self._index])
 
     @property
     def n_inconsistent(self) -> int:

@@ -29,6 +29,10 @@ FUSIONS = ("intersect", "relaxed", "robust")
 #: contradicting regions left out).
 ROBUST_SETS = ("guaranteed", "likely")
 
+#: Which bound the robust fusion reads bearings with: its ``"estimate"`` (epsilon,
+#: grown when the data show it too small) or the ``"nominal"`` epsilon throughout.
+NOISE_BOUNDS = ("estimate", "nominal")
+
 # The kernels take the transfer, the policy and the fusion as indices into these tuples.
 if (
     TRANSFERS.index("conservative") != kernels.TRANSFER_CONSERVATIVE
@@ -68,6 +72,7 @@ class MapSettings:
     window: int = DEFAULT_WINDOW
     risk: float = DEFAULT_RISK
     robust_set: str = "guaranteed"
+    noise_bound: str = "estimate"
 
     def __post_init__(self) -> None:
         def normalise(name: str, value: object) -> None:
@@ -100,6 +105,10 @@ class MapSettings:
         normalise("risk", float_in(self.risk, "risk", 0.0, 0.5, closed_low=False))
         if self.robust_set not in ROBUST_SETS:
             raise ValueError(f"robust_set must be one of {ROBUST_SETS}, got {self.robust_set!r}")
+        if self.noise_bound not in NOISE_BOUNDS:
+            raise ValueError(
+                f"noise_bound must be one of {NOISE_BOUNDS}, got {self.noise_bound!r}"
+            )
 
 
 class HasMapSettings:
@@ -143,3 +152,7 @@ class HasMapSettings:
     @property
     def robust_set(self) -> str:
         return self.settings.robust_set
+
+    @property
+    def noise_bound(self) -> str:
+        return self.settings.noise_bound

@@ -1,6 +1,7 @@
 """The robust fusion (``fusion="robust"``): its nested levels against a brute force, its
 binomial rule against the exact tail, the strict intersection bit for bit on clean data,
-containment under outliers, and its settings' errors."""
+containment under outliers, the noise-bound estimate (its probe, growth and rebuild from
+the bearing history), and its settings' errors."""
 
 from __future__ import annotations
 
@@ -98,19 +99,88 @@ def test_binomial_rule_is_the_smallest_q_under_the_risk(
         assert tail(q - 1) >= risk - 1e-9
 
 
-def test_clean_data_gives_the_strict_intersection_exactly() -> None:
+@pytest.mark.parametrize("noise_bound", ["nominal", "estimate"])
+def test_clean_data_gives_the_strict_intersection_exactly(noise_bound: str) -> None:
+    """With the nominal bound always; with the estimate, in every episode whose probe
+    never fires (19 of 20 here: the probe rarely contradicts clean data)."""
     rng = np.random.default_rng(5)
+    unchanged = 0
     for _ in range(20):
         episode = random_episode(rng, 6, 14)
         strict = PolygonSLAM(6, EPS)
-        robust = PolygonSLAM(6, EPS, fusion="robust")
+        robust = PolygonSLAM(6, EPS, fusion="robust", noise_bound=noise_bound)
+        results = []
         for b1, b2 in episode.readings(EPS):
-            expected = strict.update(b1, b2)
-            assert_same_result(robust.update(b1, b2), expected)
-            np.testing.assert_array_equal(robust.areas, strict.areas)
-            for mine, theirs in zip(robust.polygons, strict.polygons, strict=True):
-                np.testing.assert_array_equal(mine, theirs)  # type: ignore[arg-type]
+            results.append((strict.update(b1, b2), robust.update(b1, b2)))
+        if robust.bound > EPS:
+            assert noise_bound == "estimate"
+            continue
+        unchanged += 1
+        for expected, result in results:
+            assert_same_result(result, expected)
+        np.testing.assert_array_equal(robust.areas, strict.areas)
+        for mine, theirs in zip(robust.polygons, strict.polygons, strict=True):
+            np.testing.assert_array_equal(mine, theirs)  # type: ignore[arg-type]
         assert robust.outliers.tolist() == [0, 0, 0, 0]
+    assert unchanged >= 19 if noise_bound == "estimate" else unchanged == 20
+
+
+def contained_with_bound(noise_bound: str, factor: float) -> tuple[int, int, int]:
+    """Regions holding the truth, regions, and maps whose bound grew, over 20 seeded
+    episodes of 24 moves whose bearing errors reach ``factor`` times the map's bound."""
+    rng = np.random.default_rng(21)
+    held = total = grown = 0
+    for _ in range(20):
+        episode = random_episode(rng, 6, 24)
+        slam = PolygonSLAM(6, EPS, fusion="robust", noise_bound=noise_bound)
+        for b1, b2 in episode.readings(factor * EPS):
+            slam.update(b1, b2)
+        inside = slam.contains(episode.truth_fl())
+        held += int(inside[slam.initialised].sum())
+        total += int(slam.initialised.sum())
+        grown += slam.bound > EPS
+    return held, total, grown
+
+
+def test_a_bound_too_small_is_found_and_the_truth_kept() -> None:
+    held, total, grown = contained_with_bound("estimate", 1.5)
+    nominal_held, nominal_total, nominal_grown = contained_with_bound("nominal", 1.5)
+    assert total == nominal_total > 0 and nominal_grown == 0
+    assert grown >= 18  # the probe saw it in nearly every episode
+    assert held >= 0.95 * total
+    assert held - nominal_held >= 0.1 * total  # the nominal bound loses 15% here
+    assert contained_with_bound("estimate", 1.0)[2] == 0  # and clean maps keep epsilon
+
+
+def test_a_grown_bound_rebuilds_the_map_from_the_kept_bearings() -> None:
+    """After each growth the levels are those of a map at the new bound (estimate off)
+    fed the last ``HISTORY`` movements, including growths after the history is full."""
+    rng = np.random.default_rng(21)
+    growths = late = 0
+    for _ in range(6):
+        episode = random_episode(rng, 6, 30)
+        readings = episode.readings(1.6 * EPS)
+        slam = PolygonSLAM(6, EPS, fusion="robust")
+        for m, (b1, b2) in enumerate(readings):
+            bound = slam.bound
+            slam.update(b1, b2)
+            if slam.bound == bound:
+                continue
+            assert slam.bound == pytest.approx(bound * kernels.BOUND_GROWTH)
+            growths += 1
+            late += m >= kernels.HISTORY
+            again = PolygonSLAM(6, slam.bound, fusion="robust", noise_bound="nominal")
+            for start, end in readings[max(0, m + 1 - kernels.HISTORY) : m + 1]:
+                again.update(start, end)
+            mine, theirs = slam.batch, again.batch
+            np.testing.assert_array_equal(mine.level_counts, theirs.level_counts)
+            for (j, k), count in np.ndenumerate(mine.level_counts[0]):
+                np.testing.assert_array_equal(
+                    mine.level_vertices[0, j, k, :count], theirs.level_vertices[0, j, k, :count]
+                )
+            np.testing.assert_array_equal(mine.robot_polygon(0), theirs.robot_polygon(0))
+            assert slam.n_updates == m + 1
+    assert growths >= 6 and late >= 1
 
 
 def test_noise_within_epsilon_is_always_contained() -> None:
@@ -166,19 +236,24 @@ def test_a_misread_landmark_is_left_out_for_that_landmark_only() -> None:
     assert robust.outliers.tolist() == [0, 1, 0, 0]
 
 
-def test_the_robust_state_survives_copies_and_pickles() -> None:
-    episode = random_episode(np.random.default_rng(2), 5, 12)
-    readings = episode.readings(EPS)
-    readings[3][0][2] += 1.0  # one outlier, so that the levels differ
+@pytest.mark.parametrize("factor", [1.0, 1.6])
+def test_the_robust_state_survives_copies_and_pickles(factor: float) -> None:
+    """With one outlier (the levels differ), and with a bound too small (the bound, the
+    probe and the bearing history carry over)."""
+    episode = random_episode(np.random.default_rng(2), 5, 24)
+    readings = episode.readings(factor * EPS)
+    readings[3][0][2] += 1.0
     slam = PolygonSLAM(5, EPS, fusion="robust")
-    for b1, b2 in readings[:9]:
+    for b1, b2 in readings[:12]:
         slam.update(b1, b2)
     copies = [slam.copy(), pickle.loads(pickle.dumps(slam))]
-    for b1, b2 in readings[9:]:
+    for b1, b2 in readings[12:]:
         expected = slam.update(b1, b2)
         for other in copies:
             assert_same_result(other.update(b1, b2), expected)
             np.testing.assert_array_equal(other.areas, slam.areas)
+            assert other.bound == slam.bound
+    assert (slam.bound > EPS) == (factor > 1.0)
 
 
 @pytest.mark.parametrize(
@@ -188,6 +263,7 @@ def test_the_robust_state_survives_copies_and_pickles() -> None:
         ({"fusion": "robust", "risk": 0.7}, ValueError, r"risk must be in \(0, 0.5\], got 0.7"),
         ({"fusion": "robust", "risk": "low"}, TypeError, "risk must be a number, got 'low'"),
         ({"robust_set": "best"}, ValueError, "robust_set must be one of .* got 'best'"),
+        ({"noise_bound": "guess"}, ValueError, "noise_bound must be one of .* got 'guess'"),
     ],
 )
 def test_bad_robust_settings_are_named(kwargs: dict[str, object], error: type, match: str) -> None:
@@ -202,6 +278,7 @@ def test_bad_robust_settings_are_named(kwargs: dict[str, object], error: type, m
     [
         ({"fusion": "robust", "risk": 1.0}, r"risk must be in \(0, 0.5\], got 1.0"),
         ({"fusion": "robust", "robust_set": "all"}, "unknown robust_set 'all'"),
+        ({"fusion": "robust", "noise_bound": "auto"}, "unknown noise_bound 'auto'"),
     ],
 )
 def test_env_rejects_bad_robust_settings(kwargs: dict[str, object], match: str) -> None:
@@ -231,4 +308,11 @@ def test_env_robust_reports_its_levels_and_decodes_them() -> None:
     copy = decode(data, slam.n_landmarks, env.config.map_settings)
     np.testing.assert_array_equal(copy.areas, slam.areas)
     np.testing.assert_array_equal(copy.outliers, slam.outliers)
+    assert copy.bound == slam.bound
+    np.testing.assert_array_equal(copy.batch.history_bearings, slam.batch.history_bearings)
+    np.testing.assert_array_equal(copy.batch.probe_counts, slam.batch.probe_counts)
+    for j, count in enumerate(slam.batch.probe_counts[0]):
+        np.testing.assert_array_equal(
+            copy.batch.probe_vertices[0, j, :count], slam.batch.probe_vertices[0, j, :count]
+        )
     env.close()

@@ -617,6 +617,7 @@ ROBUST_FUSIONS: dict[str, dict[str, Any]] = {
     "robust (risk 0.05)": {"fusion": "robust"},
     "robust (risk 0.2)": {"fusion": "robust", "risk": 0.2},
     "robust, likely set": {"fusion": "robust", "robust_set": "likely"},
+    "robust, nominal bound": {"fusion": "robust", "noise_bound": "nominal"},
 }
 ROBUST_OUTLIER_RATES: tuple[float, ...] = (0.0, 0.01, 0.05, 0.1)
 #: True noise bounds, as multiples of epsilon.

@@ -90,6 +90,10 @@ from bearing_env.slam.kernels.polygons import (
     small_convex_hull,
 )
 from bearing_env.slam.kernels.robust import (
+    BOUND_GROWTH,
+    HISTORY,
+    MAX_NOISE_SCALE,
+    PROBE_SHRINK,
     ROBUST_LEVELS,
     binomial_q,
     contamination,
@@ -124,6 +128,7 @@ from bearing_env.slam.kernels.update import (
 )
 
 __all__ = [
+    "BOUND_GROWTH",
     "CAPACITY",
     "FRAME_L1_L2_OVERLAP",
     "FRAME_L1_L2_TOO_CLOSE",
@@ -141,6 +146,7 @@ __all__ = [
     "FUSION_INTERSECT",
     "FUSION_RELAXED",
     "FUSION_ROBUST",
+    "HISTORY",
     "INCONSISTENCY_KEEP",
     "INCONSISTENCY_RESTART",
     "INDEX_OK",
@@ -154,9 +160,11 @@ __all__ = [
     "MAX_CLOUD",
     "MAX_EDGE_SAMPLES",
     "MAX_FR_EXTENT",
+    "MAX_NOISE_SCALE",
     "MAX_PAIRS",
     "MAX_SAMPLES",
     "MAX_WINDOW",
+    "PROBE_SHRINK",
     "RELATIVE_TOLERANCE",
     "ROBUST_LEVELS",
     "SCRATCH",

@@ -74,6 +74,15 @@ class State(NamedTuple):
     level_counts: IntArray  #: (maps, m, levels) (levels: 0 unless ``"robust"``)
     n_regions: IntArray  #: (maps, m) regions fused into the robust levels
     robot_fixed_at: IntArray  #: (maps,) the movement (``n_updates``) that set the robot region
+    # The robust fusion's noise-bound estimate (h: ``HISTORY`` under ``"robust"``, else 0).
+    noise_scale: FloatArray  #: (maps,) the bound fused with, over the nominal epsilon
+    bound_events: IntArray  #: (maps,) times the probe found the bound too small
+    probe_vertices: ComplexArray  #: (maps, m, CAPACITY or 0) the probe's regions
+    probe_counts: IntArray  #: (maps, m)
+    history_frame_bearings: FloatArray  #: (maps, h, 2, 2) L1's and L2's, at R1 then R2
+    history_bearings: FloatArray  #: (maps, h, 2, m) the mapped landmarks', at R1 then R2
+    history_length: IntArray  #: (maps,) movements in the history
+    history_next: IntArray  #: (maps,) the slot the next movement goes to
 
 
 @structref.register
@@ -115,6 +124,7 @@ class Params(NamedTuple):
     with_robot: bool  #: also transfer the robot's position
     risk: float  #: robust fusion: the binomial tail the reported level leaves
     likely: bool  #: robust fusion: report the likely set, not the guaranteed one
+    estimate_bound: bool  #: robust fusion: estimate the noise bound (else keep epsilon)
 
 
 class Outputs(NamedTuple):

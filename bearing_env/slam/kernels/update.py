@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -45,8 +46,14 @@ from bearing_env.slam.kernels.polygons import (
     contains_point,
 )
 from bearing_env.slam.kernels.robust import (
+    PROBE_SHRINK,
     contamination,
+    forget_regions,
     frame_contradicts_robot,
+    grow_bound,
+    history_movement,
+    probe_landmark,
+    push_history,
     robust_landmark,
 )
 from bearing_env.slam.kernels.state import (
@@ -131,21 +138,18 @@ def _transfer_robot(
 def _cone_regions(
     bearings_start: np.ndarray,
     bearings_end: np.ndarray,
-    i: int,
     epsilon: float,
     fr: np.ndarray,
     fr_count: np.ndarray,
     fr_status: np.ndarray,
 ) -> int:
-    """Every landmark's FR region from bearings row ``i``; returns the frame code the
-    regions of L1 and L2 allow (:data:`FRAME_OK` if both are bounded)."""
-    for j in range(bearings_start.shape[1]):
-        if math.isnan(bearings_start[i, j]) or math.isnan(bearings_end[i, j]):
+    """Every landmark's FR region from one movement's bearings; returns the frame code
+    the regions of L1 and L2 allow (:data:`FRAME_OK` if both are bounded)."""
+    for j in range(bearings_start.shape[0]):
+        if math.isnan(bearings_start[j]) or math.isnan(bearings_end[j]):
             fr_count[j], fr_status[j] = 0, FR_MISSING
             continue
-        fr_count[j], fr_status[j] = cone_region(
-            bearings_start[i, j], bearings_end[i, j], epsilon, fr[j]
-        )
+        fr_count[j], fr_status[j] = cone_region(bearings_start[j], bearings_end[j], epsilon, fr[j])
     if fr_status[0] == FR_MISSING:
         return FRAME_L1_MISSING
     if fr_status[1] == FR_MISSING:
@@ -155,6 +159,199 @@ def _cone_regions(
     if fr_status[1] != FR_BOUNDED:
         return FRAME_L2_UNBOUNDED
     return FRAME_OK
+
+
+class Buffers(NamedTuple):
+    """What one thread of the update works in for one movement: the FR regions
+    (``fr``, ``fr_count``, ``fr_status``), the sampled hypotheses (``h1``, ``inv_d``),
+    the relaxed fusion's new-region counts, the FR robot point, a movement's bearings
+    read back from a map's history (``start``, ``end``) and the polygon scratch."""
+
+    fr: np.ndarray
+    fr_count: np.ndarray
+    fr_status: np.ndarray
+    h1: np.ndarray
+    inv_d: np.ndarray
+    fresh_counts: np.ndarray
+    robot_point: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    scratch: Scratch
+
+
+@njit(**_JIT)
+def _new_buffers(n_landmarks: int) -> Buffers:
+    return Buffers(
+        np.empty((n_landmarks, FR_VERTICES), dtype=np.complex128),
+        np.empty(n_landmarks, dtype=np.int64),
+        np.empty(n_landmarks, dtype=np.int64),
+        np.empty(MAX_PAIRS, dtype=np.complex128),
+        np.empty(MAX_PAIRS, dtype=np.complex128),
+        np.zeros(n_landmarks, dtype=np.int64),
+        np.ones(1, dtype=np.complex128),
+        np.empty(n_landmarks),
+        np.empty(n_landmarks),
+        new_scratch(),
+    )
+
+
+@njit(**_JIT)
+def _update_row(
+    i: int,
+    row: int,
+    bearings_start: np.ndarray,
+    bearings_end: np.ndarray,
+    epsilon: float,
+    params: Params,
+    state: State,
+    out: Outputs,
+    buf: Buffers,
+) -> None:
+    """Fuse one movement (bearings ``bearings_start`` and ``bearings_end``, read with the
+    bound ``epsilon``) into map ``row``, reporting to ``out`` row ``i``."""
+    n_landmarks = bearings_start.shape[0]
+    relaxed = params.fusion == FUSION_RELAXED
+    robust = params.fusion == FUSION_ROBUST
+    keep = params.on_inconsistency == INCONSISTENCY_KEEP
+    frame_status, landmark_status = out.frame_status, out.landmark_status
+    fr, fr_count, fr_status, scratch = buf.fr, buf.fr_count, buf.fr_status, buf.scratch
+    fresh_counts = buf.fresh_counts
+    state.n_updates[row] += 1
+    out.n_bad[i] = 0
+    for j in range(n_landmarks - 2):
+        landmark_status[i, j] = LANDMARK_SKIPPED
+    frame_status[i] = _cone_regions(bearings_start, bearings_end, epsilon, fr, fr_count, fr_status)
+    if frame_status[i] != FRAME_OK:
+        return
+    status, frame = _frame_of(fr, fr_count, params, buf.h1, buf.inv_d)
+    frame_status[i] = status
+    if status != FRAME_OK:
+        return
+    newest = 0
+    if relaxed:
+        newest = _open_window_slot(state, row, scratch)
+    rate = contamination(state, row) if robust else 0.0
+    last = n_landmarks
+    if robust and params.with_robot and frame_contradicts_robot(state, row, frame, scratch):
+        frame_status[i] = FRAME_REJECTED  # a misread L1 or L2: no landmark is fused
+        last = 2
+    for j in range(2, last):
+        slot = j - 2
+        fresh_counts[slot] = 0
+        if fr_status[j] == FR_MISSING:
+            landmark_status[i, slot] = LANDMARK_MISSING
+            continue
+        if fr_status[j] == FR_EMPTY:
+            landmark_status[i, slot] = LANDMARK_INCONSISTENT
+            continue
+        if fr_status[j] != FR_BOUNDED:
+            landmark_status[i, slot] = LANDMARK_UNBOUNDED
+            continue
+        n_new = transfer_region(
+            fr[j], fr_count[j], frame, scratch.cloud, scratch.hull, scratch.fresh
+        )
+        if n_new < 3:
+            landmark_status[i, slot] = LANDMARK_UNBOUNDED
+            continue
+        landmark_status[i, slot] = LANDMARK_UPDATED
+        if relaxed:
+            _copy_polygon(scratch.fresh, n_new, state.window_vertices[row, newest, slot])
+            state.window_counts[row, newest, slot] = n_new
+            fresh_counts[slot] = n_new
+        elif robust:
+            if not robust_landmark(state, row, slot, n_new, rate, params, scratch):
+                landmark_status[i, slot] = LANDMARK_INCONSISTENT
+        elif not intersect_landmark(state, row, slot, n_new, keep, scratch):
+            landmark_status[i, slot] = LANDMARK_INCONSISTENT
+    if relaxed and relaxed_movement(state, row, fresh_counts, params, out, i, scratch):
+        frame_status[i] = FRAME_REJECTED
+    state.n_frame_changes[row] += frame_status[i] == FRAME_OK
+    bad = 0
+    for j in range(n_landmarks - 2):
+        if landmark_status[i, j] == LANDMARK_INCONSISTENT:
+            bad += 1
+    out.n_bad[i] = bad
+    state.n_inconsistent[row] += bad
+    if not params.with_robot:
+        return
+    if frame_status[i] == FRAME_REJECTED:
+        # The frame change itself is the outlier: the robot's region is unknown.
+        state.robot_counts[row] = 0
+        state.robot_area[row], state.robot_centroid[row] = np.inf, complex(np.nan, np.nan)
+        state.robot_heading[row] = np.nan
+        return
+    _transfer_robot(state, row, frame, scratch, buf.robot_point)
+    state.robot_fixed_at[row] = state.n_updates[row]
+
+
+@njit(**_JIT)
+def _probe_row(
+    i: int,
+    row: int,
+    bearings_start: np.ndarray,
+    bearings_end: np.ndarray,
+    epsilon: float,
+    params: Params,
+    state: State,
+    out: Outputs,
+    buf: Buffers,
+) -> int:
+    """Fuse the movement just fused into map ``row`` (with the bound ``epsilon``, as
+    ``out`` row ``i`` reports) into its probe, at ``PROBE_SHRINK * epsilon``; returns
+    how many landmarks give evidence that the bound is too small: the probe contradicts
+    them while the map fused them consistently."""
+    if out.frame_status[i] != FRAME_OK:
+        return 0
+    fr, fr_count, fr_status, scratch = buf.fr, buf.fr_count, buf.fr_status, buf.scratch
+    status = _cone_regions(
+        bearings_start, bearings_end, PROBE_SHRINK * epsilon, fr, fr_count, fr_status
+    )
+    if status != FRAME_OK:
+        return 0
+    status, frame = _frame_of(fr, fr_count, params, buf.h1, buf.inv_d)
+    if status != FRAME_OK:
+        return 0
+    evidence = 0
+    for j in range(2, bearings_start.shape[0]):
+        slot = j - 2
+        consistent_here = out.landmark_status[i, slot] == LANDMARK_UPDATED
+        if fr_status[j] == FR_EMPTY:
+            evidence += consistent_here
+            continue
+        if fr_status[j] != FR_BOUNDED:
+            continue
+        n_new = transfer_region(
+            fr[j], fr_count[j], frame, scratch.cloud, scratch.hull, scratch.fresh
+        )
+        if n_new >= 3 and not probe_landmark(state, row, slot, n_new, scratch):
+            evidence += consistent_here
+    return evidence
+
+
+@njit(**_JIT)
+def _rebuild_row(
+    i: int, row: int, params: Params, state: State, out: Outputs, buf: Buffers
+) -> None:
+    """Fuse map ``row``'s kept movements again, oldest first, into empty regions, levels
+    and probe at its (new) bound; ``out`` row ``i`` ends with what the newest one did.
+    The counters end as if only the newest movement had been fused at that bound."""
+    updates, changes, inconsistent = (
+        state.n_updates[row] - 1,
+        state.n_frame_changes[row] - (out.frame_status[i] == FRAME_OK),
+        state.n_inconsistent[row] - out.n_bad[i],
+    )
+    epsilon = params.epsilon * state.noise_scale[row]
+    forget_regions(state, row)
+    for k in range(state.history_length[row]):
+        history_movement(state, row, k, buf.start, buf.end)
+        _update_row(i, row, buf.start, buf.end, epsilon, params, state, out, buf)
+        _probe_row(i, row, buf.start, buf.end, epsilon, params, state, out, buf)
+    fixed_by_newest = state.robot_fixed_at[row] == state.n_updates[row]
+    state.n_updates[row] = updates + 1
+    state.n_frame_changes[row] = changes + (out.frame_status[i] == FRAME_OK)
+    state.n_inconsistent[row] = inconsistent + out.n_bad[i]
+    # Older kept robot regions cannot be told apart from this movement's: none is older.
+    state.robot_fixed_at[row] = state.n_updates[row] if fixed_by_newest else -1
 
 
 @njit(**_JIT)
@@ -168,90 +365,25 @@ def _update_rows(
     state: State,
     out: Outputs,
 ) -> None:
-    """:func:`update_maps` for bearings rows ``first`` to ``stop``, with scratch of its own."""
-    n_landmarks = bearings_start.shape[1]
-    relaxed = params.fusion == FUSION_RELAXED
-    robust = params.fusion == FUSION_ROBUST
-    keep = params.on_inconsistency == INCONSISTENCY_KEEP
-    frame_status, landmark_status = out.frame_status, out.landmark_status
-    fresh_counts = np.zeros(n_landmarks, dtype=np.int64)
-    fr = np.empty((n_landmarks, FR_VERTICES), dtype=np.complex128)
-    fr_count = np.empty(n_landmarks, dtype=np.int64)
-    fr_status = np.empty(n_landmarks, dtype=np.int64)
-    h1 = np.empty(MAX_PAIRS, dtype=np.complex128)
-    inv_d = np.empty(MAX_PAIRS, dtype=np.complex128)
-    scratch = new_scratch()
-    robot_point = np.ones(1, dtype=np.complex128)
-    newest = 0
+    """:func:`update_maps` for bearings rows ``first`` to ``stop``, with buffers of its own."""
+    estimating = params.fusion == FUSION_ROBUST and params.estimate_bound
+    buf = _new_buffers(bearings_start.shape[1])
     for i in range(first, stop):
         row = rows[i]
-        state.n_updates[row] += 1
-        out.n_bad[i] = 0
-        for j in range(n_landmarks - 2):
-            landmark_status[i, j] = LANDMARK_SKIPPED
-        frame_status[i] = _cone_regions(
-            bearings_start, bearings_end, i, params.epsilon, fr, fr_count, fr_status
+        epsilon = params.epsilon
+        if estimating:
+            epsilon *= state.noise_scale[row]
+        _update_row(i, row, bearings_start[i], bearings_end[i], epsilon, params, state, out, buf)
+        if not estimating:
+            continue
+        push_history(state, row, bearings_start[i], bearings_end[i])
+        evidence = _probe_row(
+            i, row, bearings_start[i], bearings_end[i], epsilon, params, state, out, buf
         )
-        if frame_status[i] != FRAME_OK:
-            continue
-        status, frame = _frame_of(fr, fr_count, params, h1, inv_d)
-        frame_status[i] = status
-        if status != FRAME_OK:
-            continue
-        if relaxed:
-            newest = _open_window_slot(state, row, scratch)
-        rate = contamination(state, row) if robust else 0.0
-        last = n_landmarks
-        if robust and params.with_robot and frame_contradicts_robot(state, row, frame, scratch):
-            frame_status[i] = FRAME_REJECTED  # a misread L1 or L2: no landmark is fused
-            last = 2
-        for j in range(2, last):
-            slot = j - 2
-            fresh_counts[slot] = 0
-            if fr_status[j] == FR_MISSING:
-                landmark_status[i, slot] = LANDMARK_MISSING
-                continue
-            if fr_status[j] == FR_EMPTY:
-                landmark_status[i, slot] = LANDMARK_INCONSISTENT
-                continue
-            if fr_status[j] != FR_BOUNDED:
-                landmark_status[i, slot] = LANDMARK_UNBOUNDED
-                continue
-            n_new = transfer_region(
-                fr[j], fr_count[j], frame, scratch.cloud, scratch.hull, scratch.fresh
-            )
-            if n_new < 3:
-                landmark_status[i, slot] = LANDMARK_UNBOUNDED
-                continue
-            landmark_status[i, slot] = LANDMARK_UPDATED
-            if relaxed:
-                _copy_polygon(scratch.fresh, n_new, state.window_vertices[row, newest, slot])
-                state.window_counts[row, newest, slot] = n_new
-                fresh_counts[slot] = n_new
-            elif robust:
-                if not robust_landmark(state, row, slot, n_new, rate, params, scratch):
-                    landmark_status[i, slot] = LANDMARK_INCONSISTENT
-            elif not intersect_landmark(state, row, slot, n_new, keep, scratch):
-                landmark_status[i, slot] = LANDMARK_INCONSISTENT
-        if relaxed and relaxed_movement(state, row, fresh_counts, params, out, i, scratch):
-            frame_status[i] = FRAME_REJECTED
-        state.n_frame_changes[row] += frame_status[i] == FRAME_OK
-        bad = 0
-        for j in range(n_landmarks - 2):
-            if landmark_status[i, j] == LANDMARK_INCONSISTENT:
-                bad += 1
-        out.n_bad[i] = bad
-        state.n_inconsistent[row] += bad
-        if not params.with_robot:
-            continue
-        if frame_status[i] == FRAME_REJECTED:
-            # The frame change itself is the outlier: the robot's region is unknown.
-            state.robot_counts[row] = 0
-            state.robot_area[row], state.robot_centroid[row] = np.inf, complex(np.nan, np.nan)
-            state.robot_heading[row] = np.nan
-            continue
-        _transfer_robot(state, row, frame, scratch, robot_point)
-        state.robot_fixed_at[row] = state.n_updates[row]
+        if evidence > 0:
+            state.bound_events[row] += evidence
+            if grow_bound(state, row, params.epsilon):
+                _rebuild_row(i, row, params, state, out, buf)
 
 
 @njit(**_JIT)
