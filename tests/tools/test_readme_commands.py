@@ -167,6 +167,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--workers 2 --out outputs/compare_lookahead": ("parse", ()),
     "bearing-env figures --only robust --out docs/figures": ("parse", ()),
     "bearing-env robust-eval": ("parse", ()),
+    "bearing-env robust-eval --episodes 200": ("parse", ()),
     "bearing-env compare --policies random parallax greedy pretrained:ppo_khepera --env-kwargs "
     "scenario=khepera \"noise={'kind':'uniform','bound_deg':2,'outlier_rate':0.05}\" "
     "fusion=robust --episodes 200 --out outputs/faults_robust": ("parse", ()),
