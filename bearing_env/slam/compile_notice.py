@@ -1,8 +1,8 @@
 """A one-line notice on stderr before the compiled core is built for the first time.
 
-Compiling the world model's kernels from an empty numba cache takes tens of seconds
-(measured 36-44 s on a shared 2-core machine), during which a first ``env.step`` would
-otherwise hang in silence. The first :class:`~bearing_env.slam.batch.BatchedPolygonSLAM`
+Compiling the kernels from an empty numba cache takes about a minute (a first Khepera
+``env.step`` measured 72-76 s on a quiet 2-core machine, of which the world model's
+update is about 38 s), during which it would otherwise hang in silence. The first :class:`~bearing_env.slam.batch.BatchedPolygonSLAM`
 a process makes checks numba's own cache index of the batched update (the serial and
 the parallel kernel, whichever the process will use): numba loads an index only when
 it matches the kernel's source file and this numba version, so an empty index means
@@ -16,7 +16,7 @@ import sys
 from typing import Any
 
 #: The notice's estimate, from the cold compiles measured on the development machine.
-COLD_COMPILE_SECONDS = 40
+COLD_COMPILE_SECONDS = 75
 NOTICE = (
     f"bearing_env: compiling the numba core, once (about {COLD_COMPILE_SECONDS} s; "
     "later runs load it from numba's cache)..."
