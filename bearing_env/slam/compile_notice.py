@@ -2,12 +2,12 @@
 
 Compiling the kernels from an empty numba cache takes about a minute (a first Khepera
 ``env.step`` measured 72-76 s on a quiet 2-core machine, of which the world model's
-update is about 38 s), during which it would otherwise hang in silence. The first :class:`~bearing_env.slam.batch.BatchedPolygonSLAM`
-a process makes checks numba's own cache index of the batched update (the serial and
-the parallel kernel, whichever the process will use): numba loads an index only when
-it matches the kernel's source file and this numba version, so an empty index means
-the core is about to compile (empty or stale cache). Then it prints the notice, once;
-with a warm cache it prints nothing.
+update is about 38 s), during which it would otherwise hang in silence. The first
+:class:`~bearing_env.slam.batch.BatchedPolygonSLAM` a process makes checks numba's own
+cache index of the batched update (the serial and the parallel kernel, whichever the
+process will use): numba loads an index only when it matches the kernel's source file
+and this numba version, so an empty index means the core is about to compile (empty or
+stale cache). Then it prints the notice, once; with a warm cache it prints nothing.
 """
 
 from __future__ import annotations

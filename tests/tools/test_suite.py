@@ -184,3 +184,47 @@ def test_bearing_env_dispatches_suite(capsys: pytest.CaptureFixture[str]) -> Non
     assert "bearing-env suite" in text and "--tasks" in text and "default 50" in text
     cli.main(["--help"])
     assert "suite:" in capsys.readouterr().out
+
+
+def fake_summary(folder: Path, means: dict[str, float]) -> None:
+    """A finished comparison's ``summary.json``: 4 episodes per policy, each with the
+    given mean total area after 20 moves."""
+    folder.mkdir(parents=True)
+    policies = {
+        label: {
+            "episodes": 4,
+            "area_after": {"20": {"mean": mean, "ci_low": mean / 2, "ci_high": mean * 2}},
+        }
+        for label, mean in means.items()
+    }
+    config = {"episodes": 4, "policies": list(means)}
+    (folder / "summary.json").write_text(json.dumps({"config": config, "policies": policies}))
+
+
+def test_the_index_keeps_the_rows_of_tasks_this_run_did_not_compare(tmp_path: Path) -> None:
+    from bearing_env.train.compare.task_cards import INDEX_NAME, card_name, write_index
+
+    first, second, uncarded = (TASKS_BY_ID[t] for t in (*TWO_TASKS, "BearingSLAM-Random8-v0"))
+    docs, earlier, later = tmp_path / "docs", tmp_path / "earlier", tmp_path / "later"
+    docs.mkdir()
+    for task in (first, second):
+        (docs / card_name(task)).write_text("# card\n")
+    fake_summary(earlier / first.id, {"random_polygonal": 2.0, "greedy_one_step": 0.5})
+    fake_summary(earlier / second.id, {"random_polygonal": 3.0, "greedy_one_step": 0.25})
+    fake_summary(earlier / uncarded.id, {"random_polygonal": 9.0})
+    write_index(TASKS, docs, earlier)
+    # A later run compares the first task only, with another policy set.
+    fake_summary(later / first.id, {"random_polygonal": 1.5, "lookahead": 0.125})
+    write_index(TASKS, docs, later)
+    glance = (docs / INDEX_NAME).read_text().split("## Baselines at a glance", 1)[1]
+    table = [line for line in glance.splitlines() if line.startswith("|")]
+    rows = {line.split("|")[1].strip(): line for line in table if "-v0" in line}
+    assert set(rows) == {first.id, second.id}  # no card, no row
+    header = table[0]
+    columns = [cell.strip() for cell in header.strip("|").split("|")]
+    assert columns == [
+        "task", "moves", "episodes", "random_polygonal", "lookahead", "greedy_one_step"
+    ]  # fmt: skip
+    assert "1.5 [0.75, 3]" in rows[first.id] and "0.5" not in rows[first.id]
+    cells = [cell.strip() for cell in rows[second.id].strip("|").split("|")]
+    assert cells == [second.id, "20", "4", "3 [1.5, 6]", "-", "0.25 [0.125, 0.5]"]

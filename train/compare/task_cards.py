@@ -30,6 +30,8 @@ from bearing_env.train.compare.report import (
 from bearing_env.train.compare.runner import make_env
 
 INDEX_NAME = "index.md"
+#: The heading of the index's overview table (:func:`overview_markdown`).
+OVERVIEW_HEADING = "## Baselines at a glance"
 #: Moves of the greedy policy before the card's frame is rendered.
 FRAME_MOVES = 5
 
@@ -364,34 +366,69 @@ def final_area_cell(stats: Mapping[str, Any], move: str) -> str:
     return f"{entry['mean']:.3g} [{entry['ci_low']:.3g}, {entry['ci_high']:.3g}]"
 
 
-def overview_rows(
+def overview_cells(
     results: Sequence[tuple[Task, Mapping[str, Any]]],
-) -> tuple[list[str], list[list[str]]]:
-    """Per task, the mean total area [95% CI] of each policy after the last reported
-    move count: the header and the rows (``-`` where a policy did not run)."""
-    labels: list[str] = []
-    for _, summary in results:
-        labels += [label for label in summary["policies"] if label not in labels]
-    header = ["task", "moves", "episodes", *labels]
-    rows = []
+) -> dict[str, dict[str, str]]:
+    """Per task id, its overview row as cells by column (``moves``, ``episodes`` and one
+    per policy label): each policy's mean total area [95% CI] after the last reported
+    move count."""
+    cells: dict[str, dict[str, str]] = {}
     for task, summary in results:
         policies = summary["policies"]
         moves = sorted({int(k) for p in policies.values() for k in p["area_after"]})
         last = str(moves[-1]) if moves else ""
         episodes = sorted({int(p["episodes"]) for p in policies.values()})
-        cells = [task.id, last, "/".join(str(n) for n in episodes)]
-        for label in labels:
-            cells.append(final_area_cell(policies[label], last) if label in policies else "-")
-        rows.append(cells)
-    return header, rows
+        row = {"moves": last, "episodes": "/".join(str(n) for n in episodes)}
+        for label, stats in policies.items():
+            row[label] = final_area_cell(stats, last)
+        cells[task.id] = row
+    return cells
+
+
+def overview_markdown(cells: Mapping[str, Mapping[str, str]]) -> str:
+    """The overview table of ``cells`` (:func:`overview_cells`), in their order, with its
+    title: one column per policy any task ran (``-`` where a task's did not)."""
+    labels: list[str] = []
+    for row in cells.values():
+        labels += [c for c in row if c not in ("moves", "episodes") and c not in labels]
+    header = ["task", "moves", "episodes", *labels]
+    rows = [[task, *(row.get(column, "-") for column in header[1:])] for task, row in cells.items()]
+    return (
+        "Mean total area [95% bootstrap CI] after the last move (FL units², lower is "
+        "better):\n\n" + markdown_table(header, rows)
+    )
 
 
 def overview_table(results: Sequence[tuple[Task, Mapping[str, Any]]]) -> str:
-    """:func:`overview_rows` as a Markdown table with its title."""
-    return (
-        "Mean total area [95% bootstrap CI] after the last move (FL units², lower is "
-        "better):\n\n" + markdown_table(*overview_rows(results))
-    )
+    """The overview of finished comparisons as a Markdown table with its title."""
+    return overview_markdown(overview_cells(results))
+
+
+def published_overview(index: Path) -> dict[str, dict[str, str]]:
+    """The rows of an existing ``index.md``'s overview table (:func:`overview_markdown`),
+    as cells by column per task id; empty when there is no such file or table."""
+    if not index.is_file():
+        return {}
+    lines = index.read_text(encoding="utf-8").splitlines()
+    try:
+        start = lines.index(OVERVIEW_HEADING)
+    except ValueError:
+        return {}
+    header: list[str] | None = None
+    cells: dict[str, dict[str, str]] = {}
+    for line in lines[start + 1 :]:
+        if line.startswith("#"):
+            break
+        if not line.startswith("|"):
+            if header is not None:
+                break
+            continue
+        row = [cell.strip() for cell in line.strip().strip("|").split("|")]
+        if header is None:
+            header = row
+        elif not all(set(cell) <= {"-"} for cell in row):
+            cells[row[0]] = dict(zip(header[1:], row[1:], strict=False))
+    return cells
 
 
 def finished_summary(folder: Path) -> dict[str, Any] | None:
@@ -412,7 +449,9 @@ def finished_summary(folder: Path) -> dict[str, Any] | None:
 
 def index_page(tasks: Sequence[Task], docs: Path, out: Path) -> str:
     """The Markdown of ``index.md``: the task table (linking the cards that exist in
-    ``docs``) and the baselines at a glance (from the finished comparisons in ``out``)."""
+    ``docs``) and the baselines at a glance: from the finished comparisons in ``out``,
+    and for a task with a card but none there, its row of the index already in ``docs``
+    (a suite run on some of the tasks keeps the others' rows)."""
     from bearing_env.tasks import NAMING_RULE
 
     rows = []
@@ -422,12 +461,16 @@ def index_page(tasks: Sequence[Task], docs: Path, out: Path) -> str:
         rows.append(
             [f"`{task.id}`", task.action_kind, task.description, f"`{task.settings_text()}`", link]
         )
-    finished = [
-        (task, summary)
-        for task in tasks
-        if (summary := finished_summary(out / task.id)) is not None
-        and (docs / card_name(task)).is_file()
-    ]
+    carded = [task for task in tasks if (docs / card_name(task)).is_file()]
+    fresh = overview_cells(
+        [(t, summary) for t in carded if (summary := finished_summary(out / t.id)) is not None]
+    )
+    published = published_overview(docs / INDEX_NAME)
+    overview = {
+        t.id: fresh[t.id] if t.id in fresh else published[t.id]
+        for t in carded
+        if t.id in fresh or t.id in published
+    }
     parts = [
         "# Tasks",
         "",
@@ -442,8 +485,8 @@ def index_page(tasks: Sequence[Task], docs: Path, out: Path) -> str:
         "",
         "Naming rule: " + NAMING_RULE,
     ]
-    if finished:
-        parts += ["## Baselines at a glance", "", overview_table(finished), ""]
+    if overview:
+        parts += [OVERVIEW_HEADING, "", overview_markdown(overview), ""]
     # The docs site lists the cards under this page (a hidden toctree: the table links them).
     cards = [
         card_name(task).removesuffix(".md") for task in tasks if (docs / card_name(task)).is_file()
