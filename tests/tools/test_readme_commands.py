@@ -168,6 +168,9 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env figures --only robust --out docs/figures": ("parse", ()),
     "bearing-env robust-eval": ("parse", ()),
     "bearing-env robust-eval --episodes 200": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAM-v0 --env-kwargs scenario=khepera "
+    "--init-from pretrained:ppo_khepera --timesteps 2000000 "
+    "--output runs/ppo_khepera_finetune": ("parse", ()),
     "bearing-env compare --policies random parallax greedy pretrained:ppo_khepera --env-kwargs "
     "scenario=khepera \"noise={'kind':'uniform','bound_deg':2,'outlier_rate':0.05}\" "
     "fusion=robust --episodes 200 --out outputs/faults_robust": ("parse", ()),

@@ -198,6 +198,82 @@ def test_same_seed_gives_the_same_model(tmp_path: Path) -> None:
 
 
 # --------------------------------------------------------------------------------------
+# Fine-tuning: --init-from
+# --------------------------------------------------------------------------------------
+
+
+def test_init_from_starts_a_new_run_from_the_models_weights_and_statistics(
+    tiny_runs: dict[str, TrainResult], tmp_path: Path
+) -> None:
+    source = tiny_runs["ppo"]
+    # learning_rate 0: the weights stay the source's, so any difference is the loading's.
+    settings = tiny_settings(
+        "ppo",
+        tmp_path / "fine",
+        init_from=source.run_dir,  # a run folder: its best model (or model.zip)
+        timesteps=128,
+        eval_freq=0,
+        hyperparam_overrides={**TINY_HYPERPARAMS["ppo"], "learning_rate": 0.0},
+    )
+    tuned = train(settings)
+    started_from = load_model(train_module.resolve_model_path(source.run_dir), "ppo")
+    for (name, a), (_, b) in zip(
+        tuned.model.policy.state_dict().items(),
+        started_from.policy.state_dict().items(),
+        strict=True,
+    ):
+        assert np.array_equal(a.numpy(), b.numpy()), name
+    fresh = train(replace(settings, output=tmp_path / "fresh", init_from=None))
+    assert any(
+        not np.array_equal(a.numpy(), b.numpy())
+        for a, b in zip(
+            fresh.model.policy.state_dict().values(),
+            started_from.policy.state_dict().values(),
+            strict=True,
+        )
+    )
+    # The statistics continue from the source's: more observations than this run made.
+    source_stats = load_vecnormalize(source.run_dir / "vecnormalize.pkl")
+    tuned_stats = tuned.model.get_vec_normalize_env()
+    fresh_stats = fresh.model.get_vec_normalize_env()
+    assert tuned_stats is not None and fresh_stats is not None
+    assert tuned_stats.obs_rms.count > source_stats.obs_rms.count > fresh_stats.obs_rms.count
+    record = json.loads((tmp_path / "fine" / "run.json").read_text())
+    assert record["init_from"] == str(settings.init_from)
+
+
+def test_init_from_refuses_weights_that_do_not_fit(
+    tiny_runs: dict[str, TrainResult], tmp_path: Path
+) -> None:
+    wider = {**TINY_HYPERPARAMS["ppo"], "policy_kwargs": "dict(net_arch=[48, 48])"}
+    settings = tiny_settings(
+        "ppo",
+        tmp_path / "wide",
+        init_from=tiny_runs["ppo"].run_dir / "model.zip",
+        hyperparam_overrides=wider,
+    )
+    with pytest.raises(ValueError, match=r"--init-from: the weights of .*model\.zip do not fit"):
+        train(settings)
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--init-from", "pretrained:no_such_model"], "no pretrained model named 'no_such_model'"),
+        (["--init-from", "missing_dir/model.zip"], "SB3 model file not found"),
+    ],
+)
+def test_init_from_errors_are_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], extra: list[str], message: str
+) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        train_cli.main(["--algo", "ppo", "--output", str(tmp_path / "run"), *extra])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+
+
+# --------------------------------------------------------------------------------------
 # Resume, interruption
 # --------------------------------------------------------------------------------------
 

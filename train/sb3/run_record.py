@@ -61,6 +61,7 @@ def new_run_record(
         "hyperparams": json_safe(dict(hyperparams)),
         "n_envs": n_envs,
         "seed": settings.seed,
+        "init_from": str(settings.init_from) if settings.init_from is not None else None,
         "vec_env": vec_env_kind,
         "target_timesteps": target_timesteps,
         "num_timesteps": num_timesteps,

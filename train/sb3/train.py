@@ -101,7 +101,12 @@ from stable_baselines3.common.vec_env import (
     VecNormalize,
 )
 
-from bearing_env.agents.sb3 import load_model, load_vecnormalize
+from bearing_env.agents.sb3 import (
+    find_vecnormalize,
+    load_model,
+    load_vecnormalize,
+    resolve_model_path,
+)
 from bearing_env.train.common.files import write_json_atomically
 from bearing_env.train.common.seeds import (
     training_seed_start,
@@ -161,6 +166,9 @@ class TrainSettings:
     n_envs: int | None = None
     vec_env: str = "auto"
     resume: bool = False
+    #: A model (a ``.zip``, or a run folder's best model) whose weights the new run
+    #: starts from: a fine-tune. Its VecNormalize statistics beside it are loaded too.
+    init_from: Path | None = None
     eval_freq: int = DEFAULT_EVAL_FREQ
     eval_episodes: int = DEFAULT_EVAL_EPISODES
     checkpoint_freq: int = DEFAULT_CHECKPOINT_FREQ
@@ -288,7 +296,7 @@ def train(settings: TrainSettings) -> TrainResult:
     apply_process_settings(settings, plan)
     envs = build_envs(settings, plan)
     try:
-        normalize_envs(envs, plan)
+        normalize_envs(envs, plan, settings)
         model = build_model(settings, plan, envs)
         run_log = start_run_record(settings, plan, envs, model)
         callbacks = build_callbacks(settings, plan, envs, run_log)
@@ -337,6 +345,13 @@ def plan_run(settings: TrainSettings) -> RunPlan:
     record to resume from, all checked before any env or model is built."""
     algorithm_class = algorithm_class_for(settings.algo)
     raw, checkpoint = resolve_run(settings)
+    if settings.init_from is not None:
+        if checkpoint is not None:
+            raise ValueError(
+                f"--init-from starts a new run, but {settings.output} holds a checkpoint to "
+                "resume: drop --resume, or choose another --output"
+            )
+        settings.init_from = resolve_model_path(settings.init_from)
     hyperparams = parse_hyperparameters(raw, settings.algo)
     n_envs = settings.n_envs if settings.n_envs is not None else hyperparams.n_envs
     target = settings.timesteps if settings.timesteps is not None else hyperparams.n_timesteps
@@ -420,15 +435,24 @@ def build_envs(settings: TrainSettings, plan: RunPlan) -> TrainingEnvs:
     return TrainingEnvs(venv, eval_venv, vec_env_kind, area_cap, seed_start)
 
 
-def normalize_envs(envs: TrainingEnvs, plan: RunPlan) -> None:
+def init_statistics(init_from: Path | None) -> Path | None:
+    """The VecNormalize statistics beside an ``--init-from`` model (None without one)."""
+    return None if init_from is None else find_vecnormalize(init_from)
+
+
+def normalize_envs(envs: TrainingEnvs, plan: RunPlan, settings: TrainSettings) -> None:
     """Phase 4: when the entry normalises, VecNormalize around both envs (the training
-    one resumes the checkpoint's statistics; the validation one never updates its own)."""
+    one resumes the checkpoint's statistics, or starts from those of the ``--init-from``
+    model; the validation one never updates its own)."""
     normalize = plan.hyperparams.normalize
     if normalize is None:
         return
     checkpoint = plan.checkpoint
+    statistics = init_statistics(settings.init_from)
     if checkpoint is not None and checkpoint.vecnormalize_path.is_file():
-        resumed = load_vecnormalize(checkpoint.vecnormalize_path, envs.train)
+        statistics = checkpoint.vecnormalize_path
+    if statistics is not None and statistics.is_file():
+        resumed = load_vecnormalize(statistics, envs.train)
         resumed.training = True
         envs.train = resumed
     else:
@@ -466,6 +490,8 @@ def build_model(settings: TrainSettings, plan: RunPlan, envs: TrainingEnvs) -> B
             verbose=settings.verbose,
             **plan.hyperparams.algorithm_kwargs,
         )
+        if settings.init_from is not None:
+            start_from(model, settings.init_from, settings.device)
     model.set_random_seed(envs.seed_start)  # torch/numpy/action space, env i: seed_start + i
     return model
 
@@ -522,6 +548,20 @@ def start_run_record(
     run_log = RunLog(plan.files.record, record, segment, learn_start, remaining)
     run_log.write()
     return run_log
+
+
+def start_from(model: BaseAlgorithm, path: Path, device: str) -> None:
+    """Give a new model the weights of the model saved at ``path`` (``--init-from``), or
+    a clear error when its networks do not fit (another observation kind, algorithm or
+    network size)."""
+    try:
+        model.set_parameters(str(path), exact_match=True, device=device)
+    except (RuntimeError, KeyError, ValueError) as error:
+        first_line = str(error).strip().splitlines()[0] if str(error).strip() else repr(error)
+        raise ValueError(
+            f"--init-from: the weights of {path} do not fit this run's "
+            f"{model.__class__.__name__} policy ({first_line})"
+        ) from error
 
 
 @dataclass(frozen=True)

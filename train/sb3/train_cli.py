@@ -40,6 +40,8 @@ from bearing_env.train.sb3.train import (
 from bearing_env.train.sb3.training_envs import VEC_ENV_CHOICES
 from bearing_env.train.sb3.zoo import DEFAULT_ENV_IDS, hyperparams_key
 
+#: How ``--init-from`` names a shipped model.
+PRETRAINED_PREFIX = "pretrained:"
 #: The exit status after Ctrl-C or SIGTERM stopped training (a checkpoint was saved).
 EXIT_INTERRUPTED = 130
 
@@ -109,6 +111,13 @@ def _add_run_folder_options(group: argparse._ArgumentGroup) -> None:
     add = group.add_argument
     add("--output", type=Path, help="run folder (default runs/<algo>_<env>_seed<seed>)")
     add("--resume", action="store_true", help="continue the run in --output from its checkpoint")
+    add(
+        "--init-from",
+        metavar="MODEL",
+        help="start a new run from the weights of MODEL (a .zip, a run folder, or "
+        "pretrained:NAME for a shipped model) and the VecNormalize statistics saved beside "
+        "it, for fine-tuning; its networks must fit the run's (default: none, new weights)",
+    )
     add(
         "--export",
         type=Path,
@@ -192,6 +201,7 @@ def settings_from_args(args: argparse.Namespace) -> TrainSettings:
         n_envs=args.n_envs,
         vec_env=args.vec_env,
         resume=args.resume,
+        init_from=init_model_path(args.init_from),
         eval_freq=args.eval_freq,
         eval_episodes=args.eval_episodes,
         checkpoint_freq=args.checkpoint_freq,
@@ -202,6 +212,23 @@ def settings_from_args(args: argparse.Namespace) -> TrainSettings:
         torch_threads=args.torch_threads or None,
         verbose=args.verbose,
     )
+
+
+def init_model_path(spec: str | None) -> Path | None:
+    """``--init-from``'s model: ``pretrained:NAME`` is a shipped model's ``.zip``."""
+    if spec is None:
+        return None
+    if spec.startswith(PRETRAINED_PREFIX):
+        from bearing_env.agents.sb3 import PRETRAINED_DIR, pretrained_names
+
+        name = spec.removeprefix(PRETRAINED_PREFIX)
+        if name not in pretrained_names():
+            raise ValueError(
+                f"--init-from: no pretrained model named {name!r}; available: "
+                f"{pretrained_names()}"
+            )
+        return PRETRAINED_DIR / f"{name}.zip"
+    return Path(spec)
 
 
 def _output_of(args: argparse.Namespace) -> Path:
