@@ -4,13 +4,16 @@ guarantee at every step.
 Each configuration draws an id (continuous or discrete), a scenario (random layouts of 3
 to 30 landmarks, Khepera, the paper's simulation), epsilon in 0.5-10 degrees, a move
 length range, the observation kind, the reward and the episode length; the transfer is
-conservative, the fusion the paper's intersection, and the noise uniform within
-+-epsilon, so every initialised region must hold its landmark. Episodes run on random
-actions from a seeded action space.
+conservative, the fusion the paper's intersection (or, with ``--fusion robust``, the
+robust fusion with its defaults: its noise-bound estimate only ever grows the bound, so
+the guarantee holds for it too), and the noise uniform within +-epsilon, so every
+initialised region must hold its landmark. Episodes run on random actions from a seeded
+action space.
 
     python -m bearing_env.benchmarks.soak --steps 1000000
     bearing-env soak --steps 20000 --seed 3
     bearing-env soak --steps 100000 --task BearingSLAM-FurnishedRoom-v0
+    bearing-env soak --steps 100000 --fusion robust
 
 With ``--task`` every configuration is that registered task as it is (its noise must be
 within +-epsilon and its mapping conservative for the check to hold: the tasks without a
@@ -71,8 +74,15 @@ class SoakReport:
             self.failures.append({"env_kwargs": kwargs, "seed": seed, "what": what})
 
 
-def random_configuration(rng: np.random.Generator) -> tuple[str, dict[str, Any]]:
-    """An env id and valid keyword arguments, drawn from ``rng``."""
+#: The fusions a soak of random configurations may run (``--fusion``).
+SOAK_FUSIONS = ("intersect", "robust")
+
+
+def random_configuration(
+    rng: np.random.Generator, fusion: str = "intersect"
+) -> tuple[str, dict[str, Any]]:
+    """An env id and valid keyword arguments with ``fusion``, drawn from ``rng`` (the
+    draws do not depend on ``fusion``)."""
     env_id = str(rng.choice(IDS))
     kwargs: dict[str, Any] = {
         "scenario": str(rng.choice(["random", "random", "khepera", "paper_sim"])),
@@ -81,7 +91,7 @@ def random_configuration(rng: np.random.Generator) -> tuple[str, dict[str, Any]]
         "reward": str(rng.choice(["log_area", "area"])),
         "max_moves": int(rng.integers(5, 41)),
         "transfer": "conservative",
-        "fusion": "intersect",
+        "fusion": fusion,
     }
     if kwargs["scenario"] == "random":
         kwargs["n_landmarks"] = int(rng.integers(3, 31))
@@ -139,10 +149,15 @@ def soak_configuration(
 
 
 def run(
-    steps: int, seed: int, episodes: int, progress: bool = False, task: str | None = None
+    steps: int,
+    seed: int,
+    episodes: int,
+    progress: bool = False,
+    task: str | None = None,
+    fusion: str = "intersect",
 ) -> SoakReport:
-    """Soak at least ``steps`` env steps over configurations drawn from ``seed`` (or of
-    the registered ``task`` only).
+    """Soak at least ``steps`` env steps over configurations drawn from ``seed`` with
+    ``fusion`` (or of the registered ``task`` only, as it is).
 
     Every configuration that runs steps at least one, so at most ``steps`` are drawn:
     configurations that all fail before their first step end the soak too."""
@@ -152,7 +167,9 @@ def run(
         try:
             while report.steps < steps and report.configurations < steps:
                 before = report.steps
-                env_id, kwargs = random_configuration(rng) if task is None else (task, {})
+                env_id, kwargs = (
+                    random_configuration(rng, fusion) if task is None else (task, {})
+                )
                 soak_configuration(env_id, kwargs, int(rng.integers(2**31)), episodes, report)
                 bar.update(report.steps - before)
         except KeyboardInterrupt:
@@ -188,6 +205,13 @@ def make_parser() -> argparse.ArgumentParser:
         help="soak this registered task only, e.g. BearingSLAM-FurnishedRoom-v0 "
         "(default: random configurations)",
     )
+    parser.add_argument(
+        "--fusion",
+        choices=SOAK_FUSIONS,
+        default="intersect",
+        help="the fusion of the random configurations (default %(default)s; a --task keeps "
+        "its own)",
+    )
     add_json_output(parser, "the counts")
     add_no_progress(parser)
     return parser
@@ -199,9 +223,13 @@ def main(argv: list[str] | None = None) -> None:
     if args.json:  # an unwritable --json fails before the soak, in one line
         with exit_on_output_errors(parser, Path(args.json), "--json", refusals=()):
             Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-    report = run(args.steps, args.seed, args.episodes, not args.no_progress, args.task)
+    if args.task is not None and args.fusion != "intersect":
+        parser.error("--fusion applies to random configurations; a --task keeps its own")
+    report = run(
+        args.steps, args.seed, args.episodes, not args.no_progress, args.task, args.fusion
+    )
     counts = {name: value for name, value in asdict(report).items() if name != "failures"}
-    label = f"seed {args.seed}" if args.task is None else f"seed {args.seed}, {args.task}"
+    label = f"seed {args.seed}, {args.task or args.fusion}"
     print(f"{label}: " + ", ".join(f"{name} {value:,}" for name, value in counts.items()))
     for failure in report.failures:
         print(f"failure: {failure}")

@@ -99,6 +99,10 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env region-search": ("run", ("--movements", "300", "--no-progress")),
     "bearing-env region-search --movements 20000": ("run", ("--movements", "300", "--no-progress")),
     "bearing-env soak --steps 20000": ("run", ("--steps", "30", "--no-progress")),
+    "bearing-env soak --steps 100000 --fusion robust": (
+        "run",
+        ("--steps", "30", "--fusion", "robust", "--no-progress"),
+    ),
     "bearing-env bench --sections slam,planning,startup": ("parse", ()),
     "python -m tests.golden_traces": ("help", ()),
     "bearing-env soak": ("run", ("--steps", "30", "--no-progress")),

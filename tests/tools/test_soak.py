@@ -33,6 +33,20 @@ class LosesTheTruth(gym.Wrapper):
         return observation, reward, terminated, truncated, info
 
 
+def test_a_robust_soak_draws_the_same_configurations_with_the_robust_fusion(capsys):
+    strict_rng, robust_rng = np.random.default_rng(7), np.random.default_rng(7)
+    strict = [soak.random_configuration(strict_rng) for _ in range(5)]
+    robust = [soak.random_configuration(robust_rng, "robust") for _ in range(5)]
+    assert len({str(kwargs) for _, kwargs in strict}) == 5
+    for (strict_id, strict_kwargs), (robust_id, robust_kwargs) in zip(strict, robust, strict=True):
+        assert robust_id == strict_id and robust_kwargs["fusion"] == "robust"
+        assert {**robust_kwargs, "fusion": "intersect"} == strict_kwargs
+    report = soak.run(150, seed=4, episodes=5, fusion="robust")
+    assert report.steps >= 150 and report.containment_checks > 0 and report.defects == 0
+    soak.main(["--steps", "30", "--fusion", "robust", "--no-progress"])
+    assert "seed 0, robust: steps" in capsys.readouterr().out
+
+
 def test_the_soak_counts_misses_and_exceptions_and_exits_1(monkeypatch, capsys):
     make = gym.make
     monkeypatch.setattr(soak.gym, "make", lambda *a, **k: LosesTheTruth(make(*a, **k)))
@@ -51,8 +65,14 @@ def test_the_soak_counts_misses_and_exceptions_and_exits_1(monkeypatch, capsys):
 
 @pytest.mark.parametrize(
     ("argv", "named"),
-    [(["--steps", "0"], "--steps"), (["--episodes", "-1"], "--episodes"),
-     (["--seed", "-2"], "--seed"), (["--json", "{a_file}/x.json"], "--json")],
+    [
+        (["--steps", "0"], "--steps"),
+        (["--episodes", "-1"], "--episodes"),
+        (["--seed", "-2"], "--seed"),
+        (["--json", "{a_file}/x.json"], "--json"),
+        (["--fusion", "relaxed"], "--fusion"),
+        (["--fusion", "robust", "--task", "BearingSLAM-Khepera-v0"], "--fusion"),
+    ],
 )
 def test_the_soak_refuses_bad_values_in_one_line(argv, named, capsys, tmp_path):
     a_file = tmp_path / "a_file"
