@@ -175,6 +175,9 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env train --algo ppo --env BearingSLAM-v0 --env-kwargs scenario=khepera "
     "--init-from pretrained:ppo_khepera --timesteps 2000000 "
     "--output runs/ppo_khepera_finetune": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAM-v0 --env-kwargs scenario=khepera "
+    "--init-from pretrained:ppo_khepera --hyperparams learning_rate=0.0001 "
+    "--timesteps 12000000 --eval-freq 250000 --output runs/ppo_khepera_ft1": ("parse", ()),
     "bearing-env compare --policies random parallax greedy pretrained:ppo_khepera --env-kwargs "
     "scenario=khepera \"noise={'kind':'uniform','bound_deg':2,'outlier_rate':0.05}\" "
     "fusion=robust --episodes 200 --out outputs/faults_robust": ("parse", ()),
