@@ -316,3 +316,40 @@ def test_env_robust_reports_its_levels_and_decodes_them() -> None:
             copy.batch.probe_vertices[0, j, :count], slam.batch.probe_vertices[0, j, :count]
         )
     env.close()
+
+
+@pytest.mark.parametrize("vector", [False, True])
+def test_a_reset_forgets_the_grown_bound_and_the_history(vector: bool) -> None:
+    """The bound is a property of an episode's data: a new episode starts at epsilon."""
+    import gymnasium as gym
+
+    kwargs = {
+        "scenario": "random",
+        "n_landmarks": 8,
+        "fusion": "robust",
+        "noise": {"kind": "uniform", "bound_deg": 4.0},
+        "max_moves": 30,
+        "target_area": 1e-12,
+    }
+    env = (
+        gym.make_vec("BearingSLAM-v0", num_envs=2, **kwargs)
+        if vector
+        else gym.make("BearingSLAM-v0", **kwargs)
+    )
+
+    def maps() -> list[PolygonSLAM]:
+        if vector:
+            return list(env.unwrapped.get_attr("slam"))  # type: ignore[attr-defined]
+        return [env.unwrapped.slam]  # type: ignore[attr-defined]
+
+    env.reset(seed=3)
+    env.action_space.seed(3)
+    for _ in range(29):
+        env.step(env.action_space.sample())
+    assert any(slam.bound > slam.epsilon for slam in maps())
+    env.reset(seed=4)
+    for slam in maps():
+        batch, row = slam.batch, slam.index
+        assert slam.bound == slam.epsilon and batch.history_length[row] == 0
+        assert batch.bound_events[row] == 0 and not batch.probe_counts[row].any()
+    env.close()
