@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 # of bearing_env (setuptools package-dir), so the view links them in under that name.
 TYPECHECK_VIEW := $(VENV)/typecheck
 
-.PHONY: test demo docs lint typecheck bench bench-slam clean
+.PHONY: test test-slow demo docs lint typecheck bench bench-slam clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -20,6 +20,11 @@ $(STAMP): pyproject.toml constraints.txt
 # Two workers, one per core; a test module stays on one worker (its fixtures run once).
 test: lint typecheck
 	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m "not slow" -n 2 --dist loadfile
+
+# The tests `make test` leaves out (marked slow): each costs minutes (the sdist's own test
+# run in a fresh venv, a real compile from an empty cache, a long seeded search, ...).
+test-slow: $(STAMP)
+	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m slow -n 2 --dist loadfile
 
 demo: $(STAMP)
 	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.studies.demo

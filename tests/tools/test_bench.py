@@ -259,26 +259,63 @@ def test_ppo_rounds_are_interleaved_and_the_median_counts(tmp_path: Path) -> Non
         assert row["steps_per_s"] == pytest.approx(rates[1])
 
 
-def test_quick_slam_and_startup(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    results, _ = run_quick(tmp_path, "--sections", "slam,startup")
-    check_common(results, {"slam", "startup"})
+def test_quick_slam(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    results, _ = run_quick(tmp_path, "--sections", "slam")
+    check_common(results, {"slam"})
     rows = {(row["transfer"], row["n_landmarks"]): row for row in results["slam"]}
     assert set(rows) == {(t, n) for t in ("conservative", "paper") for n in (4, 64)}
     for row in rows.values():
         assert positive_finite(row["steps_per_s"]) and positive_finite(row["ratio_to_cartpole"])
-    startup = results["startup"]
-    assert len(startup["warm_runs_s"]) == bench_timing.STARTUP_WARM_RUNS
-    assert startup["warm_first_step_s"] == sorted(startup["warm_runs_s"])[1]
-    # Compiling from an empty cache takes longer than loading it (by far: seconds vs ~1).
-    assert startup["cold_first_step_s"] > startup["warm_first_step_s"]
     targets = {target["id"]: target for target in results["targets"]}
     assert targets["e"]["value"] == rows[("conservative", 4)]["ratio_to_cartpole"]
+    assert "update(), conservative, 4 landmarks" in capsys.readouterr().out
+
+
+def check_startup(results: dict[str, Any]) -> dict[str, Any]:
+    """The startup section's figures and the targets read from them (f, j)."""
+    check_common(results, {"startup"})
+    startup: dict[str, Any] = results["startup"]
+    assert len(startup["warm_runs_s"]) == bench_timing.STARTUP_WARM_RUNS
+    assert startup["warm_first_step_s"] == sorted(startup["warm_runs_s"])[1]
+    targets = {target["id"]: target for target in results["targets"]}
     assert targets["f"]["value"] == startup["warm_first_step_s"]
     assert targets["f"]["met"] == (startup["warm_first_step_s"] <= 1.0)
     assert targets["j"]["value"] == startup["cold_first_step_s"]
     assert targets["j"]["met"] == (startup["cold_first_step_s"] <= 20.0)
+    return startup
+
+
+def test_quick_startup_times_one_cold_then_warm_runs_on_one_cache(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The fresh processes are replaced (each real run compiles or loads the whole core; the
+    # slow test below runs them): what is checked is which cache each run gets, and where
+    # each figure goes.
+    caches: list[str] = []
+    seconds = iter([30.0, 0.9, 0.7, 1.2])
+
+    def first_step_seconds(cache_dir: str) -> float:
+        assert Path(cache_dir).is_dir()
+        caches.append(cache_dir)
+        if len(caches) == 1:  # the cold run starts from an empty cache
+            assert not any(Path(cache_dir).iterdir())
+        return next(seconds)
+
+    monkeypatch.setattr(bench_timing, "first_step_seconds", first_step_seconds)
+    startup = check_startup(run_quick(tmp_path, "--sections", "startup")[0])
+    assert len(caches) == 1 + bench_timing.STARTUP_WARM_RUNS and len(set(caches)) == 1
+    assert not Path(caches[0]).exists()  # a temporary folder, removed after
+    assert startup == {"cold_first_step_s": 30.0, "warm_first_step_s": 0.9,
+                       "warm_runs_s": [0.9, 0.7, 1.2]}  # fmt: skip
     out = capsys.readouterr().out
-    assert "update(), conservative, 4 landmarks" in out and "Start-up" in out
+    assert "Start-up" in out and "30.0 s" in out and "0.90 s" in out
+
+
+@pytest.mark.slow
+def test_quick_startup_compiles_then_loads_the_cache(tmp_path: Path) -> None:
+    startup = check_startup(run_quick(tmp_path, "--sections", "startup")[0])
+    # Compiling from an empty cache takes longer than loading it (by far: seconds vs ~1).
+    assert startup["cold_first_step_s"] > startup["warm_first_step_s"]
 
 
 def test_quick_planning(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -53,6 +53,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "pip install bearing_env": ("pip", ()),
     'pip install "bearing_env[render,train]"': ("pip", ()),
     "make test": ("make", ()),
+    "make test-slow": ("make", ()),
     "make docs": ("make", ()),
     "make demo": ("make", ()),
     "make bench": ("make", ()),
