@@ -429,7 +429,7 @@ def _room_for_step(
     return STEP_DONE
 
 
-@njit(**_JIT)
+@njit(inline="always", **_JIT)
 def _update_maps(
     start: np.ndarray,
     end: np.ndarray,
@@ -462,7 +462,7 @@ def _update_maps(
         report.inconsistent[moving[k]] = out.n_bad[k]
 
 
-@njit(**_JIT)
+@njit(inline="always", **_JIT)
 def step_rows_bare(
     rows: np.ndarray,
     turns: np.ndarray,

@@ -226,7 +226,7 @@ def transfer_region(
     a1, n1, a2, n2 = frame.a1, frame.n1, frame.a2, frame.n2
     h1, inv_d, n_pairs = frame.h1, frame.inv_d, frame.n_pairs
     distance, delta1, delta2 = frame.distance, frame.delta1, frame.delta2
-    k = 0
+    k = np.int64(0)  # not 0: a literal start value compiles convex_hull once more
     for v in range(n_target):
         z = target[v]
         for p in range(n_pairs):

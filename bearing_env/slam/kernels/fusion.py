@@ -175,7 +175,9 @@ def _relaxed_union(
     window_inlier, slots, acc = state.window_inlier, scratch.slots, scratch.acc
     discarded = np.zeros(MAX_WINDOW, dtype=np.bool_)
     combination = np.empty(MAX_WINDOW, dtype=np.int64)
-    n_acc = 0
+    # np.int64(0), not 0: numba compiles calls it types before the loop widens a literal
+    # start value, so a literal 0 would compile _merge_hull once more.
+    n_acc = np.int64(0)
     for t in range(q):
         combination[t] = t
     while True:
@@ -252,7 +254,10 @@ def _solve_landmark(state: State, row: int, j: int, params: Params, scratch: Scr
             # the cap: it is dropped.
             base_counts[row, j] = 0
             state.n_dropped[row, j] += 1
-            n, _ = relaxed_region(state, row, j, k, False, params.max_outliers, scratch)
+            # Not a literal False: a literal argument would compile the relaxed
+            # region (and what it calls) a second time.
+            no_base = bool(np.bool_(False))
+            n, _ = relaxed_region(state, row, j, k, no_base, params.max_outliers, scratch)
     if n == 0 and k > 0:
         # More than max_outliers regions disagree: as the strict intersection does, keep
         # the old region, or restart from the newest movement's region alone.

@@ -97,7 +97,7 @@ def convex_hull(points: np.ndarray, n_points: int, out: np.ndarray) -> int:
     task_start[1], chain_from[1] = -1, last
     task_start[2], task_end[2], chain_from[2], chain_to[2] = 0, n_lower, first, last
     top = 3
-    k = 1
+    k = np.int64(1)  # not 1: a literal start value compiles the small hull once more
     while top > 0:
         top -= 1
         start, end, i_from, i_to = task_start[top], task_end[top], chain_from[top], chain_to[top]

@@ -192,7 +192,10 @@ def frame_contradicts_robot(state: State, row: int, frame: FrameChange, scratch:
     if n_robot == 0 or state.robot_fixed_at[row] != state.n_updates[row] - 1:
         return False
     origin = np.zeros(1, dtype=np.complex128)
-    n_start = transfer_region(origin, 1, frame, scratch.cloud, scratch.hull, scratch.fresh)
+    # origin.size, not 1: a literal argument compiles one more specialisation.
+    n_start = transfer_region(
+        origin, origin.size, frame, scratch.cloud, scratch.hull, scratch.fresh
+    )
     if n_start < 3:
         return False
     n = clip_convex(

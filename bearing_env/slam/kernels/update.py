@@ -386,7 +386,7 @@ def _update_rows(
                 _rebuild_row(i, row, params, state, out, buf)
 
 
-@njit(**_JIT)
+@njit(inline="always", **_JIT)
 def update_maps(
     bearings_start: np.ndarray,
     bearings_end: np.ndarray,
@@ -404,7 +404,9 @@ def update_maps(
     bases. Each map is updated on its own, so its result never depends on the other
     maps of the batch. What each movement did goes to ``out``.
     """
-    _update_rows(0, rows.shape[0], bearings_start, bearings_end, rows, params, state, out)
+    # np.int64(0), not 0: a literal argument would compile the whole update once more.
+    first = np.int64(0)
+    _update_rows(first, rows.shape[0], bearings_start, bearings_end, rows, params, state, out)
 
 
 @njit(parallel=True, **_JIT)
