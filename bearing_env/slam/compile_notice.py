@@ -1,8 +1,8 @@
 """A one-line notice on stderr before the compiled core is built for the first time.
 
-Compiling the kernels from an empty numba cache takes about a minute (a first Khepera
-``env.step`` measured 72-76 s on a quiet 2-core machine, of which the world model's
-update is about 38 s), during which it would otherwise hang in silence. The first
+Compiling the kernels from an empty numba cache takes a minute or two (a first Khepera
+``env.step`` measured 72-76 s on a quiet 2-core machine, 103-113 s on a slower day of
+it), during which it would otherwise hang in silence. The first
 :class:`~bearing_env.slam.batch.BatchedPolygonSLAM` a process makes checks numba's own
 cache index of the batched update (the serial and the parallel kernel, whichever the
 process will use): numba loads an index only when it matches the kernel's source file
@@ -15,10 +15,11 @@ from __future__ import annotations
 import sys
 from typing import Any
 
-#: The notice's estimate, from the cold compiles measured on the development machine.
-COLD_COMPILE_SECONDS = 75
+#: The notice's estimate, from the cold compiles measured on the 2-core development
+#: machine: 72-76 s on its quiet days, 103-113 s on slower ones.
+COLD_COMPILE_MINUTES = "1-2"
 NOTICE = (
-    f"bearing_env: compiling the numba core, once (about {COLD_COMPILE_SECONDS} s; "
+    f"bearing_env: compiling the numba core, once (about {COLD_COMPILE_MINUTES} minutes; "
     "later runs load it from numba's cache)..."
 )
 
