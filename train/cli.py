@@ -22,6 +22,8 @@
                                   counts (train/studies/generalisation.py)
     bearing-env play [...]        move the robot by hand in a pygame window (the render extra)
     bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (shipped rl-zoo3 files)
+    bearing-env distill [...]     DAgger from a planner (LookaheadOracle) into an SB3 model
+                                  (train/sb3/distill.py)
     bearing-env hyperparams ALGO  the path of a shipped rl-zoo3 hyperparameter file
     bearing-env rllib [...]       PPO with RLlib, locally or on a Ray cluster (train/ray/rllib.py)
     bearing-env sweep [...]       a Ray Tune grid of RLlib PPO runs (train/ray/sweep.py)
@@ -70,6 +72,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "train": (
         "bearing_env.train.sb3.train_cli",
         "train PPO/SAC/DQN agents with stable-baselines3 (rl-zoo3 hyperparameter files)",
+    ),
+    "distill": (
+        "bearing_env.train.sb3.distill",
+        "DAgger: train a model's actor on a planner's actions at the states it visits",
     ),
     "hyperparams": (
         "bearing_env.train.sb3.conf_files",

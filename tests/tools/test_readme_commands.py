@@ -183,6 +183,12 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "scenario=khepera \"noise={'kind':'uniform','bound_deg':2,'outlier_rate':0.05}\" "
     "fusion=robust --episodes 200 --out outputs/faults_robust": ("parse", ()),
     "bearing-env observability": ("parse", ()),
+    "bearing-env distill": ("help", ()),
+    "bearing-env distill --student pretrained:ppo_khepera --teacher lookahead_oracle "
+    "--iterations 4 --episodes 50 --output runs/distill_khepera": ("parse", ()),
+    "bearing-env compare --policies greedy pretrained:ppo_khepera "
+    "sb3:path=runs/distill_khepera/model.zip,label=dagger_oracle --episodes 200 "
+    "--out outputs/compare_distill": ("parse", ()),
     "bearing-env train --algo ppo --env BearingSLAM-v0 --seed 1 --timesteps 10000000 "
     "--hyperparams \"policy_kwargs='dict(net_arch=dict(pi=[256, 256], vf=[256, 256]))'\" "
     "--eval-freq 500000 --output runs/ppo_khepera_wide": ("parse", ()),
@@ -313,6 +319,10 @@ def _parse(argv: list[str]) -> None:
         from bearing_env.train.sb3 import train_cli
 
         train_cli.settings_from_args(train_cli.build_parser().parse_args(arguments))
+    elif command == "distill":
+        from bearing_env.train.sb3 import distill
+
+        distill.settings_from_args(distill.build_parser().parse_args(arguments))
     elif command == "figures":
         from bearing_env.train.studies import figures
 
@@ -345,7 +355,7 @@ def _parse(argv: list[str]) -> None:
 def command_extra(command: str) -> str | None:
     """The extra a README command needs to run or parse: training (and rl-zoo3's trainer)
     needs ``train``, Ray's own command line ``ray``."""
-    if command.startswith(("bearing-env train", "python -m rl_zoo3")):
+    if command.startswith(("bearing-env train", "bearing-env distill", "python -m rl_zoo3")):
         return "train"
     if command.startswith("ray "):
         return "ray"

@@ -54,6 +54,13 @@ def _finite_or_none(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
 
 
+def capped_total_area(info: Mapping[str, Any], area_cap: float) -> float:
+    """The total area the comparison reads: every landmark's area, capped at
+    ``area_cap`` (an uninitialised landmark, of infinite area, counts as the cap)."""
+    areas = np.asarray(info["landmark_area"], dtype=np.float64)
+    return float(np.sum(np.minimum(areas, area_cap)))
+
+
 def run_episode(policy: Any, env: gym.Env, seed: int) -> dict[str, Any]:
     """Play one episode; the per-move record the harness logs (JSON-safe, no timing
     except ``policy_seconds``).
@@ -74,7 +81,7 @@ def run_episode(policy: Any, env: gym.Env, seed: int) -> dict[str, Any]:
         initialised = np.isfinite(areas)
         errors = np.asarray(step_info["landmark_error"], dtype=np.float64)[initialised]
         contains = np.asarray(step_info["landmark_contains_truth"], dtype=bool)[initialised]
-        series["area"].append(float(np.sum(np.minimum(areas, area_cap))))
+        series["area"].append(capped_total_area(step_info, area_cap))
         series["uninitialised"].append(int(np.count_nonzero(~initialised)))
         series["error"].append(_finite_or_none(float(np.mean(errors))) if errors.size else None)
         series["contained"].append(int(np.count_nonzero(contains)))
