@@ -1,6 +1,7 @@
 """The models shipped under agents/pretrained/ still fit the envs they were trained on."""
 
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -11,6 +12,7 @@ import pytest
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.agents import SB3Policy, pretrained_names, pretrained_record
+from bearing_env.agents.sb3 import PRETRAINED_DIR
 from tests.extras import needs
 
 SHIPPED = ("ppo_khepera", "ppo_random", "ppo_generalist")
@@ -94,25 +96,47 @@ def test_the_generalist_runs_on_counts_outside_its_training_range(count: int) ->
 
 
 @needs("train", "stable_baselines3", "torch")
-def test_generalisation_table_covers_every_policy_and_count(tmp_path: Path) -> None:
+def test_generalisation_table_covers_every_policy_count_and_model(tmp_path: Path) -> None:
+    # A second model: an exported copy of the first (a .zip with its record), on the
+    # same envs, so the study reuses the first model's baselines for it.
+    for suffix in (".zip", ".json", "_vecnormalize.pkl"):
+        shutil.copyfile(PRETRAINED_DIR / f"ppo_random{suffix}", tmp_path / f"copy{suffix}")
     out = tmp_path / "generalisation"
     command = [sys.executable, "-m", "bearing_env.train.studies.generalisation",
-               "--model", "ppo_random", "--counts", "3", "--episodes", "1", "--workers", "1",
-               "--out", str(out)]  # fmt: skip
+               "--model", "ppo_random", str(tmp_path / "copy.zip"), "--counts", "3",
+               "--episodes", "1", "--workers", "1", "--out", str(out)]  # fmt: skip
     result = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     results = json.loads((out / "generalisation.json").read_text())
-    assert set(results) == {"ppo_random"} and set(results["ppo_random"]) == {"3"}
+    assert set(results) == {"ppo_random", "copy"} and set(results["ppo_random"]) == {"3"}
     figures = results["ppo_random"]["3"]
-    assert set(figures) == {
-        "random_polygonal", "parallax", "greedy_one_step", "lookahead", "ppo_random"
-    }  # fmt: skip
+    baselines = {"random_polygonal", "parallax", "greedy_one_step", "lookahead"}
+    assert set(figures) == baselines | {"ppo_random"}
     for values in figures.values():
         assert set(values) == {"median", "p90", "worst5_mean"}
         # One episode: its area is the median, the 90th percentile and the worst 5%.
         assert np.isfinite(values["median"]) and values["median"] > 0
         assert values["median"] == values["p90"] == values["worst5_mean"]
+    copied = results["copy"]["3"]
+    assert set(copied) == baselines | {"copy"}
+    assert all(copied[label] == figures[label] for label in baselines)
+    assert copied["copy"] == figures["ppo_random"]  # the same weights on the same episode
+    # The copy's comparison ran the model alone: the baselines were not run again.
+    ran = json.loads((out / "copy" / "n3" / "config.json").read_text())
+    assert [spec.split(",label=")[-1] for spec in ran["policies"]] == ["copy"]
     assert (out / "generalisation.png").stat().st_size > 10_000
+
+
+def test_generalisation_names_a_model_it_cannot_find(tmp_path: Path) -> None:
+    result = subprocess.run(
+        [sys.executable, "-m", "bearing_env.train.studies.generalisation", "--model",
+         str(tmp_path / "missing.zip")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )  # fmt: skip
+    assert result.returncode == 2
+    assert "unknown model" in result.stderr and "missing.zip" in result.stderr
 
 
 @pytest.mark.parametrize(

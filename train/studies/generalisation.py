@@ -11,7 +11,13 @@ model's training range shaded.
 
     bearing-env generalisation --model ppo_random --counts 3 4 6 8 10 --episodes 50
     bearing-env generalisation --model ppo_generalist ppo_random --counts 3 8 10
+    bearing-env generalisation --model ppo_generalist models/candidate.zip --counts 3 8
     python -m bearing_env.train.studies.generalisation ...     # the same
+
+A model is a shipped one by name, or a ``.zip`` that ``bearing-env train --export`` wrote
+(its ``.json`` record beside it gives its task), labelled by its file name. When a model
+runs on the same envs as the one before it (the same training env kwargs), the baselines
+are not run again: its tables and plot reuse the first runs'.
 
 The total area is summed over the mapped landmarks (L3, L4, ...), so it grows with the
 count; compare policies within a column. Every count runs with the env kwargs the model
@@ -34,6 +40,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from bearing_env.agents.model_task import ModelTask, task_record_of
 from bearing_env.agents.sb3 import pretrained_names, pretrained_record, pretrained_task
 from bearing_env.envs.config import EnvConfig
 from bearing_env.extras import available
@@ -68,6 +75,35 @@ def env_kwargs_for_count(
     return kwargs
 
 
+class StudyModel(NamedTuple):
+    """A model of the study: its label, its policy spec and what it was trained on."""
+
+    label: str
+    spec: str
+    env_kwargs: dict[str, Any]
+    task: ModelTask
+
+
+def study_model(value: str) -> StudyModel:
+    """A shipped model by name, or an exported ``.zip`` with its ``.json`` record.
+
+    Raises:
+        ValueError: neither a shipped name nor an exported model with a record.
+    """
+    if value in pretrained_names():
+        kwargs = dict(pretrained_record(value).get("env_kwargs", {}))
+        return StudyModel(value, f"pretrained:{value}", kwargs, pretrained_task(value))
+    path = Path(value)
+    task = task_record_of(path) if path.suffix == ".zip" and path.is_file() else None
+    if task is None:
+        raise ValueError(
+            f"unknown model {value!r}: neither a shipped model ({', '.join(pretrained_names())}) "
+            "nor an exported .zip with its .json record beside it (bearing-env train --export)"
+        )
+    spec = f"sb3:path={path},label={path.stem}"
+    return StudyModel(path.stem, spec, dict(task.env_kwargs), task)
+
+
 class StudySettings(NamedTuple):
     """What every comparison of the study shares."""
 
@@ -80,9 +116,13 @@ class StudySettings(NamedTuple):
 
 
 def compare_command(
-    model: str, env_kwargs: dict[str, Any], study: StudySettings, folder: Path
+    model: StudyModel,
+    env_kwargs: dict[str, Any],
+    study: StudySettings,
+    folder: Path,
+    baselines: bool = True,
 ) -> list[str]:
-    """The ``bearing-env compare`` run of one model and count."""
+    """The ``bearing-env compare`` run of one model and count (with the baselines)."""
     command = [
         sys.executable,
         "-m",
@@ -90,8 +130,8 @@ def compare_command(
         "--env-kwargs",
         *format_key_values(env_kwargs),
         "--policies",
-        *study.baselines,
-        f"pretrained:{model}",
+        *(study.baselines if baselines else []),
+        model.spec,
         "--episodes",
         str(study.episodes),
         "--workers",
@@ -105,24 +145,30 @@ def compare_command(
     return command
 
 
-def run_model(model: str, study: StudySettings) -> dict[int, dict[str, dict[str, float]]]:
+def run_model(
+    model: StudyModel,
+    study: StudySettings,
+    baselines_from: dict[int, dict[str, dict[str, float]]] | None = None,
+) -> dict[int, dict[str, dict[str, float]]]:
     """The total area after 10 moves (median, 90th percentile, worst 5% mean) per
-    landmark count and policy label, for one model and the baselines beside it. Each
-    count is its own comparison folder, so an interrupted study resumes count by count."""
-    trained = dict(pretrained_record(model).get("env_kwargs", {}))
-    slots = EnvConfig.create(**trained).observations.max_landmarks
+    landmark count and policy label, for one model and the baselines beside it (run, or
+    taken from ``baselines_from``: the baselines' results on the same envs). Each count
+    is its own comparison folder, so an interrupted study resumes count by count."""
+    slots = EnvConfig.create(**model.env_kwargs).observations.max_landmarks
     results: dict[int, dict[str, dict[str, float]]] = {}
-    with progress_bar(len(study.counts), desc=model, unit="count", enabled=True) as bar:
+    with progress_bar(len(study.counts), desc=model.label, unit="count", enabled=True) as bar:
         for count in study.counts:
-            folder = study.out / model / f"n{count}"
-            kwargs = env_kwargs_for_count(trained, count, slots)
-            command = compare_command(model, kwargs, study, folder)
+            folder = study.out / model.label / f"n{count}"
+            kwargs = env_kwargs_for_count(model.env_kwargs, count, slots)
+            command = compare_command(model, kwargs, study, folder, baselines_from is None)
             subprocess.run(command, check=True)
             summary = json.loads((folder / "summary.json").read_text())
             results[count] = {
                 label: {name: float(stats["area_after"][MOVES][name]) for name in FIGURES}
                 for label, stats in summary["policies"].items()
             }
+            if baselines_from is not None:
+                results[count] = {**baselines_from[count], **results[count]}
             bar.update()
     return results
 
@@ -177,7 +223,8 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="+",
         default=["ppo_random"],
         metavar="NAME",
-        help=f"shipped models, one or more: {', '.join(pretrained_names())} (default ppo_random)",
+        help=f"models, one or more: shipped ({', '.join(pretrained_names())}) or an exported "
+        ".zip with its .json record (default ppo_random)",
     )
     parser.add_argument(
         "--baselines",
@@ -228,20 +275,26 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser = build_parser()
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
     training_counts: dict[str, tuple[int, int]] = {}
-    for model in args.model:
-        if model not in pretrained_names():
-            parser.error(f"unknown model {model!r}; shipped: {', '.join(pretrained_names())}")
+    models: list[StudyModel] = []
+    for value in args.model:
+        try:
+            model = study_model(value)
+        except ValueError as error:
+            parser.error(str(error))
+        if model.label in training_counts:
+            parser.error(f"two models are labelled {model.label!r}: rename one")
         # The env's own resolution of the training settings: counts and observation slots.
-        trained = EnvConfig.create(**pretrained_record(model).get("env_kwargs", {}))
+        trained = EnvConfig.create(**model.env_kwargs)
         max_landmarks = trained.observations.max_landmarks
-        if pretrained_task(model).slot_free:
+        if model.task.slot_free:
             max_landmarks = max(args.counts)  # a set policy: any count, with more slots
         if min(args.counts) < 3 or max(args.counts) > max_landmarks:
             parser.error(
-                f"--counts must lie in [3, {max_landmarks}]: {model} has "
+                f"--counts must lie in [3, {max_landmarks}]: {model.label} has "
                 f"max_landmarks={max_landmarks} observation slots"
             )
-        training_counts[model] = trained.layout.landmark_counts
+        training_counts[model.label] = trained.layout.landmark_counts
+        models.append(model)
     for module in ("stable_baselines3", "torch", "rich", "matplotlib"):
         if not available(module):
             fail(parser.prog, str(MissingExtraError(module, "this command")))
@@ -249,9 +302,18 @@ def main(argv: Sequence[str] | None = None) -> None:
         args.counts, args.baselines, args.episodes, args.workers, args.out, args.resume
     )
     results: Results = {}
-    for model in args.model:
-        results[model] = run_model(model, study)
-        print_results(model, results[model])
+    for index, model in enumerate(models):
+        # The baselines run once per set of envs: a model on the first model's envs
+        # reuses its baselines.
+        first = models[0]
+        baselines = None
+        if index > 0 and model.env_kwargs == first.env_kwargs:
+            baselines = {
+                count: {label: row[label] for label in row if label != first.label}
+                for count, row in results[first.label].items()
+            }
+        results[model.label] = run_model(model, study, baselines)
+        print_results(model.label, results[model.label])
     write_json_atomically(
         args.out / "generalisation.json",
         {model: {str(k): v for k, v in by_count.items()} for model, by_count in results.items()},
