@@ -166,3 +166,20 @@ def test_generalisation_gives_a_set_policy_the_slots_a_count_needs() -> None:
         **trained, "n_landmarks": 24, "max_landmarks": 24,
     }  # fmt: skip
     assert env_kwargs_for_count(trained, 24) == {**trained, "n_landmarks": 24}
+
+
+def test_models_trained_on_other_counts_share_the_studys_envs() -> None:
+    from bearing_env.agents.model_task import ModelTask
+    from bearing_env.train.studies.generalisation import StudyModel, study_envs
+
+    def model(**kwargs: object) -> StudyModel:
+        trained = {"scenario": "random", "max_landmarks": 16, "observation": "entities", **kwargs}
+        return StudyModel("m", "spec", trained, ModelTask("BearingSLAM-v0", trained))
+
+    counts = [3, 8, 24]
+    narrow, wide = model(n_landmarks=[3, 12]), model(n_landmarks=[3, 16])
+    assert study_envs(narrow, counts) == study_envs(wide, counts)  # the count is replaced
+    assert study_envs(wide, counts)[2]["max_landmarks"] == 24
+    assert study_envs(model(n_landmarks=[3, 12], max_landmarks=12), counts) != study_envs(
+        narrow, counts
+    )

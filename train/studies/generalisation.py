@@ -16,8 +16,8 @@ model's training range shaded.
 
 A model is a shipped one by name, or a ``.zip`` that ``bearing-env train --export`` wrote
 (its ``.json`` record beside it gives its task), labelled by its file name. When a model
-runs on the same envs as the one before it (the same training env kwargs), the baselines
-are not run again: its tables and plot reuse the first runs'.
+runs on the same envs as the first (its training env kwargs give the same env at every
+count), the baselines are not run again: its tables and plot reuse the first model's.
 
 The total area is summed over the mapped landmarks (L3, L4, ...), so it grows with the
 count; compare policies within a column. Every count runs with the env kwargs the model
@@ -104,6 +104,12 @@ def study_model(value: str) -> StudyModel:
     return StudyModel(path.stem, spec, dict(task.env_kwargs), task)
 
 
+def study_envs(model: StudyModel, counts: Sequence[int]) -> list[dict[str, Any]]:
+    """The env kwargs a model's comparisons run with, one per count."""
+    slots = EnvConfig.create(**model.env_kwargs).observations.max_landmarks
+    return [env_kwargs_for_count(model.env_kwargs, count, slots) for count in counts]
+
+
 class StudySettings(NamedTuple):
     """What every comparison of the study shares."""
 
@@ -154,12 +160,11 @@ def run_model(
     landmark count and policy label, for one model and the baselines beside it (run, or
     taken from ``baselines_from``: the baselines' results on the same envs). Each count
     is its own comparison folder, so an interrupted study resumes count by count."""
-    slots = EnvConfig.create(**model.env_kwargs).observations.max_landmarks
     results: dict[int, dict[str, dict[str, float]]] = {}
+    envs = study_envs(model, study.counts)
     with progress_bar(len(study.counts), desc=model.label, unit="count", enabled=True) as bar:
-        for count in study.counts:
+        for count, kwargs in zip(study.counts, envs, strict=True):
             folder = study.out / model.label / f"n{count}"
-            kwargs = env_kwargs_for_count(model.env_kwargs, count, slots)
             command = compare_command(model, kwargs, study, folder, baselines_from is None)
             subprocess.run(command, check=True)
             summary = json.loads((folder / "summary.json").read_text())
@@ -307,7 +312,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         # reuses its baselines.
         first = models[0]
         baselines = None
-        if index > 0 and model.env_kwargs == first.env_kwargs:
+        if index > 0 and study_envs(model, study.counts) == study_envs(first, study.counts):
             baselines = {
                 count: {label: row[label] for label in row if label != first.label}
                 for count, row in results[first.label].items()
