@@ -76,9 +76,9 @@ def test_a_shipped_model_acts_alike_on_the_vector_env(name: str) -> None:
 @needs("train", "stable_baselines3", "torch")
 @pytest.mark.parametrize("count", [3, 16])
 def test_the_generalist_runs_on_counts_outside_its_training_range(count: int) -> None:
-    # Trained on 3 to 12 landmarks; its deep set reads any count up to max_landmarks.
+    # Trained on 3 to 16 landmarks; its deep set reads any count (more slots beyond 16).
     record = pretrained_record("ppo_generalist")
-    assert record["env_kwargs"]["n_landmarks"] == [3, 12]
+    assert record["env_kwargs"]["n_landmarks"] == [3, 16]
     assert record["env_kwargs"]["max_landmarks"] == 16
     env = gym.make(record["env_id"], **{**record["env_kwargs"], "n_landmarks": count})
     policy = SB3Policy.pretrained("ppo_generalist", env)

@@ -52,7 +52,7 @@ def test_a_pretrained_model_is_compared_on_its_own_task(tmp_path: Path) -> None:
             "bearing-env compare: error: model 'ppo_generalist' was trained on another task "
             "than this env: observation 'entities' (env: 'flat'), max_landmarks 16 (env: 8), "
             "scenario 'random' (env: 'khepera'); its task (ppo_generalist.json): "
-            "BearingSLAM-v0 with max_landmarks=16, n_landmarks=[3, 12], "
+            "BearingSLAM-v0 with max_landmarks=16, n_landmarks=[3, 16], "
             "observation='entities', scenario='random'",
         ),
         (

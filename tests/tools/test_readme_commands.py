@@ -152,7 +152,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     ),
     "python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 "
     '--conf-file "$(bearing-env hyperparams ppo_entities)" --eval-env-kwargs '
-    '"scenario:\'random\'" "n_landmarks:[3, 12]" max_landmarks:16 "observation:\'entities\'"': (
+    '"scenario:\'random\'" "n_landmarks:[3, 16]" max_landmarks:16 "observation:\'entities\'"': (
         "zoo",
         (),
     ),
@@ -162,8 +162,17 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--seed 0 --eval-freq 100000 --output runs/ppo_attention": ("parse", ()),
     "bearing-env train --algo ppo --output runs/ppo_generalist --export "
     "agents/pretrained/ppo_generalist --export-only": ("parse", ()),
-    "python -m bearing_env.train.studies.generalisation --model ppo_generalist --counts 3 8 12 16 "
-    "--episodes 200 --out outputs/generalisation_generalist": ("parse", ()),
+    "python -m bearing_env.train.studies.generalisation --model ppo_generalist "
+    "runs/exported/ppo_attention.zip --counts 3 8 12 16 --episodes 200 "
+    "--out outputs/generalisation_generalist": ("parse", ()),
+    "bearing-env train --algo ppo --output runs/ppo_attention --export "
+    "runs/exported/ppo_attention --export-only": ("parse", ()),
+    'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_entities)" '
+    "--init-from agents/pretrained/ppo_generalist.zip --hyperparams learning_rate=0.0001 "
+    "--timesteps 2000000 --seed 1 --eval-freq 100000 --output runs/ppo_generalist_ft": (
+        "parse",
+        (),
+    ),
     "python -m bearing_env.train.studies.generalisation --model ppo_generalist --counts 24 32 "
     "--baselines random greedy --episodes 200 --out outputs/generalisation_24_32": ("parse", ()),
     "cp outputs/generalisation_generalist/generalisation.png "
