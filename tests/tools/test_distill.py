@@ -10,8 +10,6 @@ settings end in one clear line.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -28,6 +26,7 @@ import torch  # noqa: E402
 import bearing_env.train.sb3.distill as distill_module  # noqa: E402
 from bearing_env.agents import SB3Policy  # noqa: E402
 from bearing_env.agents.sb3 import PRETRAINED_DIR, find_vecnormalize  # noqa: E402
+from bearing_env.train.sb3.callbacks import StopRequest  # noqa: E402
 from bearing_env.train.sb3.distill import (  # noqa: E402
     DATASET_NAME,
     MODEL_NAME,
@@ -113,17 +112,19 @@ def test_an_interrupted_run_resumes_to_the_same_result(
     whole_run: tuple[Path, DistillResult], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     whole_output, whole = whole_run
-    calls = {"n": 0}
 
-    @contextmanager
-    def stop_after_three_checks() -> Iterator[Any]:
-        def stop() -> bool:
-            calls["n"] += 1
-            return calls["n"] >= 3  # after episode 1, episode 2 (+ training), ...
+    class StopAtTheThirdCheck(StopRequest):
+        """Ctrl-C, as the run sees it, from its third check on. The run checks after
+        every episode and every training step: the third check follows iteration 0's
+        training."""
 
-        yield stop
+        checks = 0
 
-    monkeypatch.setattr(distill_module, "_interruptible", stop_after_three_checks)
+        def __bool__(self) -> bool:
+            StopAtTheThirdCheck.checks += 1
+            return StopAtTheThirdCheck.checks >= 3
+
+    monkeypatch.setattr(distill_module, "StopRequest", StopAtTheThirdCheck)
     stopped = distill(settings(tmp_path / "parts"))
     assert stopped.interrupted and len(stopped.iterations) == 1
     monkeypatch.undo()
@@ -176,14 +177,17 @@ def test_the_command_refuses_to_mix_runs_and_names_what_changed(
         ([], "holds a distillation already: pass --resume"),
         (["--resume", "--episodes", "2"], "other settings than the run's: episodes 1 -> 2"),
         (["--resume", "--teacher", "parallax"], "teacher 'greedy' -> 'parallax'"),
+        (["--resume", "--iterations", "2"], "iterations 1 -> 2"),
     ):
         with pytest.raises(SystemExit) as stopped:
             distill_module.main([*base, *extra])
         assert stopped.value.code == 2
         (line,) = capsys.readouterr().err.strip().splitlines()
         assert line.startswith("bearing-env distill: error: ") and expected in line, line
-    with pytest.raises(SystemExit):
-        distill_module.main(
-            ["--student", str(tmp_path / "missing.zip"), "--output", str(tmp_path / "o")]
-        )
-    assert "missing.zip" in capsys.readouterr().err
+    for student, expected in (
+        (str(tmp_path / "missing.zip"), "missing.zip"),
+        ("pretrained:nope", "--student: no pretrained model named 'nope'"),
+    ):
+        with pytest.raises(SystemExit):
+            distill_module.main(["--student", student, "--output", str(tmp_path / "o")])
+        assert expected in capsys.readouterr().err

@@ -13,9 +13,10 @@ labels over the states the learner itself visits:
    states it reaches, and step 2 runs again on the grown dataset.
 
 The student is any continuous-action SB3 actor-critic model with a task record (a
-``.zip``, a run folder, or ``pretrained:NAME``); its episodes run in its own task's env,
-which the teacher sees as well (a privileged teacher reads the true world). Observations
-are stored raw and normalised with the student's frozen ``VecNormalize`` statistics.
+``.zip`` that ``bearing-env train --export`` wrote, or ``pretrained:NAME``); its episodes
+run in its own task's env, which the teacher sees as well (a privileged teacher reads the
+true world). Observations are stored raw and normalised with the student's frozen
+``VecNormalize`` statistics.
 
 The output folder holds the student as a shipped model is laid out, so
 ``bearing-env train --init-from OUTPUT/model.zip`` fine-tunes it and ``compare
@@ -26,10 +27,12 @@ The output folder holds the student as a shipped model is laid out, so
     distill.json    the settings, and per iteration: who acted, the seeds, the capped
                     total area after 10 moves and at the end (median), and the loss
 
-Everything is saved after every episode and every training step: Ctrl-C loses at most
-the episode under way, and ``--resume`` continues where the run stopped. Episode ``e``
-of iteration ``i`` resets with seed ``seed_start + i * episodes + e``, in the training
-seed range (``bearing_env.train.common.seeds``), so no evaluation episode is trained on.
+Everything is saved after every episode and every training step. Ctrl-C (or SIGTERM)
+stops the run once the episode under way is saved (a second Ctrl-C stops at once, losing
+that episode), and ``--resume`` continues where the run stopped, with the same settings.
+Episode ``e`` of iteration ``i`` resets with seed ``seed_start + i * episodes + e``, in the
+training seed range (``bearing_env.train.common.seeds``), so no evaluation episode is
+trained on.
 
     bearing-env distill --student pretrained:ppo_khepera --teacher lookahead_oracle \\
         --iterations 4 --episodes 50 --output runs/distill_khepera
@@ -41,8 +44,7 @@ import argparse
 import json
 import shutil
 import sys
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -50,9 +52,8 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
-from bearing_env.agents.model_task import ModelTask
 from bearing_env.agents.registry import make_policy
-from bearing_env.agents.sb3 import SB3Policy, pretrained_record
+from bearing_env.agents.sb3 import SB3Policy
 from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import COUNT, SEED, at_least
 from bearing_env.train.common.errors import fail, write_error_message
@@ -60,6 +61,9 @@ from bearing_env.train.common.files import atomic_path, write_json_atomically
 from bearing_env.train.common.progress import progress_bar
 from bearing_env.train.common.seeds import TRAINING_SEED_LIMIT
 from bearing_env.train.compare.runner import capped_total_area
+from bearing_env.train.sb3.callbacks import StopRequest
+from bearing_env.train.sb3.train import stop_on_signals
+from bearing_env.train.sb3.train_cli import EXIT_INTERRUPTED, init_model_path
 
 MODEL_NAME = "model.zip"
 VECNORMALIZE_NAME = "model_vecnormalize.pkl"
@@ -68,10 +72,8 @@ DATASET_NAME = "dataset.npz"
 STATE_NAME = "distill.json"
 #: The move after which the per-iteration log reads the total area (and at the end).
 AREA_MOVE = 10
-#: How the student names a shipped model (as ``bearing-env train --init-from`` does).
-PRETRAINED_PREFIX = "pretrained:"
-#: The exit status after Ctrl-C (everything up to the last finished episode is saved).
-EXIT_INTERRUPTED = 130
+#: What Ctrl-C prints: the episode under way is finished and saved first.
+STOP_NOTICE = "stopping after this episode"
 
 
 @dataclass(frozen=True)
@@ -79,7 +81,7 @@ class DistillSettings:
     """One distillation run (validated on creation).
 
     Args:
-        student: the model to train: a ``.zip``, a run folder, or ``pretrained:NAME``.
+        student: the model to train: an exported ``.zip`` or ``pretrained:NAME``.
         output: the folder the run writes (see the module doc).
         teacher: the labelling policy, as a policy spec (``lookahead_oracle``,
             ``lookahead:depth=3``, ``greedy``, ...).
@@ -208,40 +210,34 @@ def _as_keyed(observation: Any) -> dict[str, np.ndarray]:
     return {"": np.asarray(observation)}
 
 
-def load_student(settings: DistillSettings, resume: bool) -> tuple[SB3Policy, dict[str, Any]]:
-    """The student (the output's ``model.zip`` when resuming after a training step, with
-    the statistics beside it) and its task record.
+def load_student(settings: DistillSettings, resume: bool) -> SB3Policy:
+    """The student: the output's ``model.zip`` when resuming after a training step, else
+    the given model; its task is the ``.json`` record beside it.
 
     Raises:
         ValueError: a model that is not a continuous-action actor-critic, or that has no
             task record or no ``VecNormalize`` statistics.
     """
-    name = settings.student.removeprefix(PRETRAINED_PREFIX)
-    if settings.student.startswith(PRETRAINED_PREFIX):
-        original = SB3Policy.pretrained(name)
-        record = dict(pretrained_record(name))
-    else:
-        original = SB3Policy(None, settings.student)
-        path = original.model_path.with_suffix(".json")
-        if not path.is_file():
-            raise ValueError(
-                f"the student {settings.student} has no task record ({path.name}): distill "
-                "a model exported with bearing-env train --export, or pretrained:NAME"
-            )
-        record = dict(json.loads(path.read_text()))
-    if not isinstance(original.model.action_space, spaces.Box):
+    saved = settings.output / MODEL_NAME
+    path = saved if resume and saved.is_file() else init_model_path(settings.student, "--student")
+    assert path is not None  # the student is required
+    student = SB3Policy(None, path)
+    if student.task is None:
+        raise ValueError(
+            f"the student {settings.student} has no task record "
+            f"({student.model_path.with_suffix('.json').name}): distill a model exported "
+            "with bearing-env train --export, or pretrained:NAME"
+        )
+    if not isinstance(student.model.action_space, spaces.Box):
         raise ValueError(
             f"distill trains continuous-action models; {settings.student} outputs "
-            f"{original.model.action_space}"
+            f"{student.model.action_space}"
         )
-    if not hasattr(original.model.policy, "action_net"):
+    if not hasattr(student.model.policy, "action_net"):
         raise ValueError(f"distill trains actor-critic models (PPO, A2C), not {settings.student}")
-    if original.obs_normalizer is None:
+    if student.obs_normalizer is None:
         raise ValueError(f"{settings.student} has no VecNormalize statistics beside it")
-    saved = settings.output / MODEL_NAME
-    student = SB3Policy(None, saved, task=None) if resume and saved.is_file() else original
-    student.task = ModelTask.from_record(record, name, RECORD_NAME)
-    return student, record
+    return student
 
 
 def play_episode(
@@ -381,8 +377,8 @@ def _check_output(settings: DistillSettings, resume: bool) -> dict[str, Any]:
         return {}
     if not state:
         raise FileNotFoundError(f"--resume: {settings.output} holds no {STATE_NAME}")
-    saved = {k: v for k, v in state["settings"].items() if k not in ("progress", "iterations")}
-    current = {k: v for k, v in settings.as_record().items() if k not in ("progress", "iterations")}
+    saved = {k: v for k, v in state["settings"].items() if k != "progress"}
+    current = {k: v for k, v in settings.as_record().items() if k != "progress"}
     changed = [f"{k} {saved.get(k)!r} -> {v!r}" for k, v in current.items() if saved.get(k) != v]
     if changed:
         raise ValueError(f"--resume with other settings than the run's: {', '.join(changed)}")
@@ -392,7 +388,8 @@ def _check_output(settings: DistillSettings, resume: bool) -> dict[str, Any]:
 def distill(settings: DistillSettings, resume: bool = False) -> DistillResult:
     """Run (or finish, with ``resume``) a DAgger distillation; see the module doc."""
     state = _check_output(settings, resume)
-    student, record = load_student(settings, resume)
+    student = load_student(settings, resume)
+    record = json.loads(student.model_path.with_suffix(".json").read_text())
     env = student.make_env()
     teacher = make_policy(settings.teacher, env)
     dataset_path = settings.output / DATASET_NAME
@@ -420,8 +417,9 @@ def distill(settings: DistillSettings, resume: bool = False) -> DistillResult:
     total = settings.iterations * settings.episodes
     done = sum(len(dataset.seeds_of(i)) for i in range(settings.iterations))
     interrupted = False
+    stop = StopRequest()
     with (
-        _interruptible() as stop,
+        stop_on_signals(stop, STOP_NOTICE),
         progress_bar(
             total, desc="distill", unit="episode", enabled=settings.progress, initial=done
         ) as bar,
@@ -445,7 +443,7 @@ def distill(settings: DistillSettings, resume: bool = False) -> DistillResult:
                 dataset.save(dataset_path)
                 write_state()
                 bar.update(1)
-                if stop():
+                if stop:
                     interrupted = True
                     break
             if interrupted:
@@ -457,7 +455,7 @@ def distill(settings: DistillSettings, resume: bool = False) -> DistillResult:
             entry["trained"] = True
             write_state()
             bar.set_postfix(loss=f"{entry['loss_after']:.4f}")
-            if stop():
+            if stop:
                 interrupted = True
                 break
     env.close()
@@ -467,30 +465,6 @@ def distill(settings: DistillSettings, resume: bool = False) -> DistillResult:
 
 def _actor(iteration: int) -> str:
     return "student" if iteration > 0 else "teacher"
-
-
-@contextmanager
-def _interruptible() -> Iterator[Any]:
-    """A ``stop()`` that turns true after Ctrl-C or SIGTERM: the run ends after the
-    episode under way has been saved (a second Ctrl-C stops at once)."""
-    import signal
-
-    requested = {"stop": False}
-    previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
-
-    def handle(signum: int, frame: Any) -> None:
-        if requested["stop"]:
-            raise KeyboardInterrupt
-        requested["stop"] = True
-        print("\nstopping after this episode (Ctrl-C again to stop now)", file=sys.stderr)
-
-    for sig in previous:
-        signal.signal(sig, handle)
-    try:
-        yield lambda: requested["stop"]
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -503,11 +477,14 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--student",
         required=True,
-        help="the model to train: a .zip, a run folder, or pretrained:NAME",
+        help="the model to train: a .zip exported by bearing-env train --export (its .json "
+        "record beside it), or pretrained:NAME",
     )
     parser.add_argument("--teacher", default="lookahead_oracle", help="the labelling policy spec")
     parser.add_argument("--output", type=Path, required=True, help="the run folder")
-    parser.add_argument("--resume", action="store_true", help="finish the run in --output")
+    parser.add_argument(
+        "--resume", action="store_true", help="finish the run in --output (same settings)"
+    )
     parser.add_argument("--iterations", type=COUNT, default=4, help="DAgger iterations")
     parser.add_argument("--episodes", type=COUNT, default=50, help="episodes per iteration")
     parser.add_argument("--epochs", type=COUNT, default=20, help="passes over the dataset")

@@ -196,9 +196,11 @@ class TrainResult:
 
 
 @contextlib.contextmanager
-def stop_on_signals(request: StopRequest) -> Iterator[None]:
-    """While active, Ctrl-C and SIGTERM set ``request`` (the trainer stops at the next step);
-    a second Ctrl-C raises ``KeyboardInterrupt`` at once."""
+def stop_on_signals(
+    request: StopRequest, notice: str = "stopping at the next step and saving a checkpoint"
+) -> Iterator[None]:
+    """While active, Ctrl-C and SIGTERM set ``request`` and print ``notice`` (the trainer
+    stops at the next step); a second Ctrl-C raises ``KeyboardInterrupt`` at once."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -208,8 +210,7 @@ def stop_on_signals(request: StopRequest) -> Iterator[None]:
             raise KeyboardInterrupt
         request.set(signal.Signals(signum).name)
         print(
-            f"\n{signal.Signals(signum).name}: stopping at the next step and saving a checkpoint "
-            "(Ctrl-C again to stop at once)",
+            f"\n{signal.Signals(signum).name}: {notice} (Ctrl-C again to stop at once)",
             file=sys.stderr,
             flush=True,
         )

@@ -214,8 +214,9 @@ def settings_from_args(args: argparse.Namespace) -> TrainSettings:
     )
 
 
-def init_model_path(spec: str | None) -> Path | None:
-    """``--init-from``'s model: ``pretrained:NAME`` is a shipped model's ``.zip``."""
+def init_model_path(spec: str | None, option: str = "--init-from") -> Path | None:
+    """``--init-from``'s model (or another ``option``'s): ``pretrained:NAME`` is a shipped
+    model's ``.zip``."""
     if spec is None:
         return None
     if spec.startswith(PRETRAINED_PREFIX):
@@ -224,7 +225,7 @@ def init_model_path(spec: str | None) -> Path | None:
         name = spec.removeprefix(PRETRAINED_PREFIX)
         if name not in pretrained_names():
             raise ValueError(
-                f"--init-from: no pretrained model named {name!r}; available: "
+                f"{option}: no pretrained model named {name!r}; available: "
                 f"{pretrained_names()}"
             )
         return PRETRAINED_DIR / f"{name}.zip"
