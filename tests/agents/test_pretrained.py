@@ -174,7 +174,7 @@ def test_models_trained_on_other_counts_share_the_studys_envs() -> None:
 
     def model(**kwargs: object) -> StudyModel:
         trained = {"scenario": "random", "max_landmarks": 16, "observation": "entities", **kwargs}
-        return StudyModel("m", "spec", trained, ModelTask("BearingSLAM-v0", trained))
+        return StudyModel("m", "spec", ModelTask("BearingSLAM-v0", trained))
 
     counts = [3, 8, 24]
     narrow, wide = model(n_landmarks=[3, 12]), model(n_landmarks=[3, 16])

@@ -41,7 +41,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from bearing_env.agents.model_task import ModelTask, task_record_of
-from bearing_env.agents.sb3 import pretrained_names, pretrained_record, pretrained_task
+from bearing_env.agents.sb3 import pretrained_names, pretrained_task
 from bearing_env.envs.config import EnvConfig
 from bearing_env.extras import available
 from bearing_env.train.common.cli_parser import command_parser, doc_summary
@@ -80,7 +80,6 @@ class StudyModel(NamedTuple):
 
     label: str
     spec: str
-    env_kwargs: dict[str, Any]
     task: ModelTask
 
 
@@ -91,8 +90,7 @@ def study_model(value: str) -> StudyModel:
         ValueError: neither a shipped name nor an exported model with a record.
     """
     if value in pretrained_names():
-        kwargs = dict(pretrained_record(value).get("env_kwargs", {}))
-        return StudyModel(value, f"pretrained:{value}", kwargs, pretrained_task(value))
+        return StudyModel(value, f"pretrained:{value}", pretrained_task(value))
     path = Path(value)
     task = task_record_of(path) if path.suffix == ".zip" and path.is_file() else None
     if task is None:
@@ -101,13 +99,14 @@ def study_model(value: str) -> StudyModel:
             "nor an exported .zip with its .json record beside it (bearing-env train --export)"
         )
     spec = f"sb3:path={path},label={path.stem}"
-    return StudyModel(path.stem, spec, dict(task.env_kwargs), task)
+    return StudyModel(path.stem, spec, task)
 
 
 def study_envs(model: StudyModel, counts: Sequence[int]) -> list[dict[str, Any]]:
     """The env kwargs a model's comparisons run with, one per count."""
-    slots = EnvConfig.create(**model.env_kwargs).observations.max_landmarks
-    return [env_kwargs_for_count(model.env_kwargs, count, slots) for count in counts]
+    trained = model.task.env_kwargs
+    slots = EnvConfig.create(**trained).observations.max_landmarks
+    return [env_kwargs_for_count(trained, count, slots) for count in counts]
 
 
 class StudySettings(NamedTuple):
@@ -289,7 +288,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         if model.label in training_counts:
             parser.error(f"two models are labelled {model.label!r}: rename one")
         # The env's own resolution of the training settings: counts and observation slots.
-        trained = EnvConfig.create(**model.env_kwargs)
+        trained = EnvConfig.create(**model.task.env_kwargs)
         max_landmarks = trained.observations.max_landmarks
         if model.task.slot_free:
             max_landmarks = max(args.counts)  # a set policy: any count, with more slots
