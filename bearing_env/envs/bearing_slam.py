@@ -501,7 +501,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         if self.render_mode == "human":
             self.render()
         return (
-            self._observation(report.observations[0]),
+            self._observation(report.observations[0].copy()),  # the step reuses its report
             report.rewards.item(),
             report.terminated.item(),
             report.truncated.item(),

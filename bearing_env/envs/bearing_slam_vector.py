@@ -255,8 +255,9 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         if len(groups) == 1 and groups[0][1].size == n:  # the common case: one group, every row
             config, rows, turns, lengths = groups[0]
             report, group_infos = self._step_group(config, rows, turns, lengths)
-            observations, rewards = report.observations, report.rewards
-            terminations, truncations = report.terminated, report.truncated
+            # Copies: the step reuses its report's arrays.
+            observations, rewards = report.observations.copy(), report.rewards.copy()
+            terminations, truncations = report.terminated.copy(), report.truncated.copy()
             infos = _as_vector_infos(group_infos, n)
         else:
             observations = np.zeros(self._flat_shape, dtype=np.float32)

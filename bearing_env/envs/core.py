@@ -85,8 +85,11 @@ class MapBank:
         self.batches: dict[tuple[int, MapSettings], BatchedPolygonSLAM] = {}
         self._views: dict[tuple[int, MapSettings, int], PolygonSLAM] = {}
         #: Each (landmark count, config)'s kernel inputs (an ``InputsRef``), with the
-        #: state and map references they were made of.
-        self._inputs: dict[tuple[int, EnvConfig], tuple[Any, Any, kernels.Inputs]] = {}
+        #: state and map references they were made of, and what its steps reuse (the
+        #: step kernels' compiled functions and output arrays: see :func:`step`).
+        self._inputs: dict[
+            tuple[int, EnvConfig], tuple[Any, Any, kernels.Inputs, dict[Any, Any]]
+        ] = {}
 
     def group(self, state: BatchState, rows: IntArray, config: EnvConfig) -> Group:
         """The group of ``rows`` (all with ``config`` and one landmark count), with its
@@ -96,22 +99,22 @@ class MapBank:
         last = self.__dict__.get("_last")
         if last is None or last[0] is not config or last[1] != n or last[2] is not state_ref:
             last = self._last = (config, n, state_ref, *self._inputs_for(n, config, state_ref))
-        return Group(rows, config, n, last[3], last[4])
+        return Group(rows, config, n, last[3], last[4], last[5])
 
     def batch(self, n_landmarks: int, config: EnvConfig) -> BatchedPolygonSLAM:
         return self._batch_for(int(n_landmarks), config.map_settings)
 
     def _inputs_for(
         self, n: int, config: EnvConfig, state_ref: BatchState
-    ) -> tuple[BatchedPolygonSLAM, kernels.Inputs]:
+    ) -> tuple[BatchedPolygonSLAM, kernels.Inputs, dict[Any, Any]]:
         batch = self._batch_for(n, config.map_settings)
         maps_ref = batch._kernel_state()
         kept = self._inputs.get((n, config))
         if kept is None or kept[0] is not state_ref or kept[1] is not maps_ref:
             settings, params = kernel_settings(n, config), batch._kernel_params(True)
             inputs = kernels.inputs_ref(kernels.Inputs(settings, params, maps_ref, state_ref))
-            kept = self._inputs[n, config] = (state_ref, maps_ref, inputs)
-        return batch, kept[2]
+            kept = self._inputs[n, config] = (state_ref, maps_ref, inputs, {})
+        return batch, kept[2], kept[3]
 
     def _batch_for(self, n_landmarks: int, settings: MapSettings) -> BatchedPolygonSLAM:
         key = (n_landmarks, settings)
@@ -144,6 +147,9 @@ class Group(NamedTuple):
     n: int  #: the rows' landmark count
     batch: BatchedPolygonSLAM  #: their maps
     inputs: kernels.Inputs  #: what the kernels take (an ``InputsRef``)
+    #: What the group's steps reuse: the step kernels' compiled functions for these
+    #: inputs (:func:`_call`) and their output arrays (:func:`_outputs`).
+    reused: dict[Any, Any]
 
 
 def kernel_settings(n_landmarks: int, config: EnvConfig) -> Settings:
@@ -418,29 +424,77 @@ def step(
     comes from the rows' noise buffers, which the rows' generators fill ahead
     (:func:`fill_noise`, called at reset and whenever a block is spent).
     """
-    rows, config, inputs = group.rows, group.config, group.inputs
-    turns = np.ascontiguousarray(turns, dtype=np.float64)
-    lengths = np.ascontiguousarray(lengths, dtype=np.float64)
+    config, inputs = group.config, group.inputs
+    rows, turns, lengths = _owned(group.rows, np.int64), _owned(turns), _owned(lengths)
     # Small batches stay on one thread (see PARALLEL_MIN_MAPS): asking numba costs ~2 us.
     threads = slam_kernels.threads() if rows.size >= PARALLEL_MIN_MAPS else 1
-    map_slots = config.observations.max_landmarks - 2
+    report, encoded = _outputs(group, rows.size)
     while True:
-        if config.observations.robot_map_info:
-            status, report, encoded = kernels.step_rows(
-                rows, turns, lengths, inputs, state.trajectory, threads, map_slots
-            )
+        if encoded is not None:
+            args = (rows, turns, lengths, inputs, state.trajectory, threads, report)
+            status = _call(group, kernels.step_rows, (*args, encoded.kernel))
         else:
-            status, report = kernels.step_rows_bare(
-                rows, turns, lengths, inputs, state.trajectory, threads
-            )
-            encoded = None
+            args = (rows, turns, lengths, inputs, state.trajectory, threads, report)
+            status = _call(group, kernels.step_rows_bare, args)
         if status == kernels.STEP_DONE:
-            return report, _robot_map(group, encoded)
+            return report, _robot_map_of(group, encoded)
         if status == kernels.STEP_NEEDS_NOISE:
             spent = state.noise_used[rows] + 2 * group.n > state.noise_filled[rows]
             fill_noise(state, rows[spent], config)
         else:
             state.grow_trajectory()
+
+
+def _outputs(group: Group, size: int) -> tuple[kernels.Report, robot_map.Buffers | None]:
+    """The step kernels' output arrays for ``size`` of the group's rows: made once per
+    group (for every row of the bank), then reused, so that a step hands nothing new out
+    of its compiled call (see :mod:`bearing_env.envs.kernels`); the robot map's encoded
+    arrays are None with ``robot_map_info`` off. Whoever keeps what a step wrote copies
+    it (:func:`infos`, :func:`single_info`)."""
+    outputs = group.reused.get(_OUTPUTS)
+    if outputs is None:
+        every_row = np.arange(group.batch.num_maps)
+        encoded = None
+        if group.config.observations.robot_map_info:
+            slots = max(group.config.observations.max_landmarks - 2, group.n - 2)
+            maps = group.batch._kernel_state()
+            encoded = robot_map.buffers(robot_map.encode_map(maps, every_row, slots))
+        outputs = group.reused[_OUTPUTS] = (
+            kernels.new_report(every_row.size, group.inputs),
+            encoded,
+        )
+    report, encoded = outputs
+    if size == report.rewards.size:
+        return report, encoded
+    return (
+        kernels.Report._make(values[:size] for values in report),
+        None if encoded is None else encoded.rows(size),
+    )
+
+
+#: The key of the step kernels' output arrays in :attr:`Group.reused`.
+_OUTPUTS = "outputs"
+
+
+def _owned(values: NDArray[Any], dtype: type = np.float64) -> NDArray[Any]:
+    """``values`` as a C-contiguous, writeable array of ``dtype`` (itself if it is one):
+    the one array type the step kernels' compiled functions are resolved for."""
+    flags = values.flags
+    if values.dtype == dtype and values.ndim == 1 and flags.c_contiguous and flags.writeable:
+        return values
+    return np.require(np.array(values, dtype=dtype, ndmin=1), requirements=["C", "W"])
+
+
+def _call(group: Group, kernel: Any, args: tuple[Any, ...]) -> Any:
+    """``kernel(*args)`` through its compiled function for the group's inputs, resolved at
+    the first call (:func:`bearing_env.slam.kernels.entry_point`): numba's dispatcher types
+    every argument in Python on each call, about 30 us of a single env's step. The arrays
+    are :func:`_owned` or the group's own outputs, so their types never change for one
+    inputs object."""
+    entry = group.reused.get(kernel)
+    if entry is None:
+        entry = group.reused[kernel] = slam_kernels.entry_point(kernel, args)
+    return entry(*args)
 
 
 def report(state: BatchState, group: Group) -> tuple[kernels.Report, dict[str, Any] | None]:
@@ -452,20 +506,28 @@ def report(state: BatchState, group: Group) -> tuple[kernels.Report, dict[str, A
 
 
 def _robot_map(group: Group, encoded: tuple[Any, ...] | None) -> dict[str, Any] | None:
-    """The ``robot_map`` info from the kernel's encoded arrays, with the relaxed fusion's
-    window and bases or the robust fusion's levels (one more compiled call); None when
-    the setting is off."""
+    """The ``robot_map`` info from :func:`robot_map.encode_map`'s arrays, with the relaxed
+    fusion's window and bases or the robust fusion's levels (one more compiled call);
+    None when the setting is off."""
     if encoded is None or not group.config.observations.robot_map_info:
         return None
+    return _robot_map_of(group, robot_map.buffers(encoded))
+
+
+def _robot_map_of(group: Group, encoded: robot_map.Buffers | None) -> dict[str, Any] | None:
+    """:func:`_robot_map` from the step's reused arrays (views of them)."""
+    if encoded is None:
+        return None
     batch = group.batch
+    if batch.fusion == "intersect":
+        return dict(encoded.info)
     slots = max(group.config.observations.max_landmarks - 2, group.n - 2)
     if batch.fusion == "relaxed":
-        encoded += robot_map.encode_window(batch._kernel_state(), group.rows, slots)
-    elif batch.fusion == "robust":
-        encoded += robot_map.encode_levels(batch._kernel_state(), group.rows, slots)
+        more = robot_map.encode_window(batch._kernel_state(), group.rows, slots)
     else:
-        return robot_map.as_info(robot_map.MAP_ARRAYS, encoded)
-    return robot_map.as_info(batch.state_names, encoded)
+        more = robot_map.encode_levels(batch._kernel_state(), group.rows, slots)
+    names = batch.state_names[len(robot_map.MAP_ARRAYS) :]
+    return {**encoded.info, **robot_map.as_info(names, more)}
 
 
 # ----------------------------------------------------------------------------------------
@@ -550,27 +612,27 @@ def infos(
     robot_map_info: dict[str, Any] | None,
     sensor: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """The group's infos, batched along a first axis (see the env's Info section): the
-    report's arrays themselves, ``robot_map`` unless it is None (the setting off), and
-    the :func:`sensor_info` entries unless they are None."""
+    """The group's infos, batched along a first axis (see the env's Info section): copies
+    of the report's arrays (the step reuses them), ``robot_map`` unless it is None (the
+    setting off), and the :func:`sensor_info` entries unless they are None."""
     infos: dict[str, Any] = {
-        "landmark_area": report.landmark_area,
-        "landmark_error": report.landmark_error,
-        "landmark_contains_truth": report.landmark_contains_truth,
-        "total_area": report.total_area,
-        "robot_error": report.robot_error,
-        "frame_changed": report.frame_changed,
-        "inconsistent": report.inconsistent,
-        "outliers": report.outliers,
-        "path_length": report.path_length,
+        "landmark_area": report.landmark_area.copy(),
+        "landmark_error": report.landmark_error.copy(),
+        "landmark_contains_truth": report.landmark_contains_truth.copy(),
+        "total_area": report.total_area.copy(),
+        "robot_error": report.robot_error.copy(),
+        "frame_changed": report.frame_changed.copy(),
+        "inconsistent": report.inconsistent.copy(),
+        "outliers": report.outliers.copy(),
+        "path_length": report.path_length.copy(),
         "rewards": {
-            "uncertainty": report.uncertainty,
-            "path_cost": report.path_cost,
-            "move_cost": report.move_cost,
+            "uncertainty": report.uncertainty.copy(),
+            "path_cost": report.path_cost.copy(),
+            "move_cost": report.move_cost.copy(),
         },
     }
     if robot_map_info is not None:
-        infos[robot_map.KEY] = robot_map_info
+        infos[robot_map.KEY] = {key: value.copy() for key, value in robot_map_info.items()}
     if sensor is not None:
         infos.update(sensor)
     return infos
@@ -594,17 +656,17 @@ def single_info(
     robot_map_info: dict[str, Any] | None,
     sensor: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """The info of a group of one row (the single env): Python scalars and per-landmark
-    arrays (views of the report's, which is made anew at every step and kept by no one)."""
+    """The info of a group of one row (the single env): Python scalars and copies of the
+    per-landmark arrays (the step reuses its report)."""
     info: dict[str, Any] = {
-        "landmark_area": report.landmark_area[0],
-        "landmark_error": report.landmark_error[0],
-        "landmark_contains_truth": report.landmark_contains_truth[0],
+        "landmark_area": report.landmark_area[0].copy(),
+        "landmark_error": report.landmark_error[0].copy(),
+        "landmark_contains_truth": report.landmark_contains_truth[0].copy(),
         "total_area": report.total_area.item(),
         "robot_error": report.robot_error.item(),
         "frame_changed": report.frame_changed.item(),
         "inconsistent": report.inconsistent.item(),
-        "outliers": report.outliers[0],
+        "outliers": report.outliers[0].copy(),
         "path_length": report.path_length.item(),
         "rewards": {
             "uncertainty": report.uncertainty.item(),
@@ -614,7 +676,7 @@ def single_info(
     }
     if robot_map_info is not None:
         info[robot_map.KEY] = {
-            key: value[0] if value.ndim > 1 else value.item()
+            key: value[0].copy() if value.ndim > 1 else value.item()
             for key, value in robot_map_info.items()
         }
     if sensor is not None:

@@ -20,7 +20,7 @@ what the robot knows, never ground truth.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -77,6 +77,37 @@ def as_info(names: tuple[str, ...], arrays: tuple[NDArray[Any], ...]) -> dict[st
     }
 
 
+class Buffers(NamedTuple):
+    """:func:`encode_map`'s arrays, kept from step to step, in two forms over the same
+    memory: as the info gives them (``info``, by name, complex points as (x, y) pairs) and
+    as :func:`encode_map_into` writes them (``kernel``, complex views)."""
+
+    info: dict[str, NDArray[Any]]
+    kernel: tuple[NDArray[Any], ...]
+
+    def rows(self, size: int) -> Buffers:
+        """The first ``size`` rows (views)."""
+        return Buffers(
+            {name: values[:size] for name, values in self.info.items()},
+            tuple(values[:size] for values in self.kernel),
+        )
+
+
+def buffers(arrays: tuple[NDArray[Any], ...]) -> Buffers:
+    """:class:`Buffers` holding (copies of) :func:`encode_map`'s ``arrays``: its padding
+    stays, as only the mapped slots are written again."""
+    info, kernel = {}, []
+    for name, values in zip(MAP_ARRAYS, arrays, strict=True):
+        if values.dtype.kind == "c":
+            pairs = np.ascontiguousarray(values).view(np.float64).reshape(*values.shape, 2)
+            info[name] = pairs = pairs.copy()
+            kernel.append(pairs.view(np.complex128).reshape(values.shape))
+        else:
+            info[name] = values = values.copy()
+            kernel.append(values)
+    return Buffers(info, tuple(kernel))
+
+
 @njit(**JIT_OPTIONS)
 def _known(value: complex) -> complex:  # pragma: no cover  (compiled)
     """A complex point, inf + inf j if unknown (NaN in either part)."""
@@ -89,38 +120,30 @@ def _known(value: complex) -> complex:  # pragma: no cover  (compiled)
 def encode_map(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
     """The arrays every fusion uses (``STATE_ARRAYS`` up to ``n_inconsistent``), in
     their order, for ``rows``: landmark slots padded to ``slots`` (see the module doc)."""
-    size, mapped, capacity = rows.size, state.counts.shape[1], state.vertices.shape[2]
-    vertices = np.zeros((size, slots, capacity), np.complex128)
-    counts = np.zeros((size, slots), np.int64)
-    areas = np.full((size, slots), np.inf)
-    centroids = np.full((size, slots), complex(np.inf, np.inf))
-    robot_vertices = np.zeros((size, capacity), np.complex128)
-    robot_counts = np.empty(size, np.int64)
-    robot_area = np.empty(size)
-    robot_centroid = np.empty(size, np.complex128)
-    robot_heading = np.empty(size)
-    n_updates = np.empty(size, np.int64)
-    n_frame_changes = np.empty(size, np.int64)
-    n_inconsistent = np.empty(size, np.int64)
-    for i in range(size):
-        row = rows[i]
-        for j in range(mapped):
-            count = state.counts[row, j]
-            counts[i, j] = count
-            vertices[i, j, :count] = state.vertices[row, j, :count]
-            areas[i, j] = state.areas[row, j]
-            centroids[i, j] = _known(state.centroids[row, j])
-        count = state.robot_counts[row]
-        robot_counts[i] = count
-        robot_vertices[i, :count] = state.robot_vertices[row, :count]
-        robot_area[i] = state.robot_area[row]
-        robot_centroid[i] = _known(state.robot_centroid[row])
-        heading = state.robot_heading[row]
-        robot_heading[i] = np.inf if np.isnan(heading) else heading
-        n_updates[i] = state.n_updates[row]
-        n_frame_changes[i] = state.n_frame_changes[row]
-        n_inconsistent[i] = state.n_inconsistent[row]
-    return (
+    size, capacity = rows.size, state.vertices.shape[2]
+    encoded = (
+        np.zeros((size, slots, capacity), np.complex128),
+        np.zeros((size, slots), np.int64),
+        np.full((size, slots), np.inf),
+        np.full((size, slots), complex(np.inf, np.inf)),
+        np.zeros((size, capacity), np.complex128),
+        np.empty(size, np.int64),
+        np.empty(size),
+        np.empty(size, np.complex128),
+        np.empty(size),
+        np.empty(size, np.int64),
+        np.empty(size, np.int64),
+        np.empty(size, np.int64),
+    )
+    encode_map_into(state, rows, encoded)
+    return encoded
+
+
+@njit(**JIT_OPTIONS)
+def encode_map_into(state: Any, rows: Any, encoded: Any) -> None:  # pragma: no cover
+    """:func:`encode_map` into its arrays ``encoded`` (of ``len(rows)`` rows, its slot
+    count theirs), whatever they held: the env step reuses them from step to step."""
+    (
         vertices,
         counts,
         areas,
@@ -133,7 +156,28 @@ def encode_map(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (
         n_updates,
         n_frame_changes,
         n_inconsistent,
-    )
+    ) = encoded
+    mapped = state.counts.shape[1]
+    for i in range(rows.size):
+        row = rows[i]
+        for j in range(mapped):
+            count = state.counts[row, j]
+            counts[i, j] = count
+            vertices[i, j, :count] = state.vertices[row, j, :count]
+            vertices[i, j, count:] = 0.0
+            areas[i, j] = state.areas[row, j]
+            centroids[i, j] = _known(state.centroids[row, j])
+        count = state.robot_counts[row]
+        robot_counts[i] = count
+        robot_vertices[i, :count] = state.robot_vertices[row, :count]
+        robot_vertices[i, count:] = 0.0
+        robot_area[i] = state.robot_area[row]
+        robot_centroid[i] = _known(state.robot_centroid[row])
+        heading = state.robot_heading[row]
+        robot_heading[i] = np.inf if np.isnan(heading) else heading
+        n_updates[i] = state.n_updates[row]
+        n_frame_changes[i] = state.n_frame_changes[row]
+        n_inconsistent[i] = state.n_inconsistent[row]
 
 
 @njit(**JIT_OPTIONS)
