@@ -46,7 +46,9 @@ from bearing_env.envs.observations import (
     BEARING_FEATURES,
     ENTITY_FEATURES,
     ROBOT_FEATURES,
+    EntityObservation,
     observation_slices,
+    spec_for,
 )
 from bearing_env.numerics import wrap
 from bearing_env.slam import PolygonSLAM
@@ -108,13 +110,18 @@ class ObservationReader:
         self.bearing_block = observation_slices(int(base.config.observations.max_landmarks))[
             "bearings"
         ]
+        #: The landmark table's columns, for the kinds with a table (every kind's table
+        #: starts with ENTITY_FEATURES).
+        spec = spec_for(base.config)
+        self.table_width = len(spec.features) if isinstance(spec, EntityObservation) else 0
 
     def read(self, observation: NDArray[np.float32] | Mapping[str, Any]) -> ObservationView:
-        """The view of a flat observation, or of an entity one (``observation="entities"``)."""
+        """The view of a flat observation, or of one with a landmark table
+        (``observation="entities"`` or ``"shapes"``)."""
         if isinstance(observation, Mapping):
             robot = np.asarray(observation["robot"], dtype=np.float64)
             table = np.asarray(observation["landmarks"], dtype=np.float64)
-            table = table.reshape(-1, len(ENTITY_FEATURES))
+            table = table.reshape(-1, self.table_width)
             present, cos, sin = (
                 ENTITY_FEATURES.index(name) for name in ("present", "bearing_cos", "bearing_sin")
             )

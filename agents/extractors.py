@@ -39,13 +39,14 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 import torch
 from gymnasium import spaces
 from stable_baselines3.common.policies import MultiInputActorCriticPolicy
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
-from bearing_env.envs.observations import ENTITY_FEATURES
+from bearing_env.envs.observations import ENTITY_FEATURES, SPECS, EntityObservation
 
 #: The log-area column is divided by this (log-areas span about [-23, 14]).
 LOG_AREA_SCALE = 10.0
@@ -53,10 +54,23 @@ _PRESENT = ENTITY_FEATURES.index("present")
 _LOG_AREA = ENTITY_FEATURES.index("log_area")
 
 
+def table_width(observation: str) -> int:
+    """The landmark table's columns in observation kind ``observation`` (``"entities"``
+    or ``"shapes"``; ValueError for a kind without a table)."""
+    spec = SPECS.get(observation)
+    if not isinstance(spec, EntityObservation):
+        kinds = [kind for kind, spec in SPECS.items() if isinstance(spec, EntityObservation)]
+        raise ValueError(
+            f"observation must be one of {kinds} (a landmark table), got {observation!r}"
+        )
+    return len(spec.features)
+
+
 def _check_entity_space(
-    extractor: str, observation_space: spaces.Dict, hidden: int, features_dim: int
+    extractor: str, observation_space: spaces.Dict, hidden: int, features_dim: int, width: int
 ) -> int:
-    """The robot block's size, after checking the space is the entity observation."""
+    """The robot block's size, after checking the space is the entity observation with
+    ``width`` columns per table row."""
     if not isinstance(observation_space, spaces.Dict) or set(observation_space.spaces) != {
         "robot",
         "landmarks",
@@ -67,16 +81,23 @@ def _check_entity_space(
         )
     if int(hidden) < 1 or int(features_dim) < 1:
         raise ValueError(f"hidden and features_dim must be >= 1, got {hidden}, {features_dim}")
+    # Every row of a table has the same bounds: rows of another width would not.
+    table = observation_space["landmarks"]
+    high = np.asarray(getattr(table, "high", ()), dtype=np.float64).ravel()
+    if high.size % width or not (high.reshape(-1, width) == high[:width]).all():
+        raise ValueError(
+            f"{extractor}: the landmark table ({high.size} values) is not rows of {width} "
+            "columns: pass the env's observation kind as observation= ('entities' or 'shapes')"
+        )
     robot_space = observation_space["robot"]
     return int(robot_space.shape[0]) if robot_space.shape else 0
 
 
 def _robot_and_table(
-    observations: dict[str, torch.Tensor],
+    observations: dict[str, torch.Tensor], width: int
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """The robot block (batch, robot), the scaled table (batch, rows, features) and the
+    """The robot block (batch, robot), the scaled table (batch, rows, ``width``) and the
     present mask (batch, rows, 1)."""
-    width = len(ENTITY_FEATURES)
     robot = observations["robot"].float()
     table = observations["landmarks"].float().reshape(robot.shape[0], -1, width)
     scale = torch.ones(width, device=table.device)
@@ -99,16 +120,23 @@ class LandmarkSetExtractor(BaseFeaturesExtractor):
         observation_space: the env's ``Dict`` space (keys ``"robot"``, ``"landmarks"``).
         hidden: width of the per-landmark encoder phi and of the robot encoder.
         features_dim: size of the output features.
+        observation: the env's observation kind, ``"entities"`` or ``"shapes"`` (its
+            table has three more columns).
     """
 
     def __init__(
-        self, observation_space: spaces.Dict, hidden: int = 64, features_dim: int = 128
+        self,
+        observation_space: spaces.Dict,
+        hidden: int = 64,
+        features_dim: int = 128,
+        observation: str = "entities",
     ) -> None:
+        width = table_width(observation)
         robot_dim = _check_entity_space(
-            "LandmarkSetExtractor", observation_space, hidden, features_dim
+            "LandmarkSetExtractor", observation_space, hidden, features_dim, width
         )
         super().__init__(observation_space, int(features_dim))
-        self.width = len(ENTITY_FEATURES)
+        self.width = width
         hidden = int(hidden)
         self.phi = nn.Sequential(
             nn.Linear(self.width + robot_dim, hidden),
@@ -120,7 +148,7 @@ class LandmarkSetExtractor(BaseFeaturesExtractor):
         self.rho = nn.Sequential(nn.Linear(3 * hidden, int(features_dim)), nn.ReLU())
 
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
-        robot, table, present = _robot_and_table(observations)
+        robot, table, present = _robot_and_table(observations, self.width)
         context = robot.unsqueeze(1).expand(-1, table.shape[1], -1)
         encoded = self.phi(torch.cat([table, context], dim=-1))
         mean = _masked_mean(encoded, present)
@@ -139,6 +167,7 @@ class LandmarkAttentionExtractor(BaseFeaturesExtractor):
         hidden: width of the landmark embeddings (a multiple of ``heads``).
         features_dim: size of the output features.
         heads: attention heads.
+        observation: the env's observation kind, ``"entities"`` or ``"shapes"``.
     """
 
     def __init__(
@@ -147,15 +176,17 @@ class LandmarkAttentionExtractor(BaseFeaturesExtractor):
         hidden: int = 64,
         features_dim: int = 128,
         heads: int = 4,
+        observation: str = "entities",
     ) -> None:
+        width = table_width(observation)
         robot_dim = _check_entity_space(
-            "LandmarkAttentionExtractor", observation_space, hidden, features_dim
+            "LandmarkAttentionExtractor", observation_space, hidden, features_dim, width
         )
         hidden, heads = int(hidden), int(heads)
         if heads < 1 or hidden % heads:
             raise ValueError(f"hidden ({hidden}) must be a positive multiple of heads ({heads})")
         super().__init__(observation_space, int(features_dim))
-        width = len(ENTITY_FEATURES)
+        self.width = width
         self.embed = nn.Sequential(nn.Linear(width + robot_dim, hidden), nn.ReLU())
         self.self_attention = nn.MultiheadAttention(hidden, heads, batch_first=True)
         self.norm_attention = nn.LayerNorm(hidden)
@@ -169,7 +200,7 @@ class LandmarkAttentionExtractor(BaseFeaturesExtractor):
         self.rho = nn.Sequential(nn.Linear(3 * hidden, int(features_dim)), nn.ReLU())
 
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
-        robot, table, present = _robot_and_table(observations)
+        robot, table, present = _robot_and_table(observations, self.width)
         context = robot.unsqueeze(1).expand(-1, table.shape[1], -1)
         rows = self.embed(torch.cat([table, context], dim=-1))
         # A table with no present row would leave attention nothing to weigh (NaN): let

@@ -87,7 +87,7 @@ def random_configuration(
     kwargs: dict[str, Any] = {
         "scenario": str(rng.choice(["random", "random", "khepera", "paper_sim"])),
         "epsilon_deg": float(rng.uniform(0.5, 10.0)),
-        "observation": str(rng.choice(["flat", "entities"])),
+        "observation": str(rng.choice(["flat", "entities", "shapes"])),
         "reward": str(rng.choice(["log_area", "area"])),
         "max_moves": int(rng.integers(5, 41)),
         "transfer": "conservative",

@@ -201,6 +201,13 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     not initialised, estimate x, y, log-area (`log(1e-10)` for the exact L1 and L2) and
     the latest bearing's cos and sin. Absent rows are zeros.
 
+    With `observation="shapes"` the table has three more columns per row,
+    `observations.SHAPE_FEATURES` (a Box of `M * 11`; reshape to `(M, 11)`): the shape of
+    the landmark's region from the second moments of its area, its elongation (half the
+    log of the ratio of the principal moments: 0 when round, at most 10) and its long axis
+    theta in FL as (cos 2 theta, sin 2 theta) ((0, 0) when round). They are zeros for L1,
+    L2, absent rows and landmarks without a region yet.
+
     ## Rewards
 
     With `reward="log_area"` (default), the reward is the decrease of the potential
@@ -329,7 +336,8 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     - `on_inconsistency`: `"restart"` (default: a landmark whose regions contradict
       each other restarts from the newest one) or `"keep"` (it keeps its old region).
       With `"relaxed"`, this applies beyond `max_outliers`.
-    - `observation`: `"flat"` (default, the Box above) or `"entities"` (the Dict above).
+    - `observation`: `"flat"` (default, the Box above), `"entities"` or `"shapes"` (the
+      Dicts above).
     - `robot_map_info`: True (default) or False: whether infos carry `robot_map` (see
       Info). The map-based planners (`Parallax`, `GreedyOneStep`, `Lookahead` and their
       oracles) need it and refuse an env without it; training runs that never read it

@@ -23,7 +23,6 @@ from bearing_env.envs.bearing_slam import BearingSLAMEnv, Setting, check_reset_o
 from bearing_env.envs.bearing_slam_discrete import BearingSLAMDiscreteEnv
 from bearing_env.envs.config import MAX_N_LANDMARKS, EnvConfig
 from bearing_env.envs.core import MapBank, WorldView
-from bearing_env.envs.observations import observation_size
 from bearing_env.envs.state import BatchState
 from bearing_env.validation import int_at_least, is_integer
 
@@ -177,7 +176,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
         slots = observations.max_landmarks
         self._info_slots = slots - 2 if layout.has_count_range else None
         #: The sub-envs' observations, flat (the observation kind cannot change per env).
-        self._flat_shape = (self.num_envs, observation_size(slots))
+        self._flat_shape = (self.num_envs, prototype.observation_spec.flat_size(slots))
         self._observation_spec = prototype.observation_spec
         self._max_landmarks = slots
         self._autoreset_envs = np.zeros(self.num_envs, dtype=bool)

@@ -125,7 +125,7 @@ MAX_ACTION_TABLE = 4096
 REWARDS: tuple[str, ...] = ("log_area", "area")
 #: Observation kinds: the flat Box (default) or a Dict of a robot block and a landmark
 #: table (``bearing_env.envs.observations.EntityObservation``).
-OBSERVATIONS: tuple[str, ...] = ("flat", "entities")
+OBSERVATIONS: tuple[str, ...] = ("flat", "entities", "shapes")
 
 #: Why a setting cannot change on a live env: it fixes the observation space.
 FIXES_THE_SPACES = "it fixes the observation space; make a new env"

@@ -159,6 +159,7 @@ def kernel_settings(n_landmarks: int, config: EnvConfig) -> Settings:
     return Settings(
         n=int(n_landmarks),
         n_slots=int(config.observations.max_landmarks),
+        shape_features=config.observations.observation == "shapes",
         width=float(arena.width),
         height=float(arena.height),
         margin=float(arena.wall_margin),

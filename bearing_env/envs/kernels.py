@@ -28,7 +28,13 @@ from numba.core import types
 from numba.experimental import structref
 from numpy.typing import NDArray
 
-from bearing_env.envs.observations import BEARING_FEATURES, LANDMARK_FEATURES, ROBOT_FEATURES
+from bearing_env.envs.observations import (
+    BEARING_FEATURES,
+    ELONGATION_LIMIT,
+    LANDMARK_FEATURES,
+    ROBOT_FEATURES,
+    SHAPE_FEATURES,
+)
 from bearing_env.envs.robot_map import encode_map, encode_map_into
 from bearing_env.numerics import JIT_OPTIONS as _JIT
 from bearing_env.numerics import wrap
@@ -52,6 +58,7 @@ BoolArray = NDArray[np.bool_]
 _ROBOT_FEATURES = len(ROBOT_FEATURES)
 _LANDMARK_FEATURES = len(LANDMARK_FEATURES)
 _BEARING_FEATURES = len(BEARING_FEATURES)
+_SHAPE_FEATURES = len(SHAPE_FEATURES)
 
 
 class Settings(NamedTuple):
@@ -59,6 +66,7 @@ class Settings(NamedTuple):
 
     n: int  #: landmarks of the group's rows
     n_slots: int  #: the observation's landmark slots (max_landmarks)
+    shape_features: bool  #: the flat vector ends with the regions' shapes ("shapes" kind)
     width: float  #: the arena, metres
     height: float
     margin: float  #: the wall margin
@@ -375,6 +383,51 @@ def _write_observation(row: int, inputs: Inputs, out: np.ndarray) -> None:
         if not math.isnan(latest[row, k]):  # a missed reading reads (0, 0)
             out[at + 1] = math.cos(latest[row, k])
             out[at + 2] = math.sin(latest[row, k])
+    if settings.shape_features:
+        shapes_at = bearings_at + _BEARING_FEATURES * settings.n_slots
+        for j in range(settings.n - 2):
+            if maps.counts[row, j] >= 3:
+                _write_shape(maps.vertices[row, j], maps.counts[row, j], out[shapes_at:], j)
+
+
+@njit(**_JIT)
+def _write_shape(vertices: np.ndarray, count: int, out: np.ndarray, j: int) -> None:
+    """Region ``j``'s shape block (:data:`SHAPE_FEATURES`) into ``out``: from the second
+    moments of the polygon's area, its elongation (half the log of the ratio of the
+    principal moments, 0 for a round region, at most ``ELONGATION_LIMIT``) and its long
+    axis as (cos 2 theta, sin 2 theta) (an axis has no sign; (0, 0) when round).
+    Degenerate regions (no area) leave the block at zeros."""
+    origin = vertices[0]
+    area2 = sx = sy = sxx = syy = sxy = 0.0
+    for k in range(count):
+        p, q = vertices[k] - origin, vertices[(k + 1) % count] - origin
+        c = p.real * q.imag - q.real * p.imag
+        area2 += c
+        sx += c * (p.real + q.real)
+        sy += c * (p.imag + q.imag)
+        sxx += c * (p.real * p.real + p.real * q.real + q.real * q.real)
+        syy += c * (p.imag * p.imag + p.imag * q.imag + q.imag * q.imag)
+        cross_terms = p.real * q.imag + q.real * p.imag
+        sxy += c * (2.0 * p.real * p.imag + cross_terms + 2.0 * q.real * q.imag)
+    if not abs(area2) > 0.0:
+        return
+    # Central moments per unit area (the signs of a clockwise ring cancel).
+    cx, cy = sx / (3.0 * area2), sy / (3.0 * area2)
+    a = sxx / (6.0 * area2) - cx * cx
+    b = sxy / (12.0 * area2) - cx * cy
+    d = syy / (6.0 * area2) - cy * cy
+    half_difference = 0.5 * (a - d)
+    radius = math.sqrt(half_difference * half_difference + b * b)
+    mean = 0.5 * (a + d)
+    longest, shortest = mean + radius, mean - radius
+    at = _SHAPE_FEATURES * j
+    if not shortest > 0.0 or longest > shortest * math.exp(2.0 * ELONGATION_LIMIT):
+        out[at] = ELONGATION_LIMIT
+    else:
+        out[at] = 0.5 * math.log(longest / shortest)
+    if radius > 0.0:
+        out[at + 1] = half_difference / radius
+        out[at + 2] = b / radius
 
 
 @njit(**_JIT)
@@ -418,7 +471,8 @@ def _observe(rows: np.ndarray, inputs: Inputs, report: Report) -> None:
 @njit(**_JIT)
 def _observation_size(settings: Settings) -> int:
     slots = settings.n_slots
-    return _ROBOT_FEATURES + _LANDMARK_FEATURES * (slots - 2) + _BEARING_FEATURES * slots
+    size = _ROBOT_FEATURES + _LANDMARK_FEATURES * (slots - 2) + _BEARING_FEATURES * slots
+    return size + _SHAPE_FEATURES * (slots - 2) if settings.shape_features else size
 
 
 @njit(**_JIT)

@@ -11,6 +11,10 @@ Every observation starts as the flat vector (float32) that
 * :data:`ENTITIES` (``observation="entities"``): a ``Dict`` of the robot block and a
   landmark table, a row per slot with the columns :data:`ENTITY_FEATURES` (the same
   numbers, rearranged).
+* :data:`SHAPES` (``observation="shapes"``): the entity observation with three more
+  columns per row, :data:`SHAPE_FEATURES`: the shape of each landmark's region (how
+  elongated, along which axis). The kernels then write one more block per mapped slot at
+  the end of the flat vector.
 
 An env picks its spec once (:func:`spec_for`); the rest asks the spec.
 """
@@ -57,6 +61,18 @@ ENTITY_FEATURES: tuple[str, ...] = (
     "bearing_sin",
 )
 
+#: The shape of a landmark's region, in the ``"shapes"`` kind, from the second moments
+#: of its area: ``elongation`` is half the log of the ratio of the principal moments (the
+#: log of the axis ratio of the ellipse of the same moments: 0 when round, clipped to
+#: :data:`ELONGATION_LIMIT`), ``axis_cos2``/``axis_sin2`` the long axis's direction
+#: theta in FL as (cos 2 theta, sin 2 theta) (an axis has no sign; (0, 0) when round).
+#: Zeros for a landmark without a region yet (and for L1, L2).
+SHAPE_FEATURES: tuple[str, ...] = ("elongation", "axis_cos2", "axis_sin2")
+#: The elongation's upper bound (an axis ratio of e**10, about 22,000).
+ELONGATION_LIMIT = 10.0
+#: The landmark table's columns in the ``"shapes"`` kind.
+SHAPE_ENTITY_FEATURES: tuple[str, ...] = ENTITY_FEATURES + SHAPE_FEATURES
+
 #: FL coordinates in the observation are clipped to +-this (the frame is |L1 - L2| = 1, so
 #: this is 50 baselines away: far beyond any landmark of a sensible layout).
 FL_COORD_LIMIT = 50.0
@@ -90,6 +106,10 @@ class FlatObservation:
     """``observation="flat"``: the flat vector itself (see the module doc)."""
 
     kind: ClassVar[str] = "flat"
+
+    def flat_size(self, max_landmarks: int) -> int:
+        """Length of the flat vector the kernels write for this kind."""
+        return observation_size(max_landmarks)
 
     def space(self, config: EnvConfig) -> spaces.Space[Any]:
         """The Box of envs with ``config`` (the env's Observation Space section)."""
@@ -127,13 +147,18 @@ class EntityObservation:
     #: The landmark table's columns.
     features: ClassVar[tuple[str, ...]] = ENTITY_FEATURES
 
+    def flat_size(self, max_landmarks: int) -> int:
+        """Length of the flat vector the kernels write for this kind."""
+        return observation_size(max_landmarks)
+
     def space(self, config: EnvConfig) -> spaces.Space[Any]:
         """The flat space's bounds, rearranged as :meth:`convert` rearranges the values
         (each table column's bounds are its extremes over the slots)."""
         flat = FLAT.space(config)
         assert isinstance(flat, spaces.Box)
         slots = config.observations.max_landmarks
-        low, high = self.convert(flat.low, slots), self.convert(flat.high, slots)
+        convert = EntityObservation.convert  # the flat kind's vector, not a longer one
+        low, high = convert(self, flat.low, slots), convert(self, flat.high, slots)
         rows = (slots, len(ENTITY_FEATURES))
         table_low = np.minimum(low["landmarks"], high["landmarks"]).reshape(rows).min(axis=0)
         table_high = np.maximum(low["landmarks"], high["landmarks"]).reshape(rows).max(axis=0)
@@ -178,11 +203,57 @@ class EntityObservation:
         return {"robot": robot, "landmarks": table.reshape(*lead, -1)}
 
 
+class ShapeEntityObservation(EntityObservation):
+    """``observation="shapes"``: the entity observation, each row followed by its
+    region's shape (:data:`SHAPE_FEATURES`; see the module doc)."""
+
+    kind: ClassVar[str] = "shapes"
+    features: ClassVar[tuple[str, ...]] = SHAPE_ENTITY_FEATURES
+
+    def flat_size(self, max_landmarks: int) -> int:
+        return observation_size(max_landmarks) + len(SHAPE_FEATURES) * (max_landmarks - 2)
+
+    def space(self, config: EnvConfig) -> spaces.Space[Any]:
+        """The entity space with the shape columns' bounds: elongation in [0,
+        ELONGATION_LIMIT], the axis in [-1, 1]^2."""
+        entity = super().space(config)
+        assert isinstance(entity, spaces.Dict)
+        slots, width = config.observations.max_landmarks, len(ENTITY_FEATURES)
+        table = entity["landmarks"]
+        assert isinstance(table, spaces.Box)
+        shape_low = np.array([0.0, -1.0, -1.0], dtype=np.float32)
+        shape_high = np.array([ELONGATION_LIMIT, 1.0, 1.0], dtype=np.float32)
+        low = np.concatenate([table.low.reshape(slots, width), np.tile(shape_low, (slots, 1))], 1)
+        high = np.concatenate(
+            [table.high.reshape(slots, width), np.tile(shape_high, (slots, 1))], 1
+        )
+        return spaces.Dict(
+            {
+                "robot": entity["robot"],
+                "landmarks": spaces.Box(low.ravel(), high.ravel(), dtype=np.float32),
+            }
+        )
+
+    def convert(self, flat: NDArray[np.float32], max_landmarks: int) -> dict[str, Any]:
+        """The entity view of the flat vectors' first part, each table row followed by its
+        slot's shape block from the end of the vector (zeros for L1 and L2)."""
+        flat = np.asarray(flat, dtype=np.float32)
+        base = observation_size(max_landmarks)
+        entity = super().convert(flat[..., :base], max_landmarks)
+        lead = flat.shape[:-1]
+        table = entity["landmarks"].reshape(*lead, max_landmarks, len(ENTITY_FEATURES))
+        shapes = np.zeros((*lead, max_landmarks, len(SHAPE_FEATURES)), dtype=np.float32)
+        shapes[..., 2:, :] = flat[..., base:].reshape(*lead, max_landmarks - 2, -1)
+        entity["landmarks"] = np.concatenate([table, shapes], axis=-1).reshape(*lead, -1)
+        return entity
+
+
 FLAT = FlatObservation()
 ENTITIES = EntityObservation()
+SHAPES = ShapeEntityObservation()
 ObservationSpec = FlatObservation | EntityObservation
 #: The spec of each ``config.observations.observation`` kind.
-SPECS: dict[str, ObservationSpec] = {spec.kind: spec for spec in (FLAT, ENTITIES)}
+SPECS: dict[str, ObservationSpec] = {spec.kind: spec for spec in (FLAT, ENTITIES, SHAPES)}
 
 
 def spec_for(config: EnvConfig) -> ObservationSpec:

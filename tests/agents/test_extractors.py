@@ -22,6 +22,7 @@ from bearing_env.agents.extractors import (
     LandmarkAttentionPolicy,
     LandmarkSetExtractor,
     LandmarkSetPolicy,
+    table_width,
 )
 from bearing_env.envs.observations import ENTITY_FEATURES
 from bearing_env.train.sb3.train import train
@@ -33,11 +34,18 @@ HYPERPARAMS = REPO_ROOT / "train" / "sb3" / "hyperparams"
 CONF_FILE = HYPERPARAMS / "ppo_entities.yml"
 WIDTH = len(ENTITY_FEATURES)
 EXTRACTORS = (LandmarkSetExtractor, LandmarkAttentionExtractor)
-#: Each extractor's policy and shipped hyperparameter file.
+#: Each extractor's policy, shipped hyperparameter file and observation kind.
 CONFIGS = (
-    (LandmarkSetExtractor, LandmarkSetPolicy, HYPERPARAMS / "ppo_entities.yml"),
-    (LandmarkAttentionExtractor, LandmarkAttentionPolicy, HYPERPARAMS / "ppo_attention.yml"),
+    (LandmarkSetExtractor, LandmarkSetPolicy, HYPERPARAMS / "ppo_entities.yml", "entities"),
+    (
+        LandmarkAttentionExtractor,
+        LandmarkAttentionPolicy,
+        HYPERPARAMS / "ppo_attention.yml",
+        "entities",
+    ),
+    (LandmarkSetExtractor, LandmarkSetPolicy, HYPERPARAMS / "ppo_shapes.yml", "shapes"),
 )
+CONFIG_FIELDS = ("extractor_class", "policy_class", "conf_file", "kind")
 
 
 def entity_batch(max_landmarks: int, seeds: range) -> dict[str, torch.Tensor]:
@@ -87,6 +95,20 @@ def test_extractor_refuses_the_flat_observation(extractor_class: type) -> None:
         extractor_class(flat)
 
 
+@pytest.mark.parametrize("extractor_class", EXTRACTORS)
+@pytest.mark.parametrize(("kind", "told"), [("shapes", "entities"), ("entities", "shapes")])
+def test_extractor_refuses_a_table_of_another_kind(
+    extractor_class: type, kind: str, told: str
+) -> None:
+    # 8 slots: 88 shape values are also 11 rows of 8, so the row size alone would pass.
+    space = gym.make("BearingSLAM-v0", max_landmarks=8, observation=kind).observation_space
+    with pytest.raises(ValueError, match=f"not rows of {table_width(told)} columns"):
+        extractor_class(space, hidden=16, features_dim=8, observation=told)
+    with pytest.raises(ValueError, match=r"observation must be one of .*got 'flat'"):
+        extractor_class(space, hidden=16, features_dim=8, observation="flat")
+    extractor_class(space, hidden=16, features_dim=8, observation=kind)
+
+
 def test_attention_heads_must_divide_the_width() -> None:
     space = gym.make("BearingSLAM-v0", observation="entities").observation_space
     with pytest.raises(
@@ -105,20 +127,22 @@ def test_attention_features_of_an_empty_table_are_finite() -> None:
     assert torch.isfinite(features).all()
 
 
-@pytest.mark.parametrize(("extractor_class", "policy_class", "conf_file"), CONFIGS)
+@pytest.mark.parametrize(CONFIG_FIELDS, CONFIGS)
 def test_the_entities_configs_name_their_policy_class(
-    extractor_class: type, policy_class: type, conf_file: Path
+    extractor_class: type, policy_class: type, conf_file: Path, kind: str
 ) -> None:
     raw = read_hyperparameters("ppo", "BearingSLAM-v0", conf_file)
     parsed = parse_hyperparameters(raw)
     assert parsed.algorithm_kwargs["policy"] is policy_class
-    assert parsed.env_kwargs["observation"] == "entities"
+    assert parsed.env_kwargs["observation"] == kind
+    extractor_kwargs = parsed.algorithm_kwargs["policy_kwargs"]["features_extractor_kwargs"]
+    assert extractor_kwargs.get("observation", "entities") == kind
     assert parsed.normalize is not None and parsed.normalize["norm_obs_keys"] == ["robot"]
 
 
-@pytest.mark.parametrize(("extractor_class", "policy_class", "conf_file"), CONFIGS)
+@pytest.mark.parametrize(CONFIG_FIELDS, CONFIGS)
 def test_a_tiny_run_trains_and_its_model_plays_other_landmark_counts(
-    tmp_path: Path, extractor_class: type, policy_class: type, conf_file: Path
+    tmp_path: Path, extractor_class: type, policy_class: type, conf_file: Path, kind: str
 ) -> None:
     settings = tiny_settings(
         "ppo",
@@ -129,7 +153,8 @@ def test_a_tiny_run_trains_and_its_model_plays_other_landmark_counts(
             "n_steps": 64,
             "batch_size": 64,
             "n_epochs": 2,
-            "policy_kwargs": "dict(features_extractor_kwargs=dict(hidden=16, features_dim=16))",
+            "policy_kwargs": "dict(features_extractor_kwargs=dict(hidden=16, features_dim=16, "
+            f"observation={kind!r}))",
         },
     )
     result = train(settings)
@@ -140,7 +165,7 @@ def test_a_tiny_run_trains_and_its_model_plays_other_landmark_counts(
             "BearingSLAM-v0",
             n_landmarks=count,
             max_landmarks=16,
-            observation="entities",
+            observation=kind,
             max_moves=4,
             max_episode_steps=4,
         )

@@ -170,7 +170,7 @@ def test_generalisation_gives_a_set_policy_the_slots_a_count_needs() -> None:
 
 def test_models_trained_on_other_counts_share_the_studys_envs() -> None:
     from bearing_env.agents.model_task import ModelTask
-    from bearing_env.train.studies.generalisation import StudyModel, study_envs
+    from bearing_env.train.studies.generalisation import StudyModel, baseline_envs, study_envs
 
     def model(**kwargs: object) -> StudyModel:
         trained = {"scenario": "random", "max_landmarks": 16, "observation": "entities", **kwargs}
@@ -181,5 +181,12 @@ def test_models_trained_on_other_counts_share_the_studys_envs() -> None:
     assert study_envs(narrow, counts) == study_envs(wide, counts)  # the count is replaced
     assert study_envs(wide, counts)[2]["max_landmarks"] == 24
     assert study_envs(model(n_landmarks=[3, 12], max_landmarks=12), counts) != study_envs(
+        narrow, counts
+    )
+    # The baselines' episodes do not depend on the observation kind.
+    shapes = model(n_landmarks=[3, 16], observation="shapes")
+    assert study_envs(shapes, counts) != study_envs(wide, counts)
+    assert baseline_envs(shapes, counts) == baseline_envs(wide, counts)
+    assert baseline_envs(model(n_landmarks=[3, 12], max_landmarks=12), counts) != baseline_envs(
         narrow, counts
     )

@@ -130,7 +130,7 @@ def test_make_by_module_prefixed_id_without_importing_first() -> None:
 
 
 @needs("render")
-@pytest.mark.parametrize("observation", ["flat", "entities"])
+@pytest.mark.parametrize("observation", ["flat", "entities", "shapes"])
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_gymnasium_check_env_without_warnings(env_id: str, observation: str) -> None:
     env = gym.make(env_id, observation=observation)
@@ -142,7 +142,7 @@ def test_gymnasium_check_env_without_warnings(env_id: str, observation: str) -> 
 
 @needs("train", "stable_baselines3", "torch")
 @needs("render")
-@pytest.mark.parametrize("observation", ["flat", "entities"])
+@pytest.mark.parametrize("observation", ["flat", "entities", "shapes"])
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_sb3_check_env_without_warnings(env_id: str, observation: str) -> None:
     from stable_baselines3.common.env_checker import check_env as sb3_check_env

@@ -120,6 +120,7 @@ def observation_text(config: Any, space: Any) -> str:
         ENTITY_FEATURES,
         LANDMARK_FEATURES,
         ROBOT_FEATURES,
+        SHAPE_ENTITY_FEATURES,
     )
 
     m = config.max_landmarks
@@ -128,11 +129,12 @@ def observation_text(config: Any, space: Any) -> str:
         "log-area and heading in the landmark frame FL, where L1 = (0, 0) and L2 = (1, 0), "
         "the progress through the episode and flags of the last move)"
     )
-    if config.observation == "entities":
+    if config.observation in ("entities", "shapes"):
+        columns = ENTITY_FEATURES if config.observation == "entities" else SHAPE_ENTITY_FEATURES
         layout = (
             f'a `Dict` of {robot} under `"robot"` and a landmark table under '
-            f'`"landmarks"`, {m} rows of {len(ENTITY_FEATURES)} columns '
-            f"({', '.join(ENTITY_FEATURES)}), flattened"
+            f'`"landmarks"`, {m} rows of {len(columns)} columns '
+            f"({', '.join(columns)}), flattened"
         )
     else:
         layout = (

@@ -17,7 +17,8 @@ model's training range shaded.
 A model is a shipped one by name, or a ``.zip`` that ``bearing-env train --export`` wrote
 (its ``.json`` record beside it gives its task), labelled by its file name. When a model
 runs on the same envs as the first (its training env kwargs give the same env at every
-count), the baselines are not run again: its tables and plot reuse the first model's.
+count, whatever its observation kind), the baselines are not run again: its tables and
+plot reuse the first model's.
 
 The total area is summed over the mapped landmarks (L3, L4, ...), so it grows with the
 count; compare policies within a column. Every count runs with the env kwargs the model
@@ -107,6 +108,16 @@ def study_envs(model: StudyModel, counts: Sequence[int]) -> list[dict[str, Any]]
     trained = model.task.env_kwargs
     slots = EnvConfig.create(**trained).observations.max_landmarks
     return [env_kwargs_for_count(trained, count, slots) for count in counts]
+
+
+def baseline_envs(model: StudyModel, counts: Sequence[int]) -> list[dict[str, Any]]:
+    """:func:`study_envs` as the baselines see them: without the observation kind, which
+    changes how an observation is laid out, not the episodes (the planners act on the
+    robot's map and the bearings, the same numbers in every kind)."""
+    return [
+        {key: value for key, value in kwargs.items() if key != "observation"}
+        for kwargs in study_envs(model, counts)
+    ]
 
 
 class StudySettings(NamedTuple):
@@ -311,7 +322,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         # reuses its baselines.
         first = models[0]
         baselines = None
-        if index > 0 and study_envs(model, study.counts) == study_envs(first, study.counts):
+        if index > 0 and baseline_envs(model, study.counts) == baseline_envs(first, study.counts):
             baselines = {
                 count: {label: row[label] for label in row if label != first.label}
                 for count, row in results[first.label].items()
