@@ -78,8 +78,11 @@ LANDMARK_CODE = {name: code for code, name in enumerate(LANDMARK_STATUSES)}
 
 
 #: Batches of at least this many maps are updated on all of numba's threads
-#: (``NUMBA_NUM_THREADS``; see :func:`bearing_env.slam.kernels.threads`).
-PARALLEL_MIN_MAPS = 8
+#: (``NUMBA_NUM_THREADS``; see :func:`bearing_env.slam.kernels.threads`). Below it, handing
+#: the work to the threads costs more than it saves: on the 2-core development VM, a
+#: 16-env batched step took 65 against 46 us per sub-env (two threads against one, best of
+#: five rounds), level at 32-48 envs, and 9-12% faster from 64 envs.
+PARALLEL_MIN_MAPS = 32
 
 #: How far outside a region a point may lie and still count as inside, relative to the
 #: region's size: far above rounding, far below any bearing error.

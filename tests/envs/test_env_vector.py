@@ -127,6 +127,20 @@ def test_many_landmarks_reproduce_the_single_env_exactly() -> None:
         assert_same(batched.step(actions), reference.step(actions))
 
 
+def test_a_batch_large_enough_for_the_threads_matches_single_envs() -> None:
+    from bearing_env.slam.batch import PARALLEL_MIN_MAPS
+
+    # The map update is split over numba's threads from this size (when it has two).
+    batched, reference = make_pair(
+        "BearingSLAM-v0", PARALLEL_MIN_MAPS, AutoresetMode.NEXT_STEP, scenario="khepera"
+    )
+    assert_same(batched.reset(seed=11), reference.reset(seed=11))
+    batched.action_space.seed(11)
+    for _ in range(4):
+        actions = batched.action_space.sample()
+        assert_same(batched.step(actions), reference.step(actions))
+
+
 def test_landmark_count_ranges_match_single_envs_with_padded_infos() -> None:
     n, slots = 4, 8
     batched = gym.make_vec(
