@@ -160,6 +160,13 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--seed 0 --eval-freq 100000 --output runs/ppo_generalist": ("parse", ()),
     'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_attention)" '
     "--seed 0 --eval-freq 100000 --output runs/ppo_attention": ("parse", ()),
+    'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_shapes)" '
+    "--seed 0 --eval-freq 100000 --output runs/ppo_shapes": ("parse", ()),
+    "bearing-env train --algo ppo --output runs/ppo_shapes --export "
+    "runs/exported/ppo_shapes --export-only": ("parse", ()),
+    "python -m bearing_env.train.studies.generalisation --model ppo_generalist "
+    "runs/exported/ppo_shapes.zip --counts 3 8 12 16 --episodes 200 "
+    "--out outputs/generalisation_shapes": ("parse", ()),
     "bearing-env train --algo ppo --output runs/ppo_generalist --export "
     "agents/pretrained/ppo_generalist --export-only": ("parse", ()),
     "python -m bearing_env.train.studies.generalisation --model ppo_generalist "
