@@ -431,11 +431,11 @@ def step(
     threads = slam_kernels.threads() if rows.size >= PARALLEL_MIN_MAPS else 1
     report, encoded = _outputs(group, rows.size)
     while True:
+        # The trajectory array is replaced when it grows: read it on every try.
+        args = (rows, turns, lengths, inputs, state.trajectory, threads, report)
         if encoded is not None:
-            args = (rows, turns, lengths, inputs, state.trajectory, threads, report)
             status = _call(group, kernels.step_rows, (*args, encoded.kernel))
         else:
-            args = (rows, turns, lengths, inputs, state.trajectory, threads, report)
             status = _call(group, kernels.step_rows_bare, args)
         if status == kernels.STEP_DONE:
             return report, _robot_map_of(group, encoded)
