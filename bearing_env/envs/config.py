@@ -123,8 +123,9 @@ MAX_ACTION_TABLE = 4096
 
 
 REWARDS: tuple[str, ...] = ("log_area", "area")
-#: Observation kinds: the flat Box (default) or a Dict of a robot block and a landmark
-#: table (``bearing_env.envs.observations.EntityObservation``).
+#: Observation kinds: the flat Box (default), or a Dict of a robot block and a landmark
+#: table (``bearing_env.envs.observations.EntityObservation``), with each region's shape
+#: in ``"shapes"`` (``ShapeEntityObservation``).
 OBSERVATIONS: tuple[str, ...] = ("flat", "entities", "shapes")
 
 #: Why a setting cannot change on a live env: it fixes the observation space.
