@@ -507,28 +507,32 @@ def report(state: BatchState, group: Group) -> tuple[kernels.Report, dict[str, A
 
 
 def _robot_map(group: Group, encoded: tuple[Any, ...] | None) -> dict[str, Any] | None:
-    """The ``robot_map`` info from :func:`robot_map.encode_map`'s arrays, with the relaxed
-    fusion's window and bases or the robust fusion's levels (one more compiled call);
-    None when the setting is off."""
+    """The ``robot_map`` info from :func:`robot_map.encode_map`'s new arrays (after a
+    reset); None when the setting is off."""
     if encoded is None or not group.config.observations.robot_map_info:
         return None
-    return _robot_map_of(group, robot_map.buffers(encoded))
+    return _with_fusion_arrays(group, robot_map.as_info(robot_map.MAP_ARRAYS, encoded))
 
 
 def _robot_map_of(group: Group, encoded: robot_map.Buffers | None) -> dict[str, Any] | None:
-    """:func:`_robot_map` from the step's reused arrays (views of them)."""
-    if encoded is None:
-        return None
+    """The ``robot_map`` info from the step's reused arrays (views of them); None when the
+    setting is off."""
+    return None if encoded is None else _with_fusion_arrays(group, dict(encoded.info))
+
+
+def _with_fusion_arrays(group: Group, info: dict[str, Any]) -> dict[str, Any]:
+    """``info`` (every fusion's arrays) with the relaxed fusion's window and bases or the
+    robust fusion's levels (one more compiled call)."""
     batch = group.batch
     if batch.fusion == "intersect":
-        return dict(encoded.info)
+        return info
     slots = max(group.config.observations.max_landmarks - 2, group.n - 2)
     if batch.fusion == "relaxed":
         more = robot_map.encode_window(batch._kernel_state(), group.rows, slots)
     else:
         more = robot_map.encode_levels(batch._kernel_state(), group.rows, slots)
     names = batch.state_names[len(robot_map.MAP_ARRAYS) :]
-    return {**encoded.info, **robot_map.as_info(names, more)}
+    return {**info, **robot_map.as_info(names, more)}
 
 
 # ----------------------------------------------------------------------------------------
