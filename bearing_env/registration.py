@@ -8,14 +8,15 @@ cheap: the environment modules load on first make.
 Besides the two base ids (one per action kind), every task of :mod:`bearing_env.tasks`
 (``BearingSLAM-Khepera-v0``, ``BearingSLAM-Random8-v0``, ...) is registered as its own id:
 its base id's env and vector env with the task's settings as ``kwargs``, as Minigrid
-registers its variants.
+registers its variants; so is every training task (``BearingSLAM-Random3to16-Entities-v0``,
+the id ``ppo_entities.yml`` is keyed by).
 """
 
 from __future__ import annotations
 
 import gymnasium as gym
 
-from bearing_env.tasks import TASKS
+from bearing_env.tasks import TASKS, TRAINING_TASKS
 
 #: The registered ids and their entry points. They register ``max_episode_steps=None``:
 #: the envs' own ``max_moves`` is the one episode cap (a registered TimeLimit would cut
@@ -36,7 +37,7 @@ def register_envs() -> None:
     """Register the bearing_env ids and the task ids; safe to call more than once."""
     for env_id, entry_point in ENV_IDS.items():
         _register(env_id, entry_point, VECTOR_ENTRY_POINTS[env_id], {})
-    for task in TASKS:
+    for task in (*TASKS, *TRAINING_TASKS):
         base = task.base_id
         _register(task.id, ENV_IDS[base], VECTOR_ENTRY_POINTS[base], task.kwargs())
 

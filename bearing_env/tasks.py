@@ -22,18 +22,24 @@ from typing import Any
 
 #: How the task ids are formed (Markdown; the task index quotes it).
 NAMING_RULE = """\
-`<kind>-<setting>[-<sensor>][-<fault>]-v<version>`:
+`<kind>-<setting>[-<sensor>][-<fault>][-<observation>]-v<version>`:
 
 - `kind` is the base id's name: `BearingSLAM` (continuous actions) or
   `BearingSLAMDiscrete` (the discrete action grid);
 - `setting` names the layout: `Khepera` (the paper's real arena, fixed landmarks),
-  `Random<N>` (a new random layout of N landmarks every episode, on the Khepera field)
+  `Random<N>` (a new random layout of N landmarks every episode, on the Khepera field;
+  `Random<A>to<B>`: a count drawn from A to B every episode, `max_landmarks` = B)
   or `FurnishedRoom` (a room whose furniture blocks motion and sight, fixed landmarks);
 - `sensor` names a camera narrower than the paper's panoramic one: `Camera<D>` (a
   forward field of view of D degrees about the move's direction);
-- `fault` names a sensor that breaks the paper's assumptions, mapped with the robust
-  fusion (`fusion="relaxed"`): `Outliers` (some bearings replaced by random angles) or
-  `Missed` (some landmarks not detected in a reading);
+- `fault` names a sensor that breaks the paper's assumptions, mapped with the relaxed
+  fusion (`fusion="relaxed"`, which tolerates `max_outliers` contradicting readings):
+  `Outliers` (some bearings replaced by random angles) or `Missed` (some landmarks not
+  detected in a reading);
+- `observation` names an observation other than the flat vector: `Entities` (the landmark
+  table, `observation="entities"`) or `Shapes` (the table with each region's shape,
+  `observation="shapes"`); such an id is what an rl-zoo3 hyperparameter file is keyed by,
+  so that its training and evaluation envs have the same observation space;
 - `version` starts at 0 and goes up whenever a change alters what an agent faces (the
   task's settings, an env default it relies on, the dynamics or the reward), so scores
   reported under one id stay comparable.
@@ -69,6 +75,9 @@ class Task:
     # Hashed by the rest (a mapping has no hash); compared all the same.
     settings: Mapping[str, Any] = field(hash=False)
     description: str = ""
+    #: What each version changed, one line each, oldest first (the cards' "Version
+    #: history").
+    history: tuple[str, ...] = ("v0: the first version (bearing_env 0.1.0).",)
 
     def __post_init__(self) -> None:
         if self.base_id not in BASE_IDS.values():
@@ -134,13 +143,13 @@ TASKS: tuple[Task, ...] = (
         id="BearingSLAM-Khepera-Outliers-v0",
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "khepera", "noise": OUTLIER_NOISE, "fusion": "relaxed"},
-        description="Khepera arena, 5% of bearings replaced by random angles, robust fusion",
+        description="Khepera arena, 5% of bearings replaced by random angles, relaxed fusion",
     ),
     Task(
         id="BearingSLAM-Khepera-Missed-v0",
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "khepera", "noise": MISSED_NOISE, "fusion": "relaxed"},
-        description="Khepera arena, each landmark missed in 20% of readings, robust fusion",
+        description="Khepera arena, each landmark missed in 20% of readings, relaxed fusion",
     ),
     _camera(90),
     _camera(180),
@@ -155,6 +164,32 @@ TASKS: tuple[Task, ...] = (
 
 #: The tasks by id.
 TASKS_BY_ID: dict[str, Task] = {task.id: task for task in TASKS}
+
+
+def _random_table(observation: str) -> Task:
+    return Task(
+        id=f"BearingSLAM-Random3to16-{observation.capitalize()}-v0",
+        base_id=BASE_IDS["continuous"],
+        settings={
+            "scenario": "random",
+            "n_landmarks": [3, 16],
+            "max_landmarks": 16,
+            "observation": observation,
+        },
+        description=f"a new random layout of 3 to 16 landmarks every episode, the "
+        f'`"{observation}"` observation (a landmark table, for set and attention policies)',
+    )
+
+
+#: The training tasks: registered like :data:`TASKS`, the ids the shipped rl-zoo3 files
+#: are keyed by when their observation is not the flat vector (rl-zoo3 builds its
+#: evaluation env from the id alone); the suite does not card them.
+TRAINING_TASKS: tuple[Task, ...] = (_random_table("entities"), _random_table("shapes"))
+
+#: Every registered task by id: :data:`TASKS` and :data:`TRAINING_TASKS`.
+REGISTERED_TASKS_BY_ID: dict[str, Task] = {
+    task.id: task for task in (*TASKS, *TRAINING_TASKS)
+}
 
 
 def task_named(task_id: str) -> Task:

@@ -26,7 +26,7 @@ from bearing_env.agents.extractors import (
 )
 from bearing_env.envs.observations import ENTITY_FEATURES
 from bearing_env.train.sb3.train import train
-from bearing_env.train.sb3.zoo import parse_hyperparameters, read_hyperparameters
+from bearing_env.train.sb3.zoo import default_env_id, parse_hyperparameters, read_hyperparameters
 from tests.tools.test_train import TINY_TIMESTEPS, tiny_settings
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -131,10 +131,11 @@ def test_attention_features_of_an_empty_table_are_finite() -> None:
 def test_the_entities_configs_name_their_policy_class(
     extractor_class: type, policy_class: type, conf_file: Path, kind: str
 ) -> None:
-    raw = read_hyperparameters("ppo", "BearingSLAM-v0", conf_file)
+    env_id = default_env_id("ppo", conf_file)  # the entry's key: a task id of that observation
+    raw = read_hyperparameters("ppo", env_id, conf_file)
     parsed = parse_hyperparameters(raw)
     assert parsed.algorithm_kwargs["policy"] is policy_class
-    assert parsed.env_kwargs["observation"] == kind
+    assert gym.spec(env_id).kwargs["observation"] == kind
     extractor_kwargs = parsed.algorithm_kwargs["policy_kwargs"]["features_extractor_kwargs"]
     assert extractor_kwargs.get("observation", "entities") == kind
     assert parsed.normalize is not None and parsed.normalize["norm_obs_keys"] == ["robot"]
@@ -147,7 +148,7 @@ def test_a_tiny_run_trains_and_its_model_plays_other_landmark_counts(
     settings = tiny_settings(
         "ppo",
         tmp_path / "run",
-        env_id="BearingSLAM-v0",
+        env_id=default_env_id("ppo", conf_file),
         conf_file=conf_file,
         hyperparam_overrides={
             "n_steps": 64,

@@ -13,7 +13,11 @@ env rl-zoo3 builds: the training envs are the YAML entry's ``env_kwargs``, and t
 evaluation env (and ``enjoy``'s env) has exactly the training envs' settings. rl-zoo3
 gives a YAML's ``env_kwargs`` to its training envs only, so a command without
 ``--eval-env-kwargs`` evaluates on the defaults (``scenario="random"``) and fails here,
-as the ``ppo_entities`` command did (``norm_obs_keys`` on a Box observation).
+as the ``ppo_entities`` command did (``norm_obs_keys`` on a Box observation). A file
+keyed by a task id (``ppo_entities.yml``: ``BearingSLAM-Random3to16-Entities-v0``) needs
+no such flag: rl-zoo3 makes the evaluation env from the id, whose kwargs carry the
+settings; :func:`test_the_plain_command_trains_and_evaluates_each_task_keyed_file` runs
+that plain form for every such shipped file, whatever the docs show.
 
 The ``ppo`` and ``ppo_entities`` runs and ``enjoy`` are in the default run; the other
 algorithms' commands are ``slow``.
@@ -180,6 +184,8 @@ COMMANDS = documented_commands()
 def test_the_docs_show_the_zoo_commands_this_test_must_run() -> None:
     labels = {command.label for command in COMMANDS}
     assert {"train-ppo-ppo", "train-ppo-ppo_entities", "enjoy-ppo-BearingSLAM-v0"} <= labels
+    entities = [c for c in COMMANDS if c.label == "train-ppo-ppo_entities"]
+    assert entities and all("--eval-env-kwargs" not in c.argv for c in entities)
     text = (
         "Train:\n\n```bash\npython -m rl_zoo3.train --algo ppo \\\n    --env E  # why\n```\n"
         "or `python -m rl_zoo3.enjoy --algo ppo --env E`.\n"
@@ -258,11 +264,17 @@ def zoo_runs(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ZooRuns]:
 
 
 def yaml_env_kwargs(command: DocumentedCommand) -> dict[str, object]:
-    """The ``env_kwargs`` of the shipped YAML entry the command trains with."""
+    """The settings of the env the command trains on: the registered id's kwargs, then
+    the ``env_kwargs`` of the shipped YAML entry the command trains with."""
+    import gymnasium as gym
+
+    import bearing_env  # noqa: F401  (registers the ids)
+
     conf = re.fullmatch(r"\$\(bearing-env hyperparams (\w+)\)", command.option("--conf-file"))
     assert conf is not None, "the docs name a shipped file: $(bearing-env hyperparams NAME)"
     entries = yaml.safe_load(default_conf_file(conf.group(1)).read_text())
-    return dict(entries[hyperparams_key(command.option("--env"))].get("env_kwargs") or {})
+    key = hyperparams_key(command.option("--env"))
+    return {**gym.spec(key).kwargs, **(entries[key].get("env_kwargs") or {})}
 
 
 def _marks(command: DocumentedCommand) -> list[pytest.MarkDecorator]:
@@ -311,3 +323,37 @@ def test_a_documented_enjoy_command_plays_the_trained_model_on_its_task(
     run = run_in(trained.folder, command.command, extra)
     assert run.envs["enjoy"] == trained.envs["train"][:1]
     assert "Episode Reward" in run.output  # a whole episode was played
+
+
+#: The shipped files whose entries are keyed by a task id (its kwargs carry the settings).
+TASK_KEYED_FILES = ("ppo_entities", "ppo_attention", "ppo_shapes")
+
+
+def plain_command(name: str) -> DocumentedCommand:
+    """rl-zoo3's plain command for a shipped file: its entry's id, no other flag."""
+    entries = yaml.safe_load(default_conf_file(name).read_text())
+    (env_id,) = entries
+    return DocumentedCommand(
+        f"python -m rl_zoo3.train --algo ppo --env {env_id} --gym-packages bearing_env "
+        f'--conf-file "$(bearing-env hyperparams {name})"',
+        f"train/sb3/hyperparams/{name}.yml",
+    )
+
+
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(n, marks=[] if n == "ppo_entities" else [pytest.mark.slow])
+     for n in TASK_KEYED_FILES],
+)
+def test_the_plain_command_trains_and_evaluates_each_task_keyed_file(
+    name: str, zoo_runs: ZooRuns
+) -> None:
+    """The entry has no ``env_kwargs`` of its own, so nothing differs between the training
+    envs and the evaluation env rl-zoo3 makes from the id."""
+    entries = yaml.safe_load(default_conf_file(name).read_text())
+    (entry,) = entries.values()
+    assert "env_kwargs" not in entry
+    command = plain_command(name)
+    test_a_documented_training_command_evaluates_on_its_training_task(command, zoo_runs)
+    run = zoo_runs.train(command)
+    assert "ValueError" not in run.output

@@ -68,7 +68,7 @@ from typing import Any
 
 from bearing_env.agents.model_task import ModelTask, TaskMismatchError, setting_differences
 from bearing_env.extras import DISTRIBUTIONS, install_command
-from bearing_env.tasks import TASKS_BY_ID
+from bearing_env.tasks import REGISTERED_TASKS_BY_ID
 from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import (
     COUNT,
@@ -318,7 +318,7 @@ def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
     registered_env_id(args.env)
     # A task id carries its own settings (scenario included): the Khepera default is
     # for the base ids only, or it would silently replace a task's arena.
-    is_task = args.env.rpartition(":")[2] in TASKS_BY_ID
+    is_task = args.env.rpartition(":")[2] in REGISTERED_TASKS_BY_ID
     env_id, env_kwargs = args.env, {} if is_task else dict(DEFAULT_ENV_KWARGS)
     task = None if args.env_kwargs is not None else models_task(args.policies or [])
     if args.env_kwargs is not None:

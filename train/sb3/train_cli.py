@@ -38,7 +38,7 @@ from bearing_env.train.sb3.train import (
     train,
 )
 from bearing_env.train.sb3.training_envs import VEC_ENV_CHOICES
-from bearing_env.train.sb3.zoo import DEFAULT_ENV_IDS, hyperparams_key
+from bearing_env.train.sb3.zoo import DEFAULT_ENV_IDS, default_env_id, hyperparams_key
 
 #: How ``--init-from`` names a shipped model.
 PRETRAINED_PREFIX = "pretrained:"
@@ -188,7 +188,7 @@ def default_output(algo: str, env_id: str, seed: int) -> Path:
 
 
 def settings_from_args(args: argparse.Namespace) -> TrainSettings:
-    env_id = registered_env_id(args.env or DEFAULT_ENV_IDS[args.algo])
+    env_id = registered_env_id(args.env or default_env_id(args.algo, args.conf_file))
     return TrainSettings(
         algo=args.algo,
         env_id=env_id,
@@ -234,7 +234,7 @@ def init_model_path(spec: str | None, option: str = "--init-from") -> Path | Non
 
 def _output_of(args: argparse.Namespace) -> Path:
     """The run folder the arguments name (``--output`` or its default)."""
-    env_id = args.env or DEFAULT_ENV_IDS[args.algo]
+    env_id = args.env or default_env_id(args.algo, args.conf_file)
     return Path(args.output or default_output(args.algo, env_id, args.seed))
 
 

@@ -105,6 +105,23 @@ def rl_zoo3_module(name: str) -> ModuleType:
                 setattr(module, attribute, value)
 
 
+def default_env_id(algo: str, conf_file: Path | None = None) -> str:
+    """The env id a run trains on when ``--env`` is not given: the one entry's key of a
+    hyperparameter file with a single entry (``ppo_entities.yml``:
+    ``BearingSLAM-Random3to16-Entities-v0``), else the algorithm's default
+    (:data:`DEFAULT_ENV_IDS`)."""
+    if conf_file is not None and conf_file.is_file():
+        import yaml
+
+        try:
+            entries = yaml.safe_load(conf_file.read_text(encoding="utf-8"))
+        except yaml.YAMLError:
+            entries = None  # read_hyperparameters says what is wrong with it
+        if isinstance(entries, dict) and len(entries) == 1:
+            return str(next(iter(entries)))
+    return DEFAULT_ENV_IDS[algo]
+
+
 def hyperparams_key(env_id: str) -> str:
     """The file key of an env id: ``bearing_env:BearingSLAM-v0`` -> ``BearingSLAM-v0``."""
     return env_id.split(":")[-1]
