@@ -172,7 +172,30 @@ def machine_info() -> dict[str, Any]:
     for module in ("torch", "stable_baselines3"):
         if module in sys.modules:
             info[module] = getattr(sys.modules[module], "__version__", None)
+    info["commit"] = source_commit()
     return info
+
+
+def source_commit() -> str | None:
+    """The git commit of the code measured (its checkout's HEAD, with ``+changes`` when
+    the working tree differs from it), or None outside a git checkout."""
+    import subprocess
+
+    folder = Path(bearing_env.__file__).resolve().parent
+    try:
+        head = subprocess.run(
+            ["git", "rev-parse", "HEAD"], cwd=folder, capture_output=True, text=True, check=True
+        ).stdout.strip()
+        changes = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no"],
+            cwd=folder,
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return f"{head}+changes" if changes else head
 
 
 def _finite(value: Any) -> Any:
@@ -476,3 +499,125 @@ def print_table(results: dict[str, Any]) -> None:
     print(format_table(results))
 
 
+
+
+# --------------------------------------------------------------------------------------
+# Markdown for the docs (``bearing-env docs-tables`` writes the performance page's tables
+# from the results file with these)
+# --------------------------------------------------------------------------------------
+
+#: What each goal is about, in the docs' words (the goals' ids stay internal).
+GOAL_NAMES: dict[str, str] = {
+    "a": "single env, Khepera, `env.step`",
+    "b": "batched vector env, 64 Khepera sub-envs",
+    "i": "batched vector env, 256 Khepera sub-envs",
+    "c": "single env, 64 landmarks ÷ 4 landmarks",
+    "d": "PPO on the batched env ÷ PPO on `SubprocVecEnv` (16 envs)",
+    "e": "`PolygonSLAM.update`, 4 landmarks, conservative",
+    "f": "first env step in a fresh process, warm cache",
+    "g": "`GreedyOneStep` planning per move (median)",
+    "h": "PPO on the batched env ÷ PPO on CartPole-v1 (16 envs)",
+    "j": "first env step in a fresh process, empty cache",
+}
+
+
+def _goal_figures(target: dict[str, Any]) -> tuple[str, str]:
+    """The measured value and the goal of a target, as the docs write them."""
+    key, value, threshold = target["id"], target["value"], target["threshold"]
+    if key in ("a", "b", "e", "i"):
+        shown = "-" if value is None else f"{value:.1%} of CartPole-v1"
+        goal = f"≥ {threshold:.0%}"
+    elif key == "c":
+        shown, goal = ("-" if value is None else f"{value:.3f}"), f"≥ {threshold:.4f} (1/16)"
+    elif key in ("f", "j"):
+        shown, goal = ("-" if value is None else f"{value:.2f} s"), f"≤ {threshold:g} s"
+    elif key == "g":
+        shown = "-" if value is None else f"{value * 1e3:.2f} ms"
+        goal = f"≤ {threshold * 1e3:g} ms"
+    else:
+        shown, goal = ("-" if value is None else f"{value:.2f}x"), f"≥ {threshold:g}x"
+    return shown, goal
+
+
+def markdown_machine(results: dict[str, Any]) -> str:
+    """Where, when and on what code the results were measured, and the command."""
+    machine = results["machine"]
+    commit = machine.get("commit")
+    code = (
+        f"commit `{commit[:7]}{'+changes' if commit.endswith('+changes') else ''}`"
+        if commit
+        else f"bearing_env {machine['bearing_env']}"
+    )
+    sections = ",".join(results["settings"]["sections"])
+    return (
+        f"Measured by `bearing-env bench --sections {sections}` "
+        f"({results['settings']['seconds']:g} s per figure) on {results['started'][:10]}, "
+        f"{code}, on a {machine['cpu_count']}-core {machine['processor']} machine "
+        f"(`{machine['platform']}`, Python {machine['python']}, numpy {machine['numpy']}, "
+        f"Gymnasium {machine['gymnasium']}); file `benchmarks/results/bench_env.json`. "
+        "CartPole-v1's `env.step` measured in the same run: "
+        + ", ".join(
+            f"{ref['steps_per_s']:,.0f}" for ref in results["cartpole_references"]
+        )
+        + " steps/s."
+    )
+
+
+def markdown_goals(results: dict[str, Any]) -> str:
+    """The goals each figure is held to, with what the results file measured."""
+    order = ("a", "b", "i", "c", "e", "f", "j", "g", "d", "h")
+    by_id = {target["id"]: target for target in evaluate_targets(results)}
+    rows = []
+    for key in order:
+        target = by_id[key]
+        shown, goal = _goal_figures(target)
+        met = "-" if target["met"] is None else ("yes" if target["met"] else "**no**")
+        rows.append((GOAL_NAMES[key], shown, goal, met))
+    return _markdown(("what", "measured", "goal", "met"), rows)
+
+
+def markdown_env_table(results: dict[str, Any]) -> str:
+    """Every env, vector env, world-model and PPO figure of the results file."""
+    rows = [
+        (section, case, steps, share, relative)
+        for section, case, steps, share, _, _, relative in table_rows(results)
+    ]
+    return _markdown(("section", "case", "steps/s", "% of CartPole-v1", "relative"), rows)
+
+
+def markdown_startup(results: dict[str, Any]) -> str:
+    """The start-up and planning figures (the one place the compile time is stated)."""
+    lines = []
+    startup = results.get("startup")
+    if startup is not None:
+        warm = " / ".join(f"{t:.2f}" for t in startup["warm_runs_s"])
+        lines.append(
+            f"- First env step in a fresh process, compiling the core from an empty numba "
+            f"cache: {startup['cold_first_step_s']:.1f} s (once per machine and version; "
+            "numba caches the result)."
+        )
+        lines.append(
+            f"- The same with the cache warm: {startup['warm_first_step_s']:.2f} s "
+            f"(median of {warm} s)."
+        )
+    planning = results.get("planning")
+    if planning is not None:
+        lines.append(
+            f"- `GreedyOneStep.act`: {planning['median_s'] * 1e3:.2f} ms per move (median of "
+            f"{planning['moves']} moves; mean {planning['mean_s'] * 1e3:.2f} ms, "
+            f"90th percentile {planning['p90_s'] * 1e3:.2f} ms)."
+        )
+    return "\n".join(lines)
+
+
+def markdown_throughput(results: dict[str, Any]) -> str:
+    """The throughput section in EnvPool's and gymnax's format."""
+    section = results["throughput"]
+    header = ("sub-envs", "CartPole-v1 steps/s", "BearingSLAM-v0 steps/s", "ratio")
+    return _markdown(header, throughput_rows(section))
+
+
+def _markdown(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(row) + " |" for row in rows]
+    return "\n".join(lines)

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from bearing_env.tasks import TASKS, TASKS_BY_ID, Task, task_named
+from bearing_env.tasks import REGISTERED_TASKS_BY_ID, TASKS, TASKS_BY_ID, Task, task_named
 from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import COUNT, NON_NEGATIVE
 from bearing_env.train.common.errors import exit_on_output_errors, fail, missing_extra
@@ -94,9 +94,9 @@ def task_models(task: Task) -> list[str]:
         record = pretrained_record(name)
         trained_on = str(record.get("env_id", "")).rpartition(":")[2]
         settings = dict(record.get("env_kwargs", {}))
-        if trained_on in TASKS_BY_ID:  # trained on a task's own id: its settings first
-            settings = {**TASKS_BY_ID[trained_on].kwargs(), **settings}
-            trained_on = TASKS_BY_ID[trained_on].base_id
+        if trained_on in REGISTERED_TASKS_BY_ID:  # trained on a task's id: its settings first
+            settings = {**REGISTERED_TASKS_BY_ID[trained_on].kwargs(), **settings}
+            trained_on = REGISTERED_TASKS_BY_ID[trained_on].base_id
         if trained_on == task.base_id and resolved(settings) == wanted:
             specs.append(f"pretrained:{name}")
     return specs
@@ -188,7 +188,7 @@ def run_suite(
         if docs is not None and result.complete:
             write_task_card(task, config, result, folder, docs, command)
     if docs is not None:
-        write_index(TASKS, docs, out)
+        write_index(TASKS, docs)
     return runs
 
 

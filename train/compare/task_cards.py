@@ -9,6 +9,7 @@ numbers (no timings), so regenerating it with the same command gives the same te
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -30,6 +31,11 @@ from bearing_env.train.compare.report import (
 from bearing_env.train.compare.runner import make_env
 
 INDEX_NAME = "index.md"
+#: The folder (under the cards' folder) of the results the cards are written from: one
+#: ``<task id>.json`` per card, the comparison's summary and the command that ran it.
+RESULTS_DIR = "results"
+#: The environment page, relative to the cards.
+ENV_PAGE = "../environment.md"
 #: The heading of the index's overview table (:func:`overview_markdown`).
 OVERVIEW_HEADING = "## Baselines at a glance"
 #: Moves of the greedy policy before the card's frame is rendered.
@@ -145,8 +151,8 @@ def observation_text(config: Any, space: Any) -> str:
         )
     return (
         f"`{space_text(space)}`: {layout}. Only what the robot can know, never ground truth; slots "
-        "beyond the episode's landmarks are zeros. The full table is in "
-        "`BearingSLAMEnv`'s docstring."
+        "beyond the episode's landmarks are zeros. Every column is in "
+        f"[the environment's observation tables]({ENV_PAGE}#observation)."
     )
 
 
@@ -189,6 +195,85 @@ def reward_text(config: Any) -> str:
     if costs:
         text += " Less " + " and ".join(costs) + "."
     return text
+
+
+def starting_state_text(config: Any, task: Task) -> str:
+    """Where an episode starts (the environment page's "Starting state", for this task)."""
+    if config.landmarks is not None:
+        count = len(config.landmarks)
+        layout = f"The {count} landmarks are the scenario's, the same every episode."
+    else:
+        lo, hi = config.landmark_counts
+        count = f"{lo}" if lo == hi else f"a count drawn from {lo} to {hi}"
+        layout = f"A new layout of {count} landmarks is drawn every episode from the reset's seed."
+    obstacles = " outside the obstacles," if config.obstacles else ""
+    return (
+        f"{layout} The robot starts at a uniformly random position inside the wall "
+        f"margin,{obstacles} away from the landmarks, with a uniformly random heading, "
+        "takes one reading and has an empty map: no landmark is initialised, so each of "
+        f"L3, L4, ... counts at `area_cap` = {_number(config.area_cap)} FL units². "
+        "`reset(seed=s)` makes the same start for the same `s`; `reset` takes no options. "
+        f"See [the environment's starting state]({ENV_PAGE}#starting-state)."
+    )
+
+
+def return_text(config: Any) -> str:
+    """How an episode's return relates to the total area the tables report."""
+    cap = _number(config.area_cap)
+    if config.reward != "log_area":
+        return (
+            f"The return is Φ(start) - Φ(end) = (n - 2) · {cap} - Σ min(area, {cap}): "
+            "the total area removed, capped areas counted."
+        )
+    lo, hi = config.landmark_counts
+    mapped = f"{lo - 2}" if lo == hi else f"{lo - 2} to {hi - 2}"
+    text = (
+        f"The return (costs aside) is R = Φ(start) - Φ(end) = Σ log({cap} / min(area, {cap})) "
+        f"over the {mapped} landmarks L3, L4, ...: the geometric mean of their final areas "
+        f"is {cap} · exp(-R / (n - 2)) FL units², n the episode's landmark count."
+    )
+    if lo == hi:
+        example = config.area_cap * np.exp(-10.0 / (lo - 2))
+        text += (
+            f" Here n = {lo}: a return of 10 means a geometric mean area of {example:.3g}, "
+            "and the total area is at least n - 2 times it."
+        )
+    return text
+
+
+INFO_KEYS = (
+    "landmark_area", "landmark_error", "landmark_contains_truth", "total_area",
+    "robot_error", "frame_changed", "inconsistent", "path_length", "rewards", "robot_map",
+)  # fmt: skip
+
+
+def info_text(config: Any) -> str:
+    keys = list(INFO_KEYS)
+    if config.sensor_info:
+        keys += ["seen", "blocked"]
+    if not config.robot_map_info:
+        keys.remove("robot_map")
+    return (
+        ", ".join(f"`{key}`" for key in keys)
+        + ". `robot_map` is the robot's own map; the others are ground truth, for evaluation. "
+        f"Their meanings are in [the environment's info table]({ENV_PAGE}#info)."
+    )
+
+
+def summary_box(task: Task, config: Any, observation_space: Any, action_space: Any) -> str:
+    """The card's top table, as Gymnasium's env pages have it."""
+    rows = [
+        ["Action space", f"`{space_text(action_space)}`"],
+        ["Observation space", f"`{space_text(observation_space)}`"],
+        ["Episode cap", f"`max_moves` = {config.max_moves} moves"],
+        ["Success", f"every region of L3, L4, ... ≤ {_number(config.target_area)} FL units²"],
+        ["Import", f'`gym.make("bearing_env:{task.id}")`'],
+    ]
+    return markdown_table(["", ""], rows)
+
+
+def version_history(task: Task) -> list[str]:
+    return [f"- {entry}" for entry in task.history]
 
 
 def termination_text(config: Any) -> str:
@@ -256,6 +341,8 @@ def task_card(
     parts = [
         f"# {task.id}",
         "",
+        summary_box(task, resolved, observation_space, action_space),
+        "",
         f"{task.description[0].upper()}{task.description[1:]}.",
         "",
         "```python",
@@ -277,13 +364,25 @@ def task_card(
         "",
         reward_text(resolved),
         "",
+        return_text(resolved),
+        "",
+        "## Starting state",
+        "",
+        starting_state_text(resolved, task),
+        "",
         "## Episode end",
         "",
         termination_text(resolved),
         "",
+        "## Info",
+        "",
+        info_text(resolved),
+        "",
         "## Settings",
         "",
         markdown_table(["setting", "value"], settings_rows(resolved, task)),
+        "",
+        f"Every setting is described in [the environment's settings table]({ENV_PAGE}#settings).",
         "",
         *baselines_section(task, config, summary),
     ]
@@ -299,7 +398,16 @@ def task_card(
             "",
         ]
     if command:
-        parts += ["Regenerate with:", "", "```bash", command, "```", ""]
+        parts += [
+            "Measured with the command below; `bearing-env docs-tables` writes this card from "
+            f"its results file, `{RESULTS_DIR}/{task.id}.json`:",
+            "",
+            "```bash",
+            command,
+            "```",
+            "",
+        ]
+    parts += ["## Version history", "", *version_history(task), ""]
     return "\n".join(parts)
 
 
@@ -356,9 +464,65 @@ def write_task_card(
     if plot:
         copy_file(plot_source, docs / area_plot_name(task))
     frame = render_frame(config, config.seeds[0], docs / frame_name(task))
+    results = {"task": task.id, "command": command, "summary": result.summary}
+    atomic_write_text(results_path(docs, task), json.dumps(results, indent=1) + "\n")
     path = docs / card_name(task)
     atomic_write_text(path, task_card(task, config, result.summary, command, frame, plot))
     return path
+
+
+def results_path(docs: Path, task: Task) -> Path:
+    return docs / RESULTS_DIR / f"{task.id}.json"
+
+
+def read_results(docs: Path, task: Task) -> dict[str, Any] | None:
+    """The results file a card is written from, or None."""
+    path = results_path(docs, task)
+    if not path.is_file():
+        return None
+    data: dict[str, Any] = json.loads(path.read_text(encoding="utf-8"))
+    return data
+
+
+def config_of(summary: Mapping[str, Any]) -> CompareConfig:
+    """The comparison a summary ran (its ``config``)."""
+    saved = {k: v for k, v in summary["config"].items() if k != "format_version"}
+    return CompareConfig(**saved)
+
+
+def published_cards(docs: Path) -> dict[Path, str]:
+    """Every card (and the index) as its results files in ``docs`` write it: the text
+    ``bearing-env docs-tables`` writes and its check compares."""
+    from bearing_env.tasks import TASKS
+
+    cards: dict[Path, str] = {}
+    for task in TASKS:
+        data = read_results(docs, task)
+        if data is None:
+            continue
+        summary = data["summary"]
+        frame = (docs / frame_name(task)).is_file()
+        plot = (docs / area_plot_name(task)).is_file()
+        text = task_card(task, config_of(summary), summary, data["command"], frame, plot)
+        cards[docs / card_name(task)] = text
+    if cards:
+        cards[docs / INDEX_NAME] = index_page(TASKS, docs)
+    return cards
+
+
+def markdown_medians(data: Mapping[str, Any]) -> str:
+    """The README's table: each policy's median total area after 10 and 20 moves, from
+    a card's results file (the cards are the canonical evaluation)."""
+    summary = data["summary"]
+    config = config_of(summary)
+    header, rows = area_median_rows(summary, config)
+    wanted = [i for i, name in enumerate(header) if name in ("policy", "after 10", "after 20")]
+    return (
+        f"Median total area of L3 and L4 (FL units², 20 = nothing mapped), {config.episodes} "
+        f"evaluation episodes per policy, from [the `{data['task']}` card]"
+        f"(docs/tasks/{data['task']}.md):\n\n"
+        + markdown_table([header[i] for i in wanted], [[row[i] for i in wanted] for row in rows])
+    )
 
 
 def final_area_cell(stats: Mapping[str, Any], move: str) -> str:
@@ -449,12 +613,11 @@ def finished_summary(folder: Path) -> dict[str, Any] | None:
     return summary
 
 
-def index_page(tasks: Sequence[Task], docs: Path, out: Path) -> str:
+def index_page(tasks: Sequence[Task], docs: Path) -> str:
     """The Markdown of ``index.md``: the task table (linking the cards that exist in
-    ``docs``) and the baselines at a glance: from the finished comparisons in ``out``,
-    and for a task with a card but none there, its row of the index already in ``docs``
-    (a suite run on some of the tasks keeps the others' rows)."""
-    from bearing_env.tasks import NAMING_RULE
+    ``docs``), the training ids, and the baselines at a glance: from the cards' results
+    files, and for a card without one, its row of the index already in ``docs``."""
+    from bearing_env.tasks import NAMING_RULE, TRAINING_TASKS
 
     rows = []
     for task in tasks:
@@ -465,7 +628,7 @@ def index_page(tasks: Sequence[Task], docs: Path, out: Path) -> str:
         )
     carded = [task for task in tasks if (docs / card_name(task)).is_file()]
     fresh = overview_cells(
-        [(t, summary) for t in carded if (summary := finished_summary(out / t.id)) is not None]
+        [(t, data["summary"]) for t in carded if (data := read_results(docs, t)) is not None]
     )
     published = published_overview(docs / INDEX_NAME)
     overview = {
@@ -486,6 +649,14 @@ def index_page(tasks: Sequence[Task], docs: Path, out: Path) -> str:
         markdown_table(["id", "actions", "description", "settings", "card"], rows),
         "",
         "Naming rule: " + NAMING_RULE,
+        "Training ids: registered the same way, without a card; the shipped rl-zoo3 files "
+        "whose observation is a landmark table are keyed by them.",
+        "",
+        markdown_table(
+            ["id", "description", "settings"],
+            [[f"`{t.id}`", t.description, f"`{t.settings_text()}`"] for t in TRAINING_TASKS],
+        ),
+        "",
     ]
     if overview:
         parts += [OVERVIEW_HEADING, "", overview_markdown(overview), ""]
@@ -498,7 +669,7 @@ def index_page(tasks: Sequence[Task], docs: Path, out: Path) -> str:
     return "\n".join(parts)
 
 
-def write_index(tasks: Sequence[Task], docs: Path, out: Path) -> Path:
+def write_index(tasks: Sequence[Task], docs: Path) -> Path:
     path = docs / INDEX_NAME
-    atomic_write_text(path, index_page(tasks, docs, out))
+    atomic_write_text(path, index_page(tasks, docs))
     return path

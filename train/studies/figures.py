@@ -843,3 +843,26 @@ def make_figures(args: argparse.Namespace, seeds: list[int], wanted: set[str]) -
 
 if __name__ == "__main__":
     main()
+
+
+def markdown_fig11(figures: dict[str, Any]) -> str:
+    """The Fig. 11 fits of ``figures.json`` as a Markdown table (``bearing-env
+    docs-tables`` writes the results page's with it)."""
+    fig11 = figures["fig11"]
+    epsilons, medians = fig11["epsilons"], fig11["final_area_median"]
+    rows = [
+        ("√area linear in ε: R²", f"{fig11['sqrt_area_linear_fit']['r_squared']:.4f}"),
+        ("power law area ∝ ε^k: exponent k", f"{fig11['power_fit']['exponent']:.2f}"),
+        ("power law: log-log R²", f"{fig11['power_fit']['r_squared_loglog']:.4f}"),
+        ("the paper's linear law, area linear in ε: R²", f"{fig11['linear_fit']['r_squared']:.3f}"),
+    ]
+    lines = [
+        f"Transfer `{fig11['transfer']}`, noise `{fig11['noise_mode']}`; median L3 area after "
+        f"10 movements: {medians[0]:.3g} FL units² at ε = {epsilons[0]:g}° to "
+        f"{medians[-1]:.3g} at {epsilons[-1]:g}° (`docs/figures/figures.json`).",
+        "",
+        "| Fig. 11 fit | value |",
+        "|---|---|",
+        *(f"| {name} | {value} |" for name, value in rows),
+    ]
+    return "\n".join(lines)

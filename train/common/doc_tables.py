@@ -1,0 +1,170 @@
+"""``bearing-env docs-tables``: every table of measured figures in the README and the docs,
+written from a results file kept in the repo.
+
+A page holds a generated block between two comment lines::
+
+    <!-- docs-tables: bench-env -->
+    ...the Markdown this module writes...
+    <!-- /docs-tables -->
+
+:data:`BLOCKS` names each block's results file and the function that writes it. The
+command rewrites every block of :data:`PAGES` from the files (and the task cards from
+``docs/tasks/results/``, through :mod:`~bearing_env.train.compare.task_cards`);
+``--check`` changes nothing and exits with status 1 naming each block whose text is not
+what its file gives, which is what ``tests/tools/test_doc_tables.py`` runs. So a figure
+has one home, its results file: after a new measurement (``bearing-env bench --json
+benchmarks/results/bench_env.json``, ``bearing-env suite``, ``bearing-env figures``),
+``bearing-env docs-tables`` updates the pages that show it.
+
+    bearing-env docs-tables            # rewrite the blocks and the cards
+    bearing-env docs-tables --check    # exit 1 on a block that differs from its file
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from bearing_env.train.common.cli_parser import command_parser
+
+#: The files whose blocks are generated (relative to the repository's root).
+PAGES: tuple[str, ...] = ("README.md", "docs/*.md", "docs/tasks/index.md")
+BLOCK = re.compile(
+    r"(?P<open><!-- docs-tables: (?P<name>[\w-]+) -->\n)(?P<body>.*?)"
+    r"(?P<close><!-- /docs-tables -->)",
+    re.DOTALL,
+)
+
+
+@dataclass(frozen=True)
+class Block:
+    """A generated block: its results file (relative to the root) and its writer."""
+
+    source: str
+    render: Callable[[Any], str]
+
+
+def _load(root: Path, source: str) -> Any:
+    return json.loads((root / source).read_text(encoding="utf-8"))
+
+
+def markdown_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def _blocks() -> dict[str, Block]:
+    from bearing_env.benchmarks import bench_report
+    from bearing_env.train.compare import task_cards
+    from bearing_env.train.studies import figures
+
+    bench = "benchmarks/results/bench_env.json"
+    khepera = "docs/tasks/results/BearingSLAM-Khepera-v0.json"
+    return {
+        "bench-machine": Block(bench, bench_report.markdown_machine),
+        "bench-goals": Block(bench, bench_report.markdown_goals),
+        "bench-env": Block(bench, bench_report.markdown_env_table),
+        "bench-startup": Block(bench, bench_report.markdown_startup),
+        "bench-throughput": Block(bench, bench_report.markdown_throughput),
+        "khepera-medians": Block(khepera, task_cards.markdown_medians),
+        "fig11-fits": Block("docs/figures/figures.json", figures.markdown_fig11),
+    }
+
+
+def pages(root: Path) -> list[Path]:
+    found: list[Path] = []
+    for pattern in PAGES:
+        found += sorted(root.glob(pattern))
+    return list(dict.fromkeys(found))
+
+
+def render_block(name: str, root: Path, blocks: Mapping[str, Block] | None = None) -> str:
+    """The Markdown of block ``name`` from its results file under ``root``."""
+    block = (blocks or _blocks())[name]
+    text = block.render(_load(root, block.source)).rstrip("\n")
+    return f"{text}\n"
+
+
+def regenerate(text: str, root: Path, blocks: Mapping[str, Block] | None = None) -> str:
+    """``text`` with every generated block rewritten (KeyError on an unknown block)."""
+    known = blocks or _blocks()
+
+    def replace(match: re.Match[str]) -> str:
+        body = render_block(match["name"], root, known)
+        return f"{match['open']}{body}{match['close']}"
+
+    return BLOCK.sub(replace, text)
+
+
+def stale(root: Path) -> list[str]:
+    """``page: block`` for every generated block (and ``docs/tasks/<card>``) whose text
+    is not what its results file gives; empty when all are current."""
+    from bearing_env.train.compare.task_cards import published_cards
+
+    blocks = _blocks()
+    differing: list[str] = []
+    for page in pages(root):
+        text = page.read_text(encoding="utf-8")
+        for match in BLOCK.finditer(text):
+            if render_block(match["name"], root, blocks) != match["body"]:
+                differing.append(f"{page.relative_to(root)}: {match['name']}")
+    for path, text in published_cards(root / "docs" / "tasks").items():
+        if not path.is_file() or path.read_text(encoding="utf-8") != text:
+            differing.append(f"{path.relative_to(root)}: the card")
+    return differing
+
+
+def write_all(root: Path) -> list[Path]:
+    """Rewrite every block and card under ``root``; the files that changed."""
+    from bearing_env.train.common.files import atomic_write_text
+    from bearing_env.train.compare.task_cards import published_cards
+
+    changed: list[Path] = []
+    blocks = _blocks()
+    for page in pages(root):
+        text = page.read_text(encoding="utf-8")
+        new = regenerate(text, root, blocks)
+        if new != text:
+            atomic_write_text(page, new)
+            changed.append(page)
+    for path, text in published_cards(root / "docs" / "tasks").items():
+        if not path.is_file() or path.read_text(encoding="utf-8") != text:
+            atomic_write_text(path, text)
+            changed.append(path)
+    return changed
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    parser: argparse.ArgumentParser = command_parser(
+        "bearing-env docs-tables",
+        "Write every table of measured figures in the README and the docs (and the task "
+        "cards) from the results files kept in the repository.",
+        "Blocks: " + ", ".join(_blocks()) + ".",
+    )
+    parser.add_argument("--check", action="store_true", help="change nothing; exit 1 if stale")
+    parser.add_argument(
+        "--root", type=Path, default=Path("."), help="the repository (default: here)"
+    )
+    args = parser.parse_args(argv)
+    if args.check:
+        differing = stale(args.root)
+        for entry in differing:
+            print(f"stale: {entry}")
+        if differing:
+            print("run `bearing-env docs-tables` to rewrite them", file=sys.stderr)
+            raise SystemExit(1)
+        print("every generated table matches its results file")
+        return
+    for path in write_all(args.root):
+        print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()
