@@ -7,39 +7,56 @@ STAMP := $(VENV)/.installed
 # of bearing_env (setuptools package-dir), so the view links them in under that name.
 TYPECHECK_VIEW := $(VENV)/typecheck
 
-.PHONY: test test-slow demo docs lint typecheck bench bench-slam clean
+.PHONY: test test-slow demo docs lint typecheck bench bench-slam clean native
+
+# The native core's sources: any change rebuilds the extension before a test or demo runs,
+# so no stale binary is ever tested.
+NATIVE_SOURCES := CMakeLists.txt $(shell find csrc -type f 2>/dev/null)
+NATIVE := $(VENV)/.native
+# The build's settings for `make`: compiler warnings are errors.
+BUILD_SETTINGS := -Ccmake.define.BEARING_ENV_WERROR=ON
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	# torch first, from the pin, so nothing later resolves a CUDA build
 	$(PY) -m pip install --quiet -c constraints.txt torch==2.13.0
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[render,train,dev,ray,docs]"
-	touch $(STAMP)
+	# the build's own tools, pinned, so the editable install below builds without isolation
+	$(PY) -m pip install --quiet -c constraints.txt scikit-build-core nanobind cmake ninja
+	$(PY) -m pip install --quiet -c constraints.txt --no-build-isolation $(BUILD_SETTINGS) \
+		-e ".[render,train,dev,ray,docs]"
+	touch $(STAMP) $(NATIVE)
+
+# Rebuild the extension (incrementally, in build/) when a C++ source changed.
+$(NATIVE): $(STAMP) $(NATIVE_SOURCES)
+	$(PY) -m pip install --quiet --no-build-isolation --no-deps $(BUILD_SETTINGS) -e .
+	touch $(NATIVE)
+
+native: $(NATIVE)
 
 # Two workers, one per core; a test module stays on one worker (its fixtures run once).
-test: lint typecheck
+test: $(NATIVE) lint typecheck
 	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m "not slow" -n 2 --dist loadfile
 
 # The tests `make test` leaves out (marked slow): each costs minutes (the sdist's own test
 # run in a fresh venv, a real compile from an empty cache, a long seeded search, ...).
-test-slow: $(STAMP)
+test-slow: $(NATIVE)
 	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m slow -n 2 --dist loadfile
 
-demo: $(STAMP)
+demo: $(NATIVE)
 	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.studies.demo
 	SDL_VIDEODRIVER=dummy $(PY) -m bearing_env.train.compare.cli --quick
 
 # The documentation site, incremental (tests/tools/test_docs_site.py builds it afresh with
 # warnings as errors and checks its links and images).
-docs: $(STAMP)
+docs: $(NATIVE)
 	$(PY) -m sphinx -W --keep-going -q -j auto -b html docs docs/_build/html
 	@echo "docs/_build/html/index.html"
 
-bench: $(STAMP)
+bench: $(NATIVE)
 	$(PY) -m bearing_env.benchmarks.bench_env
 
-bench-slam: $(STAMP)
+bench-slam: $(NATIVE)
 	$(PY) -m bearing_env.benchmarks.bench_slam
 
 lint: $(STAMP)

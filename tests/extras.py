@@ -11,17 +11,12 @@ that is wholly about an extra.
 from __future__ import annotations
 
 import importlib
-import re
-from importlib import metadata
-from pathlib import Path
+import importlib.util
 from types import ModuleType
 
 import pytest
 
 from bearing_env.extras import MODULE_EXTRAS, available, install_command
-
-#: pyproject.toml, next to the tests folder (in the repository and in the sdist alike).
-PYPROJECT = Path(__file__).resolve().parents[1] / "pyproject.toml"
 
 
 def extra_modules(extra: str) -> tuple[str, ...]:
@@ -64,17 +59,17 @@ def import_or_skip(module: str) -> ModuleType:
 
 
 def build_backend_missing() -> str | None:
-    """Why the distributions cannot be built here (pyproject.toml's build-system needs a
-    newer setuptools than this interpreter has; the ``dev`` extra installs it), or None."""
-    required = re.search(r'"setuptools>=(\d+)', PYPROJECT.read_text())
-    minimum = int(required.group(1)) if required else 0
-    try:
-        major = int(metadata.version("setuptools").split(".")[0])
-    except metadata.PackageNotFoundError:
-        major = -1
-    if major >= minimum:
+    """Why the distributions cannot be built here (pyproject.toml's build backend,
+    scikit-build-core with nanobind, is not installed; the ``dev`` extra installs it), or
+    None."""
+    missing_tools = [
+        name
+        for name in ("scikit_build_core", "nanobind")
+        if importlib.util.find_spec(name) is None
+    ]
+    if not missing_tools:
         return None
     return (
-        f"needs the dev extra (setuptools>={minimum} builds the distributions): "
+        f"needs the dev extra ({', '.join(missing_tools)} build the distributions): "
         f"{install_command('dev')}"
     )

@@ -160,23 +160,25 @@ def _checked(result: subprocess.CompletedProcess[str]) -> subprocess.CompletedPr
 
 
 def _build(out: Path) -> dict[str, Path]:
-    """The wheel and the sdist of this checkout (setuptools' backend, in the checkout).
+    """The wheel and the sdist of this checkout (scikit-build-core's backend, in the
+    checkout; the wheel compiles the native core in a build folder of its own).
 
-    One process each: a ``build_sdist`` after ``build_wheel`` in the same process writes
-    the archive where the wheel's command options point, not into ``out``.
+    One process each, as a build frontend would run them.
     """
     built = {}
-    for kind, hook in (("wheel", "build_wheel"), ("sdist", "build_sdist")):
-        program = (
-            f"import sys\nfrom setuptools import build_meta\nprint(build_meta.{hook}(sys.argv[1]))"
-        )
+    hooks = (
+        ("wheel", f"build_wheel(sys.argv[1], {{'build-dir': {str(out / 'build')!r}}})"),
+        ("sdist", "build_sdist(sys.argv[1])"),
+    )
+    for kind, hook in hooks:
+        program = f"import sys\nfrom scikit_build_core import build\nprint(build.{hook})"
         result = _checked(
             subprocess.run(
                 [sys.executable, "-c", program, str(out)],
                 cwd=ROOT,
                 capture_output=True,
                 text=True,
-                timeout=300,
+                timeout=600,
             )
         )
         built[kind] = out / result.stdout.strip().splitlines()[-1]

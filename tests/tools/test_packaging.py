@@ -29,11 +29,15 @@ def test_license_is_an_spdx_expression_with_its_file() -> None:
     assert not any(c.startswith("License ::") for c in project.get("classifiers", []))
 
 
-def test_build_system_requires_a_setuptools_that_reads_spdx_licenses() -> None:
-    requires = _pyproject()["build-system"]["requires"]
-    versions = [re.fullmatch(r"setuptools>=(\d+)(\.\d+)*", r) for r in requires]
-    (match,) = [m for m in versions if m]
-    assert int(match.group(1)) >= 77
+def test_the_build_system_compiles_the_native_core_with_nanobind() -> None:
+    build_system = _pyproject()["build-system"]
+    assert build_system["build-backend"] == "scikit_build_core.build"
+    names = {re.split(r"[<>=!~ ]", r, maxsplit=1)[0] for r in build_system["requires"]}
+    assert names == {"scikit-build-core", "nanobind"}
+    # PEP 639 licenses (the SPDX `license` with `license-files`) need scikit-build-core 0.11.
+    (core,) = [r for r in build_system["requires"] if r.startswith("scikit-build-core")]
+    minimum = re.fullmatch(r"scikit-build-core>=(\d+)\.(\d+)", core)
+    assert minimum is not None and (int(minimum[1]), int(minimum[2])) >= (0, 11)
 
 
 def test_license_file_is_mit_for_the_bearing_env_developers() -> None:
@@ -65,12 +69,14 @@ def test_the_wheel_carries_the_license_without_a_deprecation_warning(tmp_path: P
 
 
 @pytest.mark.skipif(build_backend_missing() is not None, reason=build_backend_missing() or "")
-def test_the_sdist_carries_the_tests_with_their_helpers(tmp_path: Path) -> None:
+def test_the_sdist_carries_the_tests_the_native_sources_and_no_build_output(
+    tmp_path: Path,
+) -> None:
     import tarfile
 
-    from setuptools import build_meta
+    from scikit_build_core import build as build_backend
 
-    name = build_meta.build_sdist(str(tmp_path))
+    name = build_backend.build_sdist(str(tmp_path))
     with tarfile.open(tmp_path / name) as sdist:
         names = {
             Path(*Path(member).parts[1:]).as_posix()
@@ -79,30 +85,24 @@ def test_the_sdist_carries_the_tests_with_their_helpers(tmp_path: Path) -> None:
         }
     repository_tests = {p.relative_to(ROOT).as_posix() for p in (ROOT / "tests").rglob("*.py")}
     assert repository_tests <= names, sorted(repository_tests - names)
-    assert {"LICENSE", "CITATION.cff", "docs/design.md"} <= names
-    assert not [n for n in names if n.endswith((".nbi", ".nbc", ".pyc"))]
+    native = {p.relative_to(ROOT).as_posix() for p in (ROOT / "csrc").rglob("*") if p.is_file()}
+    assert native and native <= names, sorted(native - names)
+    assert {"LICENSE", "CITATION.cff", "docs/design.md", "CMakeLists.txt"} <= names
+    assert not [n for n in names if n.endswith((".nbi", ".nbc", ".pyc", ".so", ".o"))]
+    assert not [n for n in names if n.startswith(("build/", ".venv/", "docs/_build/"))]
 
 
-#: The repository folders that install as subpackages of bearing_env (package-dir).
-SUBPACKAGE_FOLDERS = {"agents": "bearing_env.agents", "train": "bearing_env.train",
-                      "benchmarks": "bearing_env.benchmarks"}  # fmt: skip
+#: The repository folders that install as subpackages of bearing_env.
+SUBPACKAGE_FOLDERS = {"agents": "bearing_env/agents", "train": "bearing_env/train",
+                      "benchmarks": "bearing_env/benchmarks"}  # fmt: skip
 
 
-def test_every_subpackage_folder_is_in_the_package_list() -> None:
-    # setuptools ships only the packages it is told of: a folder of modules that the list
-    # misses is left out of the wheel (the data folders: tests/tools/test_install.py).
-    setuptools = _pyproject()["tool"]["setuptools"]
-    for folder, name in SUBPACKAGE_FOLDERS.items():
-        assert setuptools["package-dir"][name] == folder
-    expected = set()
-    for folder, name in SUBPACKAGE_FOLDERS.items():
-        for path in (ROOT / folder).rglob("*"):
-            if path.is_dir() and path.name != "__pycache__" and any(path.glob("*.py")):
-                parts = path.relative_to(ROOT / folder).parts
-                if "__pycache__" not in parts:
-                    expected.add(".".join((name, *parts)))
-        expected.add(name)
-    assert sorted(expected - set(setuptools["packages"])) == []
+def test_every_subpackage_folder_is_mapped_into_the_package() -> None:
+    # scikit-build-core ships a folder under the name its wheel.packages table gives it;
+    # everything below it (modules, subpackages and the data folders) comes along.
+    packages = _pyproject()["tool"]["scikit-build"]["wheel"]["packages"]
+    assert packages == {"bearing_env": "bearing_env", **{
+        name: folder for folder, name in SUBPACKAGE_FOLDERS.items()}}  # fmt: skip
 
 
 def _imported_modules(path: Path) -> set[str]:

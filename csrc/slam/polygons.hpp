@@ -1,0 +1,30 @@
+// Convex polygons in fixed-capacity arrays (bearing_env/slam/kernels/polygons.py, ported
+// function for function, same order of operations): hulls, area and centroid,
+// containment, distances, simplification, capacity reduction, clipping, outward offsets.
+// A polygon is a vertex array in counter-clockwise order plus its count n.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+
+#include "slam/common.hpp"
+
+namespace bearing::slam {
+
+// Largest point set convex_hull takes (a transfer's cloud); more raises CapacityError.
+inline constexpr int64_t MAX_HULL_POINTS = MAX_CLOUD + SCRATCH;
+
+int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out);
+int64_t small_convex_hull(const cplx* points, int64_t n_points, cplx* out, double tol);
+int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol);
+std::pair<double, cplx> area_centroid(const cplx* poly, int64_t n);
+bool contains_point(const cplx* poly, int64_t n, cplx point, double relative);
+double polygon_distance(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q);
+double longest_edge(const cplx* poly, int64_t n);
+int64_t simplify(cplx* poly, int64_t n, double tol);
+int64_t drop_edges_outward(cplx* poly, int64_t n, int64_t capacity);
+int64_t clip_convex(const cplx* subject, int64_t n_subject, const cplx* clipper,
+                    int64_t n_clipper, cplx* out, cplx* work);
+int64_t offset_outward(const cplx* poly, int64_t n, double radius, cplx* out);
+
+}  // namespace bearing::slam

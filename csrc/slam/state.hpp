@@ -1,0 +1,108 @@
+// The structures the map update takes, mirroring bearing_env/slam/kernels/state.py:
+// MapState (a batch's per-map arrays, every one with the map axis first), Params (one
+// update call's settings), Outputs (per-call statuses) and the constants they are sized by.
+#pragma once
+
+#include <cstdint>
+
+#include "core/complex.hpp"
+#include "core/views.hpp"
+
+namespace bearing::slam {
+
+// Capacities (bearing_env/slam/kernels/common.py; the Python constants are read from here).
+inline constexpr int64_t CAPACITY = 128;           // most vertices a map region holds
+inline constexpr int64_t MAX_EDGE_SAMPLES = 8;     // samples per edge, conservative transfer
+inline constexpr int64_t FR_VERTICES = 4;          // a robot-frame region is at most a quadrangle
+inline constexpr int64_t MAX_SAMPLES = FR_VERTICES * MAX_EDGE_SAMPLES;
+inline constexpr int64_t MAX_PAIRS = MAX_SAMPLES * MAX_SAMPLES;
+inline constexpr int64_t SCRATCH = 2 * CAPACITY + 8;
+inline constexpr int64_t MAX_CLOUD = FR_VERTICES * MAX_PAIRS;
+inline constexpr double MAX_FR_EXTENT = 1e4;
+inline constexpr double RELATIVE_TOLERANCE = 1e-12;
+inline constexpr int64_t MAX_WINDOW = 32;
+
+enum FrStatus : int64_t { FR_BOUNDED = 0, FR_UNBOUNDED = 1, FR_EMPTY = 2, FR_MISSING = 3 };
+enum FrameStatus : int8_t {
+    FRAME_OK = 0,
+    FRAME_L1_UNBOUNDED = 1,
+    FRAME_L2_UNBOUNDED = 2,
+    FRAME_L1_L2_OVERLAP = 3,
+    FRAME_L1_L2_TOO_CLOSE = 4,
+    FRAME_L1_MISSING = 5,
+    FRAME_L2_MISSING = 6,
+    FRAME_REJECTED = 7,
+};
+enum LandmarkStatus : int8_t {
+    LANDMARK_UPDATED = 0,
+    LANDMARK_UNBOUNDED = 1,
+    LANDMARK_INCONSISTENT = 2,
+    LANDMARK_SKIPPED = 3,
+    LANDMARK_MISSING = 4,
+};
+enum Transfer : int64_t { TRANSFER_CONSERVATIVE = 0, TRANSFER_PAPER = 1 };
+enum Inconsistency : int64_t { INCONSISTENCY_RESTART = 0, INCONSISTENCY_KEEP = 1 };
+enum Fusion : int64_t { FUSION_INTERSECT = 0, FUSION_RELAXED = 1, FUSION_ROBUST = 2 };
+
+// A batch's state: the fields of bearing_env.slam.kernels.State, in its order, as views
+// of the batch's numpy arrays (m: mapped landmarks, w: the relaxed window, levels: the
+// robust fusion's levels, h: its history; 0-sized where the fusion does not use them).
+struct MapState {
+    View3<cplx> vertices;                 // (maps, m, CAPACITY)
+    View2<int64_t> counts;                // (maps, m)
+    View2<double> areas;                  // (maps, m)
+    View2<cplx> centroids;                // (maps, m)
+    View2<cplx> robot_vertices;           // (maps, CAPACITY)
+    View1<int64_t> robot_counts;          // (maps,)
+    View1<double> robot_area;             // (maps,)
+    View1<cplx> robot_centroid;           // (maps,)
+    View1<double> robot_heading;          // (maps,)
+    View1<int64_t> n_updates;             // (maps,)
+    View1<int64_t> n_frame_changes;       // (maps,)
+    View1<int64_t> n_inconsistent;        // (maps,)
+    View4<cplx> window_vertices;          // (maps, w, m, CAPACITY)
+    View3<int64_t> window_counts;         // (maps, w, m)
+    View3<bool> window_inlier;            // (maps, w, m)
+    View2<bool> window_rejected;          // (maps, w)
+    View1<int64_t> window_length;         // (maps,)
+    View1<int64_t> window_next;           // (maps,)
+    View3<cplx> base_vertices;            // (maps, m, CAPACITY or 0)
+    View2<int64_t> base_counts;           // (maps, m)
+    View2<int64_t> n_dropped;             // (maps, m)
+    View2<int64_t> outliers;              // (maps, m)
+    View4<cplx> level_vertices;           // (maps, m, levels, CAPACITY)
+    View3<int64_t> level_counts;          // (maps, m, levels)
+    View2<int64_t> n_regions;             // (maps, m)
+    View1<int64_t> robot_fixed_at;        // (maps,)
+    View1<double> noise_scale;            // (maps,)
+    View1<int64_t> bound_events;          // (maps,)
+    View3<cplx> probe_vertices;           // (maps, m, CAPACITY or 0)
+    View2<int64_t> probe_counts;          // (maps, m)
+    View4<double> history_frame_bearings; // (maps, h, 2, 2)
+    View4<double> history_bearings;       // (maps, h, 2, m)
+    View1<int64_t> history_length;        // (maps,)
+    View1<int64_t> history_next;          // (maps,)
+};
+
+// One update call's settings (bearing_env.slam.kernels.Params, same fields, same order).
+struct Params {
+    double epsilon = 0.0;          // bearing error bound, radians
+    int64_t transfer = 0;          // Transfer
+    int64_t edge_samples = 0;      // samples per edge of A_L1 and A_L2 (conservative)
+    int64_t on_inconsistency = 0;  // Inconsistency
+    int64_t fusion = 0;            // Fusion
+    int64_t max_outliers = 0;      // relaxed fusion: most regions left out per landmark
+    bool with_robot = false;       // also transfer the robot's position
+    double risk = 0.0;             // robust fusion: the binomial tail the reported level leaves
+    bool likely = false;           // robust fusion: report the likely set
+    bool estimate_bound = false;   // robust fusion: estimate the noise bound
+};
+
+// What one call did, per bearings row i (bearing_env.slam.kernels.Outputs).
+struct Outputs {
+    View1<int8_t> frame_status;     // (rows,)
+    View2<int8_t> landmark_status;  // (rows, m)
+    View1<int64_t> n_bad;           // (rows,)
+};
+
+}  // namespace bearing::slam
