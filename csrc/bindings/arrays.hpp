@@ -47,7 +47,9 @@ nb::dlpack::dtype dtype_of() {
 template <class T, int D>
 View<T, D> view_of(nb::handle obj, const char* name, const std::array<int64_t, D>& expect = {}) {
     using Element = std::remove_const_t<T>;
-    nb::ndarray<nb::numpy> array;
+    // Read-only arrays are taken too (nb::ro); a view of a non-const T checks writeability
+    // below, naming the argument.
+    nb::ndarray<nb::numpy, nb::ro> array;
     if (!nb::try_cast(obj, array, false)) {
         type_error(std::string(name) + " must be a numpy array, not " +
                    nb::type_name(obj.type()).c_str());
@@ -63,7 +65,9 @@ View<T, D> view_of(nb::handle obj, const char* name, const std::array<int64_t, D
     int64_t expected_stride = 1;
     for (int d = D - 1; d >= 0; --d) {
         view.shape[d] = static_cast<int64_t>(array.shape(static_cast<size_t>(d)));
-        if (view.shape[d] > 1 && array.stride(static_cast<size_t>(d)) != expected_stride) {
+        // (An empty array is contiguous whatever its strides: numpy gives it zero strides.)
+        if (array.size() > 0 && view.shape[d] > 1 &&
+            array.stride(static_cast<size_t>(d)) != expected_stride) {
             value_error(std::string(name) + " must be C-contiguous");
         }
         expected_stride *= view.shape[d];
@@ -77,7 +81,7 @@ View<T, D> view_of(nb::handle obj, const char* name, const std::array<int64_t, D
             value_error(std::string(name) + " must be writeable");
         }
     }
-    view.data = reinterpret_cast<T*>(array.data());
+    view.data = reinterpret_cast<T*>(const_cast<void*>(static_cast<const void*>(array.data())));
     return view;
 }
 
