@@ -18,3 +18,22 @@ void update_maps(View2<const double> bearings_start, View2<const double> bearing
                  const Outputs& out, int64_t threads);
 
 }  // namespace bearing::slam
+
+// ---- Added by the update port: the batch helpers of update.py (check_indices,
+// ---- none_infinite, contains_points), for the bindings.
+namespace bearing::slam {
+
+// Outcomes of check_indices.
+enum IndexCheck : int64_t { INDEX_OK = 0, INDEX_OUT_OF_RANGE = 1, INDEX_REPEATED = 2 };
+
+// Whether indices[:n] are in [0, size) (and, if distinct, none repeats). `seen` holds
+// `size` flags (only used when distinct; the caller provides it).
+int64_t check_indices(const int64_t* indices, int64_t n, int64_t size, bool distinct,
+                      bool* seen);
+
+// out(i, j): region j of map rows[i] contains points(i, j) (relative tolerance).
+void contains_points(View3<const cplx> vertices, View2<const int64_t> counts,
+                     View1<const int64_t> rows, View2<const cplx> points, double relative,
+                     View2<bool> out);
+
+}  // namespace bearing::slam
