@@ -3,6 +3,7 @@
 // binomial_q, and the constants the Python side reads.
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
+#include <nanobind/stl/string.h>
 
 #include <array>
 #include <cmath>
