@@ -25,7 +25,8 @@ $(STAMP): pyproject.toml constraints.txt
 	$(PY) -m pip install --quiet -c constraints.txt scikit-build-core nanobind cmake ninja
 	$(PY) -m pip install --quiet -c constraints.txt --no-build-isolation $(BUILD_SETTINGS) \
 		-e ".[render,train,dev,ray,docs]"
-	touch $(STAMP) $(NATIVE)
+	touch $(STAMP)
+	touch $(NATIVE)
 
 # Rebuild the extension (incrementally, in build/) when a C++ source changed.
 $(NATIVE): $(STAMP) $(NATIVE_SOURCES)
