@@ -1,0 +1,473 @@
+// Convex polygons in fixed-capacity arrays: a function-for-function port of
+// bearing_env/slam/kernels/polygons.py (same operations in the same order, so the same
+// bits). Temporary arrays the numba kernels allocate are fixed-capacity arrays on the
+// stack here, sized by the documented maxima and guarded by check_capacity.
+#include "slam/polygons.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/errors.hpp"
+
+namespace bearing::slam {
+
+namespace {
+
+// -1j as Python folds the literal: complex(-0.0, -1.0).
+constexpr cplx MINUS_I{-0.0, -1.0};
+
+// Whether b fails to turn left by more than tol on the way from a to c.
+inline bool within_chord(cplx a, cplx b, cplx c, double tol) {
+    const double turn = cross(b - a, c - a);
+    if (tol == 0.0) return turn <= 0.0;
+    return turn <= tol * abs(c - a);
+}
+
+inline double point_segment_distance(cplx z, cplx a, cplx b) {
+    const cplx d = b - a;
+    const double len2 = dot(d, d);
+    if (len2 == 0.0) return abs(z - a);
+    const double t = std::min(std::max(dot(z - a, d) / len2, 0.0), 1.0);
+    return abs(z - (a + t * d));
+}
+
+inline bool separated(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q, cplx axis) {
+    double lo_p = dot(axis, p[0]), hi_p = lo_p;
+    for (int64_t i = 1; i < n_p; ++i) {
+        const double v = dot(axis, p[i]);
+        lo_p = std::min(lo_p, v);
+        hi_p = std::max(hi_p, v);
+    }
+    double lo_q = dot(axis, q[0]), hi_q = lo_q;
+    for (int64_t i = 1; i < n_q; ++i) {
+        const double v = dot(axis, q[i]);
+        lo_q = std::min(lo_q, v);
+        hi_q = std::max(hi_q, v);
+    }
+    return lo_q > hi_p || lo_p > hi_q;
+}
+
+}  // namespace
+
+// --------------------------------------------------------------------------------------
+// Convex hulls
+// --------------------------------------------------------------------------------------
+
+int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
+    if (n_points == 0) return 0;
+    check_capacity("convex_hull points", n_points, MAX_HULL_POINTS);
+    int64_t first = 0, last = 0;
+    for (int64_t i = 1; i < n_points; ++i) {
+        const cplx p = points[i];
+        const cplx lo = points[first], hi = points[last];
+        if (p.re < lo.re || (p.re == lo.re && p.im < lo.im)) first = i;
+        if (p.re > hi.re || (p.re == hi.re && p.im > hi.im)) last = i;
+    }
+    const cplx a = points[first], b = points[last];
+    out[0] = a;
+    if (a == b) return 1;
+    // Candidate indices, the lower side (right of a -> b) first, then the upper side.
+    int64_t index[MAX_HULL_POINTS];
+    int64_t n_lower = 0, n_upper = 0;
+    for (int64_t i = 0; i < n_points; ++i) {
+        const double side = cross(b - a, points[i] - a);
+        if (side < 0.0) {
+            index[n_lower] = i;
+            n_lower += 1;
+        }
+    }
+    for (int64_t i = 0; i < n_points; ++i) {
+        const double side = cross(b - a, points[i] - a);
+        if (side > 0.0) {
+            index[n_lower + n_upper] = i;
+            n_upper += 1;
+        }
+    }
+    // A stack of tasks: hull the chain from point chain_from to chain_to over the
+    // candidates index[start:end]; a task with start < 0 emits point chain_from instead.
+    constexpr int64_t MAX_TASKS = 2 * MAX_HULL_POINTS + 4;
+    const int64_t size = 2 * n_points + 4;
+    int64_t task_start[MAX_TASKS], task_end[MAX_TASKS], chain_from[MAX_TASKS],
+        chain_to[MAX_TASKS];
+    task_start[0] = n_lower;
+    task_end[0] = n_lower + n_upper;
+    chain_from[0] = last;
+    chain_to[0] = first;
+    task_start[1] = -1;
+    chain_from[1] = last;
+    task_start[2] = 0;
+    task_end[2] = n_lower;
+    chain_from[2] = first;
+    chain_to[2] = last;
+    int64_t top = 3;
+    int64_t k = 1;
+    while (top > 0) {
+        top -= 1;
+        const int64_t start = task_start[top], end = task_end[top], i_from = chain_from[top],
+                      i_to = chain_to[top];
+        if (start < 0) {
+            check_capacity("convex_hull output", k + 1, n_points + 1);
+            out[k] = points[i_from];
+            k += 1;
+            continue;
+        }
+        if (end <= start) continue;
+        const double ax = points[i_from].re, ay = points[i_from].im;
+        const double bx = points[i_to].re - ax, by = points[i_to].im - ay;
+        int64_t far = start;
+        double far_side = 0.0;
+        for (int64_t j = start; j < end; ++j) {
+            const cplx p = points[index[j]];
+            const double side = bx * (p.im - ay) - by * (p.re - ax);
+            if (side < far_side) {
+                far_side = side;
+                far = j;
+            }
+        }
+        const int64_t i_far = index[far];
+        const double cx = points[i_far].re, cy = points[i_far].im;
+        // Right of a -> c to the front, then right of c -> b; the rest is inside.
+        const double ux = cx - ax, uy = cy - ay;
+        int64_t n_left = 0;
+        for (int64_t j = start; j < end; ++j) {
+            const cplx p = points[index[j]];
+            if (ux * (p.im - ay) - uy * (p.re - ax) < 0.0) {
+                std::swap(index[start + n_left], index[j]);
+                n_left += 1;
+            }
+        }
+        const double vx = points[i_to].re - cx, vy = points[i_to].im - cy;
+        int64_t n_right = 0;
+        for (int64_t j = start + n_left; j < end; ++j) {
+            const cplx p = points[index[j]];
+            if (vx * (p.im - cy) - vy * (p.re - cx) < 0.0) {
+                const int64_t slot = start + n_left + n_right;
+                std::swap(index[slot], index[j]);
+                n_right += 1;
+            }
+        }
+        const int64_t mid = start + n_left;
+        check_capacity("convex_hull task stack", top + 3, size);
+        task_start[top] = mid;
+        task_end[top] = mid + n_right;
+        chain_from[top] = i_far;
+        chain_to[top] = i_to;
+        task_start[top + 1] = -1;
+        chain_from[top + 1] = i_far;
+        task_start[top + 2] = start;
+        task_end[top + 2] = mid;
+        chain_from[top + 2] = i_from;
+        chain_to[top + 2] = i_far;
+        top += 3;
+    }
+    cplx candidates[MAX_HULL_POINTS + 1];
+    std::copy(out, out + k, candidates);
+    const auto [extent, magnitude] = scale_of(candidates, k);
+    return small_convex_hull(candidates, k, out, tolerance_of(extent, magnitude));
+}
+
+int64_t small_convex_hull(const cplx* points, int64_t n_points, cplx* out, double tol) {
+    check_capacity("small_convex_hull points", n_points, MAX_HULL_POINTS);
+    int64_t chosen[MAX_HULL_POINTS + 1];
+    const int64_t k = small_hull_indices(points, n_points, chosen, tol);
+    for (int64_t v = 0; v < k; ++v) out[v] = points[chosen[v]];
+    return k;
+}
+
+int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol) {
+    if (n_points <= 0) return 0;
+    check_capacity("small_hull_indices points", n_points, MAX_HULL_POINTS);
+    int64_t order[MAX_HULL_POINTS];
+    for (int64_t i = 0; i < n_points; ++i) {  // insertion sort by (x, y)
+        const cplx p = points[i];
+        int64_t j = i;
+        while (j > 0) {
+            const cplx q = points[order[j - 1]];
+            if (q.re < p.re || (q.re == p.re && q.im <= p.im)) break;
+            order[j] = order[j - 1];
+            j -= 1;
+        }
+        order[j] = i;
+    }
+    int64_t k = 0;
+    for (int64_t j = 0; j < n_points; ++j) {  // lower chain
+        const cplx p = points[order[j]];
+        while (k >= 2 && within_chord(points[out[k - 2]], points[out[k - 1]], p, tol)) k -= 1;
+        out[k] = order[j];
+        k += 1;
+    }
+    const int64_t lower = k + 1;
+    for (int64_t j = n_points - 2; j > -1; --j) {  // upper chain
+        const cplx p = points[order[j]];
+        while (k >= lower && within_chord(points[out[k - 2]], points[out[k - 1]], p, tol)) k -= 1;
+        out[k] = order[j];
+        k += 1;
+    }
+    k -= 1;  // the last point repeats the first
+    if (k == 2 && points[out[0]] == points[out[1]]) return 1;
+    return std::max(k, int64_t{1});
+}
+
+// --------------------------------------------------------------------------------------
+// Area, centroid, containment, distance
+// --------------------------------------------------------------------------------------
+
+std::pair<double, cplx> area_centroid(const cplx* poly, int64_t n) {
+    const cplx origin = poly[0];
+    double twice_area = 0.0;
+    cplx weighted(0.0, 0.0);
+    for (int64_t i = 1; i < n - 1; ++i) {
+        const cplx a = poly[i] - origin;
+        const cplx b = poly[i + 1] - origin;
+        const double c = cross(a, b);
+        twice_area += c;
+        weighted += (a + b) * c;
+    }
+    if (twice_area > 0.0) return {0.5 * twice_area, origin + weighted / (3.0 * twice_area)};
+    cplx mean(0.0, 0.0);
+    for (int64_t i = 0; i < n; ++i) mean += poly[i];
+    return {0.0, mean / static_cast<double>(n)};
+}
+
+bool contains_point(const cplx* poly, int64_t n, cplx point, double relative) {
+    const auto [size, magnitude] = scale_of(poly, n);
+    const double tol = relative * size + 4e-16 * std::max(magnitude, abs(point));
+    if (n == 1) return abs(point - poly[0]) <= tol;
+    for (int64_t i = 0; i < n; ++i) {
+        const cplx a = poly[i];
+        const cplx edge = poly[py_mod(i + 1, n)] - a;
+        const double length = abs(edge);
+        if (length == 0.0) continue;
+        if (cross(edge, point - a) / length < -tol) return false;
+    }
+    if (n == 2) {  // a segment: also within its ends
+        const cplx edge = poly[1] - poly[0];
+        const double t = dot(point - poly[0], edge) / dot(edge, edge);
+        const double length = abs(edge);
+        return -tol / length <= t && t <= 1.0 + tol / length;
+    }
+    return true;
+}
+
+double polygon_distance(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q) {
+    bool sep = false;
+    for (int64_t i = 0; i < n_p; ++i) {
+        if (separated(p, n_p, q, n_q, MINUS_I * (p[py_mod(i + 1, n_p)] - p[i]))) {
+            sep = true;
+            break;
+        }
+    }
+    if (!sep) {
+        for (int64_t i = 0; i < n_q; ++i) {
+            if (separated(p, n_p, q, n_q, MINUS_I * (q[py_mod(i + 1, n_q)] - q[i]))) {
+                sep = true;
+                break;
+            }
+        }
+    }
+    if (!sep) {
+        for (int64_t i = 0; i < n_p; ++i) {
+            for (int64_t j = 0; j < n_q; ++j) {
+                if (separated(p, n_p, q, n_q, q[j] - p[i])) {
+                    sep = true;
+                    break;
+                }
+            }
+            if (sep) break;
+        }
+    }
+    if (!sep) return 0.0;
+    double gap = std::numeric_limits<double>::infinity();
+    for (int64_t i = 0; i < n_p; ++i) {
+        for (int64_t j = 0; j < n_q; ++j) {
+            gap = std::min(gap, point_segment_distance(p[i], q[j], q[py_mod(j + 1, n_q)]));
+            gap = std::min(gap, point_segment_distance(q[j], p[i], p[py_mod(i + 1, n_p)]));
+        }
+    }
+    return gap;
+}
+
+double longest_edge(const cplx* poly, int64_t n) {
+    double longest = 0.0;
+    for (int64_t i = 0; i < n; ++i) longest = std::max(longest, abs(poly[py_mod(i + 1, n)] - poly[i]));
+    return longest;
+}
+
+// --------------------------------------------------------------------------------------
+// Cleaning, capacity and clipping
+// --------------------------------------------------------------------------------------
+
+int64_t simplify(cplx* poly, int64_t n, double tol) {
+    bool changed = true;
+    while (changed && n >= 3) {
+        changed = false;
+        int64_t k = 0;
+        for (int64_t i = 0; i < n; ++i) {
+            const cplx prev = k > 0 ? poly[k - 1] : poly[n - 1];
+            const cplx nxt = poly[py_mod(i + 1, n)];
+            const cplx v = poly[i];
+            const cplx chord = nxt - prev;
+            const double length = abs(chord);
+            if (abs(v - prev) <= tol ||
+                (length > 0.0 && std::fabs(cross(chord, v - prev)) <= tol * length &&
+                 dot(v - prev, chord) >= 0.0 && dot(nxt - v, chord) >= 0.0)) {
+                changed = true;
+                continue;
+            }
+            poly[k] = v;
+            k += 1;
+        }
+        n = k;
+    }
+    if (n == 2 && abs(poly[1] - poly[0]) <= tol) n = 1;
+    return n;
+}
+
+int64_t drop_edges_outward(cplx* poly, int64_t n, int64_t capacity) {
+    while (n > capacity) {
+        int64_t best = -1;
+        double best_area = std::numeric_limits<double>::infinity();
+        cplx best_point(0.0, 0.0);
+        for (int64_t i = 0; i < n; ++i) {
+            const cplx a = poly[py_mod(i - 1, n)];
+            const cplx b = poly[i];
+            const cplx c = poly[py_mod(i + 1, n)];
+            const cplx d = poly[py_mod(i + 2, n)];
+            const cplx u = b - a;
+            const cplx w = d - c;
+            const double denom = cross(u, w);
+            if (!(denom > 0.0)) continue;  // the neighbouring edges turn by half a circle or more
+            const double t = cross(c - b, w) / denom;
+            const cplx meet = b + t * u;
+            const double added = 0.5 * std::fabs(cross(c - b, meet - b));
+            if (added < best_area) {
+                best = i;
+                best_area = added;
+                best_point = meet;
+            }
+        }
+        if (best < 0) break;
+        poly[best] = best_point;
+        for (int64_t j = best + 1; j < n - 1; ++j) poly[j] = poly[j + 1];
+        if (best == n - 1) {  // the removed edge wrapped around: its second vertex was poly[0]
+            for (int64_t j = 0; j < n - 1; ++j) poly[j] = poly[j + 1];
+        }
+        n -= 1;
+    }
+    return n;
+}
+
+int64_t clip_convex(const cplx* subject, int64_t n_subject, const cplx* clipper,
+                    int64_t n_clipper, cplx* out, cplx* work) {
+    const auto [size_s, mag_s] = scale_of(subject, n_subject);
+    const auto [size_c, mag_c] = scale_of(clipper, n_clipper);
+    const double size = std::min(size_s, size_c);
+    const double tol = tolerance_of(size, std::max(mag_s, mag_c));
+    check_capacity("clip_convex subject", n_subject, SCRATCH);
+    for (int64_t i = 0; i < n_subject; ++i) out[i] = subject[i];
+    int64_t n = n_subject;
+    bool in_out = true;  // whether the current polygon is in out (else in work)
+    double distances[SCRATCH];
+    for (int64_t e = 0; e < n_clipper; ++e) {
+        const cplx a = clipper[e];
+        const cplx edge = clipper[py_mod(e + 1, n_clipper)] - a;
+        const double length = abs(edge);
+        if (length == 0.0) continue;
+        cplx* current = in_out ? out : work;
+        cplx* other = in_out ? work : out;
+        bool all_in = true;
+        bool any_in = false;
+        for (int64_t i = 0; i < n; ++i) {
+            const double d = cross(edge, current[i] - a) / length;
+            distances[i] = d;
+            if (d < -tol) {
+                all_in = false;
+            } else {
+                any_in = true;
+            }
+        }
+        if (all_in) continue;
+        if (!any_in) return 0;
+        int64_t k = 0;
+        for (int64_t i = 0; i < n; ++i) {
+            const int64_t j = py_mod(i + 1, n);
+            const double di = distances[i], dj = distances[j];
+            if (di >= -tol) {
+                check_capacity("clip_convex output", k + 1, SCRATCH);
+                other[k] = current[i];
+                k += 1;
+                if (dj < -tol && di > tol) {
+                    check_capacity("clip_convex output", k + 1, SCRATCH);
+                    other[k] = current[i] + (di / (di - dj)) * (current[j] - current[i]);
+                    k += 1;
+                }
+            } else if (dj > tol) {
+                check_capacity("clip_convex output", k + 1, SCRATCH);
+                other[k] = current[i] + (di / (di - dj)) * (current[j] - current[i]);
+                k += 1;
+            }
+        }
+        in_out = !in_out;
+        n = k;
+        if (n == 0) return 0;
+    }
+    if (!in_out) {
+        for (int64_t i = 0; i < n; ++i) out[i] = work[i];
+    }
+    n = simplify(out, n, tol);
+    if (n < 3) return 0;
+    const double area = area_centroid(out, n).first;
+    if (!(area > tol * size)) return 0;
+    return drop_edges_outward(out, n, CAPACITY);
+}
+
+// --------------------------------------------------------------------------------------
+// Growing a polygon outward
+// --------------------------------------------------------------------------------------
+
+int64_t offset_outward(const cplx* poly, int64_t n, double radius, cplx* out) {
+    if (n < 1) {
+        // numba would read poly[-1] (the array's last slot): no meaningful result.
+        throw std::invalid_argument("offset_outward needs at least one vertex");
+    }
+    if (n <= 2) {
+        const cplx along = poly[n - 1] - poly[0];
+        const cplx tangent = abs(along) > 0.0 ? along / abs(along) : cplx(1.0, 0.0);
+        const cplx normal = MINUS_I * tangent;
+        const cplx start = poly[0] - radius * tangent;
+        const cplx end = poly[n - 1] + radius * tangent;
+        out[0] = start + radius * normal;
+        out[1] = end + radius * normal;
+        out[2] = end - radius * normal;
+        out[3] = start - radius * normal;
+        return 4;
+    }
+    int64_t k = 0;
+    for (int64_t i = 0; i < n; ++i) {
+        const cplx prev_edge = poly[i] - poly[py_mod(i - 1, n)];
+        const cplx next_edge = poly[py_mod(i + 1, n)] - poly[i];
+        const cplx t_in = prev_edge / abs(prev_edge);
+        const cplx t_out = next_edge / abs(next_edge);
+        const cplx n_in = MINUS_I * t_in;  // outward normals (CCW polygon)
+        const cplx n_out = MINUS_I * t_out;
+        const double cos_turn = dot(n_in, n_out);
+        if (cos_turn >= 0.0) {
+            check_capacity("offset_outward output", k + 1, n + 3);
+            out[k] = poly[i] + radius * (n_in + n_out) / (1.0 + cos_turn);
+            k += 1;
+        } else {
+            // tan(turn / 4) from the half-angle formulas, turn in (90, 180) degrees.
+            const double half_cos = std::sqrt(std::max(0.0, 0.5 * (1.0 + cos_turn)));
+            const double half_sin = std::sqrt(std::max(0.0, 0.5 * (1.0 - cos_turn)));
+            const double quarter_tan = half_sin / (1.0 + half_cos);
+            check_capacity("offset_outward output", k + 2, n + 3);
+            out[k] = poly[i] + radius * (n_in + quarter_tan * t_in);
+            out[k + 1] = poly[i] + radius * (n_out - quarter_tan * t_out);
+            k += 2;
+        }
+    }
+    return k;
+}
+
+}  // namespace bearing::slam
