@@ -25,6 +25,8 @@
     bearing-env distill [...]     DAgger from a planner (LookaheadOracle) into an SB3 model
                                   (train/sb3/distill.py)
     bearing-env hyperparams ALGO  the path of a shipped rl-zoo3 hyperparameter file
+    bearing-env docs-tables [...]  the docs' tables of measured figures, from the results
+                                  files in the repo (train/common/doc_tables.py)
     bearing-env rllib [...]       PPO with RLlib, locally or on a Ray cluster (train/ray/rllib.py)
     bearing-env sweep [...]       a Ray Tune grid of RLlib PPO runs (train/ray/sweep.py)
 
@@ -76,6 +78,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "distill": (
         "bearing_env.train.sb3.distill",
         "DAgger: train a model's actor on a planner's actions at the states it visits",
+    ),
+    "docs-tables": (
+        "bearing_env.train.common.doc_tables",
+        "write the docs' tables of measured figures from the results files in the repo",
     ),
     "hyperparams": (
         "bearing_env.train.sb3.conf_files",

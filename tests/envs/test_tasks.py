@@ -18,7 +18,7 @@ from gymnasium.utils.env_checker import check_env
 from bearing_env.envs.bearing_slam_vector import BearingSLAMVectorEnv
 from bearing_env.envs.config import DEFAULT_MAX_MOVES, EnvConfig
 from bearing_env.registration import ENV_IDS, VECTOR_ENTRY_POINTS, register_envs
-from bearing_env.tasks import BASE_IDS, TASKS, TASKS_BY_ID, Task, task_named
+from bearing_env.tasks import BASE_IDS, TASKS, TASKS_BY_ID, TRAINING_TASKS, Task, task_named
 from tests.extras import needs
 
 TASK_IDS = [task.id for task in TASKS]
@@ -38,8 +38,10 @@ def test_the_table_and_the_registry_agree() -> None:
         for spec in gym.registry.values()
         if isinstance(spec.entry_point, str) and spec.entry_point.startswith("bearing_env.")
     )
-    assert registered == sorted([*ENV_IDS, *TASK_IDS])
-    for task in TASKS:
+    training_ids = [task.id for task in TRAINING_TASKS]
+    assert registered == sorted([*ENV_IDS, *TASK_IDS, *training_ids])
+    assert not set(training_ids) & set(TASKS_BY_ID)  # the suite cards the TASKS only
+    for task in (*TASKS, *TRAINING_TASKS):
         spec = gym.spec(task.id)
         assert spec.entry_point == ENV_IDS[task.base_id]
         assert spec.vector_entry_point == VECTOR_ENTRY_POINTS[task.base_id]

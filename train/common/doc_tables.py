@@ -51,7 +51,41 @@ class Block:
 
 
 def _load(root: Path, source: str) -> Any:
+    """A results file's JSON; for a pattern (``agents/pretrained/*.json``), each file's
+    JSON by its name without the suffix, in name order."""
+    if "*" in source:
+        paths = sorted(root.glob(source))
+        return {path.stem: _load(root, str(path.relative_to(root))) for path in paths}
     return json.loads((root / source).read_text(encoding="utf-8"))
+
+
+def shipped_models(records: Mapping[str, Any]) -> str:
+    """The shipped models' table, from their records (``agents/pretrained/*.json``): what
+    each was trained on, its checkpoint, and its validation evaluation, the mean return
+    beside the total area it stands for."""
+    rows = []
+    for name, record in records.items():
+        kwargs = record.get("env_kwargs") or {}
+        settings = ", ".join(f"{key}={json.dumps(value)}" for key, value in kwargs.items())
+        task = f"`{record['env_id']}`" + (f" `{settings}`" if settings else "")
+        policy = str(record["hyperparams"].get("policy", "")).rpartition(".")[2]
+        validation = record["validation"]
+        rows.append(
+            (
+                f"`{name}`",
+                task,
+                f"`{policy}`, {record['hyperparams'].get('n_envs')} envs",
+                f"{record['num_timesteps']:,} of {record['run_timesteps']:,}",
+                f"{validation['mean_reward']:.2f}",
+                f"{validation['median_total_area_10']:.3g}",
+                f"{validation['median_total_area_final']:.3g}",
+            )
+        )
+    header = (
+        "model", "trained on", "policy", "checkpoint (steps of the run)",
+        "validation mean return", "median total area after 10 moves", "after the last move",
+    )  # fmt: skip
+    return markdown_table(header, rows)
 
 
 def markdown_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
@@ -75,6 +109,7 @@ def _blocks() -> dict[str, Block]:
         "bench-throughput": Block(bench, bench_report.markdown_throughput),
         "khepera-medians": Block(khepera, task_cards.markdown_medians),
         "fig11-fits": Block("docs/figures/figures.json", figures.markdown_fig11),
+        "shipped-models": Block("agents/pretrained/*.json", shipped_models),
     }
 
 
@@ -141,7 +176,7 @@ def write_all(root: Path) -> list[Path]:
     return changed
 
 
-def main(argv: Sequence[str] | None = None) -> None:
+def build_parser() -> argparse.ArgumentParser:
     parser: argparse.ArgumentParser = command_parser(
         "bearing-env docs-tables",
         "Write every table of measured figures in the README and the docs (and the task "
@@ -152,7 +187,11 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument(
         "--root", type=Path, default=Path("."), help="the repository (default: here)"
     )
-    args = parser.parse_args(argv)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    args = build_parser().parse_args(argv)
     if args.check:
         differing = stale(args.root)
         for entry in differing:

@@ -200,12 +200,12 @@ def reward_text(config: Any) -> str:
 def starting_state_text(config: Any, task: Task) -> str:
     """Where an episode starts (the environment page's "Starting state", for this task)."""
     if config.landmarks is not None:
-        count = len(config.landmarks)
-        layout = f"The {count} landmarks are the scenario's, the same every episode."
+        fixed = len(config.landmarks)
+        layout = f"The {fixed} landmarks are the scenario's, the same every episode."
     else:
         lo, hi = config.landmark_counts
-        count = f"{lo}" if lo == hi else f"a count drawn from {lo} to {hi}"
-        layout = f"A new layout of {count} landmarks is drawn every episode from the reset's seed."
+        drawn = f"{lo}" if lo == hi else f"a count drawn from {lo} to {hi}"
+        layout = f"A new layout of {drawn} landmarks is drawn every episode from the reset's seed."
     obstacles = " outside the obstacles," if config.obstacles else ""
     return (
         f"{layout} The robot starts at a uniformly random position inside the wall "
@@ -269,7 +269,7 @@ def summary_box(task: Task, config: Any, observation_space: Any, action_space: A
         ["Success", f"every region of L3, L4, ... ≤ {_number(config.target_area)} FL units²"],
         ["Import", f'`gym.make("bearing_env:{task.id}")`'],
     ]
-    return markdown_table(["", ""], rows)
+    return markdown_table(rows[0], rows[1:])
 
 
 def version_history(task: Task) -> list[str]:
@@ -517,11 +517,21 @@ def markdown_medians(data: Mapping[str, Any]) -> str:
     config = config_of(summary)
     header, rows = area_median_rows(summary, config)
     wanted = [i for i, name in enumerate(header) if name in ("policy", "after 10", "after 20")]
+    rates = {
+        stats.get("containment_rate") for stats in summary["policies"].values()
+    } - {None}
+    containment = (
+        f"\n\nContainment (the final region holds the true landmark): "
+        f"{100 * rates.pop():.1f}% for every policy."
+        if len(rates) == 1
+        else ""
+    )
     return (
         f"Median total area of L3 and L4 (FL units², 20 = nothing mapped), {config.episodes} "
         f"evaluation episodes per policy, from [the `{data['task']}` card]"
         f"(docs/tasks/{data['task']}.md):\n\n"
         + markdown_table([header[i] for i in wanted], [[row[i] for i in wanted] for row in rows])
+        + containment
     )
 
 

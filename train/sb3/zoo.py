@@ -111,7 +111,7 @@ def default_env_id(algo: str, conf_file: Path | None = None) -> str:
     ``BearingSLAM-Random3to16-Entities-v0``), else the algorithm's default
     (:data:`DEFAULT_ENV_IDS`)."""
     if conf_file is not None and conf_file.is_file():
-        import yaml
+        import yaml  # type: ignore[import-untyped]  # why: pyyaml ships no types
 
         try:
             entries = yaml.safe_load(conf_file.read_text(encoding="utf-8"))

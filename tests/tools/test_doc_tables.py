@@ -1,0 +1,135 @@
+"""Every table of measured figures in the README and the docs is what ``bearing-env
+docs-tables`` writes from a results file kept in the repo, and a hand-edited number
+fails the check. The reference pages state the current state (the history is in
+``docs/notes.md``) and stay short."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from bearing_env.train.common import doc_tables
+
+ROOT = Path(__file__).resolve().parents[2]
+#: Phrases of a lab notebook, which only the notes page may use.
+NOTEBOOK_PHRASES = re.compile(
+    r"under load|not kept|not shipped|not exported|the issue|target \(", re.IGNORECASE
+)
+#: The longest each reference page may be, in lines.
+PAGE_LINES = {"performance.md": 150, "training.md": 200, "policies.md": 150}
+
+
+def test_every_generated_table_matches_its_results_file() -> None:
+    assert doc_tables.stale(ROOT) == []
+
+
+def test_the_pages_hold_the_generated_blocks() -> None:
+    found = {
+        match["name"]
+        for page in doc_tables.pages(ROOT)
+        for match in doc_tables.BLOCK.finditer(page.read_text(encoding="utf-8"))
+    }
+    assert set(doc_tables._blocks()) <= found
+    assert "bench-goals" in (ROOT / "docs" / "performance.md").read_text(encoding="utf-8")
+    cards = doc_tables_cards()
+    assert len(cards) >= 10  # every task card and the index
+
+
+def doc_tables_cards() -> dict[Path, str]:
+    from bearing_env.train.compare.task_cards import published_cards
+
+    return published_cards(ROOT / "docs" / "tasks")
+
+
+def copy_of_the_docs(folder: Path) -> Path:
+    """The README, the pages, the cards and the results files, under ``folder``."""
+    shutil.copy(ROOT / "README.md", folder / "README.md")
+    shutil.copytree(ROOT / "docs", folder / "docs", ignore=shutil.ignore_patterns("_build"))
+    shutil.copytree(ROOT / "benchmarks" / "results", folder / "benchmarks" / "results")
+    return folder
+
+
+def edit_a_number(path: Path, block: str | None = None) -> None:
+    """Change one digit of the first number in ``block`` (or in the file's first table
+    row with a decimal number)."""
+    text = path.read_text(encoding="utf-8")
+    start = 0 if block is None else text.index(f"<!-- docs-tables: {block} -->")
+    match = re.compile(r"\| [^|\n]*?(\d)\.(\d)").search(text, start)
+    assert match is not None
+    digit = match.start(2)
+    changed = "1" if text[digit] != "1" else "2"
+    path.write_text(text[:digit] + changed + text[digit + 1 :], encoding="utf-8")
+
+
+@pytest.mark.parametrize(
+    ("page", "block"),
+    [
+        ("docs/performance.md", "bench-goals"),
+        ("docs/performance.md", "bench-env"),
+        ("README.md", "khepera-medians"),
+        ("docs/results.md", "fig11-fits"),
+        ("docs/tasks/BearingSLAM-Khepera-v0.md", None),
+    ],
+)
+def test_a_hand_edited_number_fails_the_check_and_is_written_back(
+    tmp_path: Path, page: str, block: str | None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    root = copy_of_the_docs(tmp_path)
+    original = (root / page).read_text(encoding="utf-8")
+    edit_a_number(root / page, block)
+    assert (root / page).read_text(encoding="utf-8") != original
+    expected = f"{page}: {block or 'the card'}"
+    assert doc_tables.stale(root) == [expected]
+    with pytest.raises(SystemExit) as stopped:
+        doc_tables.main(["--check", "--root", str(root)])
+    assert stopped.value.code == 1
+    assert f"stale: {expected}" in capsys.readouterr().out
+    doc_tables.main(["--root", str(root)])
+    assert (root / page).read_text(encoding="utf-8") == original
+    assert doc_tables.stale(root) == []
+
+
+def test_a_new_result_rewrites_the_page(tmp_path: Path) -> None:
+    import json
+
+    root = copy_of_the_docs(tmp_path)
+    results = root / "benchmarks" / "results" / "bench_env.json"
+    data = json.loads(results.read_text(encoding="utf-8"))
+    data["planning"]["median_s"] = 0.000123
+    results.write_text(json.dumps(data), encoding="utf-8")
+    assert "docs/performance.md: bench-startup" in doc_tables.stale(root)
+    doc_tables.write_all(root)
+    assert "0.12 ms per move" in (root / "docs" / "performance.md").read_text(encoding="utf-8")
+
+
+def test_the_reference_pages_hold_no_lab_notebook_phrases() -> None:
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    pages += sorted((ROOT / "docs" / "tasks").glob("*.md"))
+    found = [
+        f"{page.relative_to(ROOT)}:{number}: {line.strip()}"
+        for page in pages
+        if page.name != "notes.md"
+        for number, line in enumerate(page.read_text(encoding="utf-8").splitlines(), 1)
+        if NOTEBOOK_PHRASES.search(line)
+    ]
+    assert found == []
+
+
+@pytest.mark.parametrize(("page", "limit"), sorted(PAGE_LINES.items()))
+def test_the_reference_pages_are_short(page: str, limit: int) -> None:
+    lines = (ROOT / "docs" / page).read_text(encoding="utf-8").splitlines()
+    assert len(lines) <= limit
+
+
+def test_every_card_has_the_anchors_layout() -> None:
+    cards = sorted((ROOT / "docs" / "tasks").glob("BearingSLAM*.md"))
+    assert len(cards) == 10
+    for card in cards:
+        text = card.read_text(encoding="utf-8")
+        assert "| Action space |" in text and "| Observation space |" in text, card.name
+        for heading in ("## Starting state", "## Info", "## Version history"):
+            assert heading in text, (card.name, heading)
+        assert "../environment.md#observation" in text, card.name
