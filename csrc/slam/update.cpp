@@ -7,6 +7,8 @@
 #include <exception>
 #include <limits>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -258,6 +260,75 @@ void rebuild_row(int64_t i, int64_t row, int64_t n_landmarks, const Params& para
     state.robot_fixed_at(row) = fixed_by_newest ? state.n_updates(row) : -1;
 }
 
+[[noreturn]] void corrupt(int64_t row, const char* what) {
+    throw std::invalid_argument("map " + std::to_string(row) + " has a corrupt state: " + what);
+}
+
+// The counts and positions of map row that the update indexes buffers with (written by
+// the kernels only, but a user can write the arrays): any out of range raises
+// std::invalid_argument (a ValueError in Python) before the map is written.
+void check_map(const MapState& state, int64_t row, const Params& params) {
+    const int64_t m = state.counts.shape[1];
+    for (int64_t j = 0; j < m; ++j) {
+        const int64_t n = state.counts(row, j);
+        if (n < 0 || n > state.vertices.shape[2]) corrupt(row, "counts out of range");
+    }
+    const int64_t n_robot = state.robot_counts(row);
+    if (n_robot < 0 || n_robot > state.robot_vertices.shape[1]) {
+        corrupt(row, "robot_counts out of range");
+    }
+    if (params.fusion == FUSION_RELAXED) {
+        const int64_t w = state.window_counts.shape[1];
+        if (state.window_length(row) < 0 || state.window_length(row) > w) {
+            corrupt(row, "window_length out of range");
+        }
+        if (state.window_next(row) < 0 || state.window_next(row) >= w) {
+            corrupt(row, "window_next out of range");
+        }
+        for (int64_t slot = 0; slot < w; ++slot) {
+            for (int64_t j = 0; j < m; ++j) {
+                const int64_t n = state.window_counts(row, slot, j);
+                if (n < 0 || n > state.window_vertices.shape[3]) {
+                    corrupt(row, "window_counts out of range");
+                }
+            }
+        }
+        for (int64_t j = 0; j < m; ++j) {
+            const int64_t n = state.base_counts(row, j);
+            if (n < 0 || n > state.base_vertices.shape[2]) corrupt(row, "base_counts out of range");
+        }
+    }
+    if (params.fusion == FUSION_ROBUST) {
+        for (int64_t j = 0; j < m; ++j) {
+            if (state.n_regions(row, j) < 0) corrupt(row, "n_regions negative");
+            for (int64_t k = 0; k < state.level_counts.shape[2]; ++k) {
+                const int64_t n = state.level_counts(row, j, k);
+                if (n < 0 || n > state.level_vertices.shape[3]) {
+                    corrupt(row, "level_counts out of range");
+                }
+            }
+        }
+        if (!(state.noise_scale(row) > 0.0) || !std::isfinite(state.noise_scale(row))) {
+            corrupt(row, "noise_scale not a positive number");
+        }
+        if (params.estimate_bound) {
+            const int64_t h = state.history_bearings.shape[1];
+            for (int64_t j = 0; j < m; ++j) {
+                const int64_t n = state.probe_counts(row, j);
+                if (n < 0 || n > state.probe_vertices.shape[2]) {
+                    corrupt(row, "probe_counts out of range");
+                }
+            }
+            if (state.history_length(row) < 0 || state.history_length(row) > h) {
+                corrupt(row, "history_length out of range");
+            }
+            if (state.history_next(row) < 0 || state.history_next(row) >= h) {
+                corrupt(row, "history_next out of range");
+            }
+        }
+    }
+}
+
 // update_maps for bearings rows first to stop, in one thread's buffers.
 void update_rows(int64_t first, int64_t stop, View2<const double> bearings_start,
                  View2<const double> bearings_end, View1<const int64_t> rows,
@@ -270,6 +341,7 @@ void update_rows(int64_t first, int64_t stop, View2<const double> bearings_start
     buf.robot_point[0] = cplx(1.0, 0.0);
     for (int64_t i = first; i < stop; ++i) {
         const int64_t row = rows(i);
+        check_map(state, row, params);
         double epsilon = params.epsilon;
         if (estimating) epsilon *= state.noise_scale(row);
         const double* start = bearings_start.row(i);
@@ -303,6 +375,19 @@ void update_maps(View2<const double> bearings_start, View2<const double> bearing
                  const Outputs& out, int64_t threads) {
     const int64_t n_rows = rows.shape[0];
     check_capacity("landmarks per movement", bearings_start.shape[1], MAX_LANDMARKS);
+    if (bearings_start.shape[1] != state.counts.shape[1] + 2 ||
+        bearings_end.shape[1] != bearings_start.shape[1] ||
+        bearings_start.shape[0] < n_rows || bearings_end.shape[0] < n_rows ||
+        out.frame_status.shape[0] < n_rows || out.n_bad.shape[0] < n_rows ||
+        out.landmark_status.shape[0] < n_rows ||
+        out.landmark_status.shape[1] != state.counts.shape[1]) {
+        throw std::invalid_argument("update_maps: bearings or outputs of the wrong shape");
+    }
+    for (int64_t i = 0; i < n_rows; ++i) {
+        if (rows(i) < 0 || rows(i) >= state.counts.shape[0]) {
+            throw std::invalid_argument("update_maps: rows out of range");
+        }
+    }
     if (n_rows == 0) return;
     const int64_t blocks = std::max<int64_t>(1, std::min(threads, n_rows));
     if (blocks == 1) {

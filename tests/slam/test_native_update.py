@@ -53,6 +53,12 @@ class Setting:
     noise_factor: float = 1.0  # the true noise bound over epsilon
     p_outlier: float = 0.0  # chance a reading is replaced by a random angle
     p_missing: float = 0.0  # chance a reading is missed (NaN)
+    # Degenerate inputs: bearings rounded to a grid (exact ties, collinear cones), moves
+    # of length 0 (start and end bearings alike: unbounded regions), landmarks on top of
+    # each other (identical regions).
+    quantum_deg: float = 0.0
+    p_still: float = 0.0
+    p_twin: float = 0.0
     maps: int = 8
     seed: int = 0
 
@@ -90,6 +96,10 @@ class Walk:
         self.landmarks[close, 1] = self.landmarks[close, 0] + 0.02 * np.exp(
             1j * rng.uniform(-np.pi, np.pi, close.sum())
         )
+        if setting.p_twin > 0:
+            for k in range(1, n):
+                twin = rng.random(maps) < setting.p_twin
+                self.landmarks[twin, k] = self.landmarks[twin, k - 1]
         self.position = rng.uniform(0, w, maps) + 1j * rng.uniform(0, h, maps)
 
     def move(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -98,6 +108,8 @@ class Walk:
         start = self.position[rows]
         heading = rng.uniform(-np.pi, np.pi, rows.size)
         length = rng.uniform(0.05, 0.3, rows.size)
+        if s.p_still > 0:
+            length[rng.random(rows.size) < s.p_still] = 0.0
         end = start + length * np.exp(1j * heading)
         outside = (end.real < 0) | (end.real > ARENA[0]) | (end.imag < 0) | (end.imag > ARENA[1])
         centre = complex(ARENA[0] / 2, ARENA[1] / 2)
@@ -114,6 +126,9 @@ class Walk:
             np.angle(marks - end[:, None]) - heading[:, None] + bound * rng.uniform(-1, 1, shape)
         )
         for b in (b1, b2):
+            if s.quantum_deg > 0:
+                quantum = math.radians(s.quantum_deg)
+                b[...] = wrap(np.round(b / quantum) * quantum)
             if s.p_outlier > 0:
                 out = rng.random(shape) < s.p_outlier
                 b[out] = rng.uniform(-np.pi, np.pi, out.sum())
@@ -261,6 +276,9 @@ FAST_SETTINGS = [
         p_outlier=0.05,
         maps=4,
     ),
+    Setting(seed=15, quantum_deg=1.0, p_still=0.1, p_twin=0.2, p_missing=0.05),
+    Setting(seed=16, fusion="relaxed", quantum_deg=5.0, p_still=0.1, p_twin=0.2, window=4),
+    Setting(seed=17, fusion="robust", quantum_deg=0.5, p_still=0.1, p_twin=0.2, noise_factor=1.5),
     Setting(
         seed=14, fusion="relaxed", n_landmarks=30, window=8, max_outliers=3, p_outlier=0.1, maps=4
     ),
@@ -287,6 +305,9 @@ def random_setting(rng: np.random.Generator, seed: int) -> Setting:
         noise_factor=float(rng.choice([0.5, 1.0, 1.3, 1.7, 2.5])),
         p_outlier=float(rng.choice([0.0, 0.02, 0.1, 0.25])),
         p_missing=float(rng.choice([0.0, 0.05, 0.2])),
+        quantum_deg=float(rng.choice([0.0, 0.0, 0.0, 0.5, 5.0])),
+        p_still=float(rng.choice([0.0, 0.0, 0.1])),
+        p_twin=float(rng.choice([0.0, 0.0, 0.1])),
         maps=int(rng.integers(2, 17)),
         seed=seed,
     )
@@ -466,6 +487,22 @@ def test_bad_inputs_name_the_argument() -> None:
     fails(ValueError, "FUSION_RELAXED", b, b, rows, relaxed, native, out)
     robust = native_params(batch._kernel_params(True)._replace(fusion=kernels.FUSION_ROBUST))
     fails(ValueError, "FUSION_ROBUST", b, b, rows, robust, native, out)
+
+    # A corrupt state (counts or positions that would index past a buffer).
+    for fusion, name, value in [
+        ("intersect", "counts", kernels.CAPACITY + 1),
+        ("intersect", "robot_counts", -1),
+        ("relaxed", "window_next", 99),
+        ("relaxed", "window_counts", 1000),
+        ("robust", "level_counts", -3),
+        ("robust", "history_next", 16),
+        ("robust", "noise_scale", 0.0),
+    ]:
+        corrupt = dataclasses.replace(setting, fusion=fusion).batch()
+        getattr(corrupt, name).flat[0] = value
+        corrupt_params = native_params(corrupt._kernel_params(True))
+        with pytest.raises(ValueError, match=f"corrupt state: {name}"):
+            _core.update_maps(b, b, rows, corrupt_params, _core.MapState(state_of(corrupt)), out)
 
     # Params.
     good = tuple(batch._kernel_params(True))
