@@ -6,6 +6,8 @@
                                   make bench)
     bearing-env bench-slam [...]  world-model update() throughput against CartPole-v1
                                   (benchmarks/bench_slam.py; also ``bearing-env bench --slam``)
+    bearing-env bench-callgrind [...]  instructions per map update and per env step,
+                                  counted by valgrind (benchmarks/bench_callgrind.py)
     bearing-env region-search [...]  a seeded search for regions that break the world
                                   model's promises (benchmarks/region_search.py)
     bearing-env soak [...]        the envs over random configurations, checking the
@@ -62,6 +64,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "bench-slam": (
         "bearing_env.benchmarks.bench_slam",
         "world-model update() throughput vs CartPole-v1",
+    ),
+    "bench-callgrind": (
+        "bearing_env.benchmarks.bench_callgrind",
+        "instructions per map update and per env step, counted by valgrind (load-independent)",
     ),
     "region-search": (
         "bearing_env.benchmarks.region_search",

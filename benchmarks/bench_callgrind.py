@@ -1,0 +1,139 @@
+"""``bearing-env bench-callgrind``: instructions per map update and per env step, counted
+by valgrind's callgrind, a figure that does not drift with the machine's load.
+
+Ratios to CartPole-v1 (``bearing-env bench``) move with whatever else the machine runs;
+callgrind counts the instructions the native core executes, which are the same on every
+run of the same build on the same inputs. Use it to compare two versions of a kernel.
+
+    bearing-env bench-callgrind [--movements 400] [--steps 400] [--json out.json]
+
+Two runs of a small driver under ``valgrind --tool=callgrind``, each collecting only
+inside one native entry point (``--toggle-collect``):
+
+- ``update``: ``bearing::slam::update_maps``, called by ``PolygonSLAM.update`` on the
+  readings of ``bench-slam`` (4 landmarks, epsilon 2 degrees), per transfer;
+- ``step``: ``bearing::env::step_rows``, the whole native env step (moves, readings, map
+  update, rewards, observation and info arrays), on ``BearingSLAM-Khepera-v0`` with
+  seeded random actions.
+
+Each figure is the instruction count (callgrind's Ir) divided by the movements or steps,
+and the functions with the largest inclusive share are listed: where the time goes.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from bearing_env.train.common.cli_parser import add_json_output, command_parser, doc_summary
+from bearing_env.train.common.cli_values import at_least
+from bearing_env.train.common.errors import exit_on_output_errors
+from bearing_env.train.common.files import atomic_write_text
+
+#: The native entry point each measurement collects inside.
+ENTRY_POINTS = {"update": "bearing::slam::update_maps*", "step": "bearing::env::step_rows*"}
+
+UPDATE_DRIVER = """
+import sys
+import numpy as np
+from bearing_env.benchmarks.bench_slam import make_readings
+from bearing_env.slam import PolygonSLAM
+movements, transfer = int(sys.argv[1]), sys.argv[2]
+readings = make_readings(4, 20, seed=4)
+slam = PolygonSLAM(4, np.deg2rad(2.0), transfer=transfer)
+done = 0
+while done < movements:
+    slam.reset()
+    for b1, b2 in readings[: movements - done]:
+        slam.update(b1, b2)
+        done += 1
+print(done)
+"""
+
+STEP_DRIVER = """
+import sys
+import gymnasium as gym
+import numpy as np
+import bearing_env
+steps = int(sys.argv[1])
+env = gym.make("BearingSLAM-Khepera-v0").unwrapped
+env.reset(seed=0)
+rng = np.random.default_rng(0)
+for _ in range(steps):
+    action = rng.uniform(-1.0, 1.0, 2).astype(np.float32)
+    _, _, terminated, truncated, _ = env.step(action)
+    if terminated or truncated:
+        env.reset()
+print(steps)
+"""
+
+
+def count(driver: str, entry: str, arguments: Sequence[str], top: int = 12) -> dict[str, Any]:
+    """Run ``driver`` under callgrind collecting inside ``entry``; the total instructions
+    and the ``top`` functions by inclusive instructions."""
+    valgrind = shutil.which("valgrind")
+    if valgrind is None:
+        raise SystemExit("bearing-env bench-callgrind: valgrind is not installed")
+    with tempfile.TemporaryDirectory() as folder:
+        out = Path(folder) / "callgrind.out"
+        command = [
+            valgrind, "--tool=callgrind", f"--callgrind-out-file={out}",
+            f"--toggle-collect={entry}", sys.executable, "-c", driver, *arguments,
+        ]  # fmt: skip
+        result = subprocess.run(command, capture_output=True, text=True)
+        if result.returncode != 0:
+            raise SystemExit(f"callgrind run failed:\n{result.stderr[-3000:]}")
+        totals = re.search(r"^(?:totals|summary): (\d+)", out.read_text(), re.M)
+        if totals is None:
+            raise SystemExit(f"no totals in {out}")
+        annotate = subprocess.run(
+            ["callgrind_annotate", "--inclusive=yes", str(out)],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout
+    functions = []
+    for line in annotate.splitlines():
+        match = re.match(r"\s*([\d,]+)\s+\(\s*([\d.]+)%\)\s+\S*:(.+?)(?: \[.*\])?$", line)
+        if match and len(functions) < top:
+            instructions = int(match[1].replace(",", ""))
+            functions.append(
+                {"function": match[3].strip(), "instructions": instructions,
+                 "share": float(match[2]) / 100}
+            )  # fmt: skip
+    return {"instructions": int(totals[1]), "functions": functions}
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    parser = command_parser("bearing-env bench-callgrind", doc_summary(__doc__))
+    parser.add_argument("--movements", type=at_least(1), default=400,
+                        help="map updates counted per transfer (default %(default)s)")  # fmt: skip
+    parser.add_argument("--steps", type=at_least(1), default=400,
+                        help="env steps counted (default %(default)s)")  # fmt: skip
+    add_json_output(parser, "the counts")
+    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    results: dict[str, Any] = {}
+    for transfer in ("conservative", "paper"):
+        counted = count(UPDATE_DRIVER, ENTRY_POINTS["update"], [str(args.movements), transfer])
+        per = counted["instructions"] / args.movements
+        results[f"update_{transfer}_4"] = {**counted, "count": args.movements, "per_call": per}
+        print(f"PolygonSLAM.update, 4 landmarks, {transfer:>12}: {per:12,.0f} instructions"
+              " per movement")  # fmt: skip
+    counted = count(STEP_DRIVER, ENTRY_POINTS["step"], [str(args.steps)])
+    per = counted["instructions"] / args.steps
+    results["step_khepera"] = {**counted, "count": args.steps, "per_call": per}
+    print(f"BearingSLAM-Khepera-v0 env step (native part):   {per:12,.0f} instructions per step")
+    if args.json is not None:
+        with exit_on_output_errors(parser, args.json, "--json", refusals=()):
+            atomic_write_text(args.json, json.dumps(results, indent=2))
+
+
+if __name__ == "__main__":
+    main()
