@@ -202,20 +202,32 @@ def fake_summary(folder: Path, means: dict[str, float]) -> None:
 
 
 def test_the_index_keeps_the_rows_of_tasks_this_run_did_not_compare(tmp_path: Path) -> None:
+    """The overview is read from the cards' results files (``docs/results/<id>.json``),
+    which a later run on some of the tasks leaves in place for the others."""
     from bearing_env.train.compare.task_cards import INDEX_NAME, card_name, write_index
 
     first, second, uncarded = (TASKS_BY_ID[t] for t in (*TWO_TASKS, "BearingSLAM-Random8-v0"))
-    docs, earlier, later = tmp_path / "docs", tmp_path / "earlier", tmp_path / "later"
+    docs, scratch = tmp_path / "docs", tmp_path / "scratch"
     docs.mkdir()
+    scratch.mkdir()
     for task in (first, second):
         (docs / card_name(task)).write_text("# card\n")
-    fake_summary(earlier / first.id, {"random_polygonal": 2.0, "greedy_one_step": 0.5})
-    fake_summary(earlier / second.id, {"random_polygonal": 3.0, "greedy_one_step": 0.25})
-    fake_summary(earlier / uncarded.id, {"random_polygonal": 9.0})
-    write_index(TASKS, docs, earlier)
+
+    def results(task_id: str, means: dict[str, float]) -> None:
+        folder = scratch / f"{task_id}-{len(list(scratch.glob('*')))}"
+        fake_summary(folder, means)
+        summary = json.loads((folder / "summary.json").read_text())
+        (docs / "results").mkdir(exist_ok=True)
+        data = {"task": task_id, "command": None, "summary": summary}
+        (docs / "results" / f"{task_id}.json").write_text(json.dumps(data))
+
+    results(first.id, {"random_polygonal": 2.0, "greedy_one_step": 0.5})
+    results(second.id, {"random_polygonal": 3.0, "greedy_one_step": 0.25})
+    results(uncarded.id, {"random_polygonal": 9.0})
+    write_index(TASKS, docs)
     # A later run compares the first task only, with another policy set.
-    fake_summary(later / first.id, {"random_polygonal": 1.5, "lookahead": 0.125})
-    write_index(TASKS, docs, later)
+    results(first.id, {"random_polygonal": 1.5, "lookahead": 0.125})
+    write_index(TASKS, docs)
     glance = (docs / INDEX_NAME).read_text().split("## Baselines at a glance", 1)[1]
     table = [line for line in glance.splitlines() if line.startswith("|")]
     rows = {line.split("|")[1].strip(): line for line in table if "-v0" in line}
