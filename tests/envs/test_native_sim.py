@@ -173,14 +173,28 @@ def test_obstacle_kernels(
             assert_same_call(
                 sensing.visible,
                 _core.visible,
-                x, y, heading, tx, ty, half_fov, max_range, vertices, starts,
-            )  # fmt: skip
+                x,
+                y,
+                heading,
+                tx,
+                ty,
+                half_fov,
+                max_range,
+                vertices,
+                starts,
+            )
     settings_ = (2.0, 2.0, margin, 1e-4)
     assert_same_call(
         world.obstructed_move,
         _core.obstructed_move,
-        abs(x), abs(y), heading, length, settings_, vertices, starts,
-    )  # fmt: skip
+        abs(x),
+        abs(y),
+        heading,
+        length,
+        settings_,
+        vertices,
+        starts,
+    )
 
 
 # ----------------------------------------------------------------------------------------
@@ -211,8 +225,9 @@ def test_moves_and_sight_among_random_obstacles(seed: int) -> None:
             max_range = float(rng.choice([math.inf, rng.uniform(0.0, 2.0)]))
             vis = (float(x), float(y), heading, float(tx), float(ty), half_fov, max_range)
             assert_same_call(sensing.visible, _core.visible, *vis, vertices, starts)
-            assert_same_call(sensing.clearance, _core.clearance, float(x), float(y), vertices,
-                             starts)  # fmt: skip
+            assert_same_call(
+                sensing.clearance, _core.clearance, float(x), float(y), vertices, starts
+            )
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -293,9 +308,15 @@ def test_bad_arguments_are_refused_naming_them() -> None:
     with pytest.raises(ValueError, match="landmarks must be C-contiguous"):
         landmarks = np.zeros((2, 3, 4))[:, :, ::2]
         _core.visible_rows(
-            landmarks, np.zeros((2, 2)), np.zeros(2), 1.0, 1.0, vertices, starts,
+            landmarks,
+            np.zeros((2, 2)),
+            np.zeros(2),
+            1.0,
+            1.0,
+            vertices,
+            starts,
             np.zeros((2, 3), bool),
-        )  # fmt: skip
+        )
     with pytest.raises(TypeError):
         _core.obstructed_move(0.0, 0.0, 0.0, 1.0, (1.0, 1.0, 0.0), vertices, starts)
 
