@@ -205,3 +205,209 @@ def transfer_region(
     hull: NDArray[np.complex128],
     out: NDArray[np.complex128],
 ) -> int: ...
+
+# ---- The simulator (csrc/bindings/bind_sim.cpp; keep in step with it) ----
+# Same signatures and return conventions as the numba kernels of bearing_env.world and
+# bearing_env.sensing; `out` arrays are written in place. Obstacles are packed:
+# vertices (V, 2) float64, starts (k + 1,) int64.
+
+def _add_wrapped(
+    true_bearings: NDArray[np.float64], offsets: NDArray[np.float64], out: NDArray[np.float64]
+) -> None: ...
+def _add_wrapped_with_outliers(
+    true_bearings: NDArray[np.float64],
+    offsets: NDArray[np.float64],
+    is_outlier: NDArray[np.bool_],
+    replacement: NDArray[np.float64],
+    out: NDArray[np.float64],
+) -> None: ...
+def bearing(landmark_x: float, landmark_y: float, x: float, y: float, heading: float) -> float: ...
+def straight_move(
+    x: float,
+    y: float,
+    heading: float,
+    length: float,
+    width: float,
+    height: float,
+    margin: float,
+    min_baseline: float,
+) -> tuple[float, float, float, bool]: ...
+def obstructed_move(
+    x: float,
+    y: float,
+    heading: float,
+    length: float,
+    settings: tuple[float, float, float, float],
+    vertices: NDArray[np.float64],
+    starts: NDArray[np.int64],
+) -> tuple[float, float, float, bool]: ...
+def _true_bearings_into(
+    landmarks: NDArray[np.float64],
+    positions: NDArray[np.float64],
+    headings: NDArray[np.float64],
+    out: NDArray[np.float64],
+) -> None: ...
+def _edge_entry(
+    x: float,
+    y: float,
+    dx: float,
+    dy: float,
+    ax: float,
+    ay: float,
+    bx: float,
+    by: float,
+    margin: float,
+) -> float: ...
+def _disc_entry(
+    x: float, y: float, dx: float, dy: float, cx: float, cy: float, r: float
+) -> float: ...
+def free_length(
+    x: float,
+    y: float,
+    heading: float,
+    vertices: NDArray[np.float64],
+    starts: NDArray[np.int64],
+    margin: float,
+) -> float: ...
+def _cross(ox: float, oy: float, ax: float, ay: float, bx: float, by: float) -> float: ...
+def segments_cross(
+    px: float, py: float, qx: float, qy: float, ax: float, ay: float, bx: float, by: float
+) -> bool: ...
+def _on_segment(ax: float, ay: float, bx: float, by: float, px: float, py: float) -> bool: ...
+def line_of_sight(
+    x: float,
+    y: float,
+    target_x: float,
+    target_y: float,
+    vertices: NDArray[np.float64],
+    starts: NDArray[np.int64],
+) -> bool: ...
+def visible(
+    x: float,
+    y: float,
+    heading: float,
+    target_x: float,
+    target_y: float,
+    half_fov: float,
+    max_range: float,
+    vertices: NDArray[np.float64],
+    starts: NDArray[np.int64],
+) -> bool: ...
+def inside_polygon(
+    x: float, y: float, vertices: NDArray[np.float64], first: int, last: int
+) -> bool: ...
+def _segment_distance(x: float, y: float, ax: float, ay: float, bx: float, by: float) -> float: ...
+def clearance(
+    x: float, y: float, vertices: NDArray[np.float64], starts: NDArray[np.int64]
+) -> float: ...
+def visible_rows(
+    landmarks: NDArray[np.float64],
+    positions: NDArray[np.float64],
+    headings: NDArray[np.float64],
+    half_fov: float,
+    max_range: float,
+    vertices: NDArray[np.float64],
+    starts: NDArray[np.int64],
+    out: NDArray[np.bool_],
+) -> None: ...
+
+# ---- The env step (csrc/bindings/bind_env.cpp; keep in step with it) ----
+# The kernels of bearing_env.envs.kernels, bearing_env.envs.robot_map and agents.planning.
+# A report is kernels.Report's 16 arrays in order (a Report or a plain tuple); the encoded
+# robot map is robot_map.encode_map's 12 arrays (complex ones as complex128). A map state
+# (`state` of the codec) is a MapState, a bearing_env.slam.kernels.State tuple, an object
+# with State's arrays as attributes (a BatchedPolygonSLAM) or an EnvInputs (its maps).
+
+STEP_DONE: int
+STEP_NEEDS_NOISE: int
+STEP_NEEDS_TRAJECTORY: int
+ACTIONS_OK: int
+ACTIONS_NOT_FINITE: int
+ACTIONS_OUTSIDE: int
+
+class EnvInputs:
+    """A group's kernel inputs, made once per group and state: its kernels.Settings, the
+    map update's Params and MapState, the envs' BatchState (arrays checked and kept)."""
+
+    def __init__(self, settings: Any, params: Params | Any, maps: Any, state: Any) -> None: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def num_rows(self) -> int: ...
+    @property
+    def observation_size(self) -> int: ...
+
+class StepOutputs:
+    """A group's step outputs, made once: a report's arrays (a step writes their first
+    len(rows) rows), the encoded robot map's (or None) and the step's buffers."""
+
+    def __init__(
+        self,
+        inputs: EnvInputs,
+        report: tuple[NDArray[Any], ...],
+        encoded: tuple[NDArray[Any], ...] | None = None,
+    ) -> None: ...
+    @property
+    def capacity(self) -> int: ...
+    @property
+    def with_map(self) -> bool: ...
+
+def step_rows(
+    rows: NDArray[np.int64],
+    turns: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    inputs: EnvInputs,
+    trajectory: NDArray[np.float64],
+    threads: int,
+    outputs: StepOutputs,
+    with_map: bool,
+) -> int: ...
+def new_report(size: int, inputs: EnvInputs) -> tuple[NDArray[Any], ...]: ...
+def report_rows(
+    rows: NDArray[np.int64], inputs: EnvInputs, map_slots: int
+) -> tuple[tuple[NDArray[Any], ...], tuple[NDArray[Any], ...]]: ...
+def potentials(rows: NDArray[np.int64], inputs: EnvInputs, out: NDArray[np.float64]) -> None: ...
+def move_and_read(
+    row: int,
+    turn: float,
+    length: float,
+    inputs: EnvInputs,
+    reading_start: NDArray[np.float64],
+    reading_end: NDArray[np.float64],
+) -> float: ...
+def append_positions(
+    rows: NDArray[np.int64],
+    positions: NDArray[np.float64],
+    trajectory: NDArray[np.float64],
+    lengths: NDArray[np.int64],
+) -> bool: ...
+def capped(area: float, floor: float, cap: float) -> float: ...
+def potential_of(
+    areas: NDArray[np.float64], n_mapped: int, log_area: bool, floor: float, cap: float
+) -> float: ...
+def _write_shape(
+    vertices: NDArray[np.complex128], count: int, out: NDArray[np.float32], j: int
+) -> None: ...
+def decode_continuous(
+    actions: NDArray[np.float32] | NDArray[np.float64],
+    lo: float,
+    hi: float,
+    turns: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+) -> int: ...
+def _known(value: complex) -> complex: ...
+def encode_map(state: Any, rows: NDArray[np.int64], slots: int) -> tuple[NDArray[Any], ...]: ...
+def encode_map_into(
+    state: Any, rows: NDArray[np.int64], encoded: tuple[NDArray[Any], ...]
+) -> None: ...
+def encode_window(state: Any, rows: NDArray[np.int64], slots: int) -> tuple[NDArray[Any], ...]: ...
+def encode_levels(state: Any, rows: NDArray[np.int64], slots: int) -> tuple[NDArray[Any], ...]: ...
+def _potentials_of_rows(
+    rows: NDArray[np.float64], log_area: bool, floor: float, cap: float, out: NDArray[np.float64]
+) -> None: ...
+def _move_ends(
+    start: complex,
+    headings: NDArray[np.float64],
+    distances: NDArray[np.float64],
+    out: NDArray[np.complex128],
+) -> None: ...
