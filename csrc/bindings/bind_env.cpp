@@ -257,6 +257,17 @@ struct StepOutputs {
     }
 };
 
+// The map state the codec reads: an EnvInputs' (no arrays checked again: the cheap form
+// for a step's info), or what map_state_of takes (MapState, State tuple, batch).
+slam::MapState maps_of(nb::handle obj, Kept& kept) {
+    EnvInputs* inputs = nullptr;
+    if (nb::try_cast(obj, inputs) && inputs != nullptr) {
+        kept.push_back(nb::borrow(obj));
+        return inputs->inputs.maps;
+    }
+    return bindings::map_state_of(obj, kept);
+}
+
 // Marks outputs as in use for one call (two threads may not step one group at once).
 struct InUse {
     std::atomic<bool>& busy;
@@ -548,17 +559,18 @@ void bind_env(nb::module_& m) {
         "encode_map",
         [](nb::handle maps, nb::handle rows, int64_t slots) {
             Kept kept;
-            const slam::MapState state = bindings::map_state_of(maps, kept);
+            const slam::MapState state = maps_of(maps, kept);
             auto r = rows_of(rows, state.counts.shape[0], nullptr);
             return encode_map_new(state, r, slots);
         },
         "state"_a, "rows"_a, "slots"_a,
-        "The arrays every fusion uses, for rows, landmark slots padded to slots.");
+        "The arrays every fusion uses, for rows, landmark slots padded to slots; state is a "
+        "MapState, a State tuple, an object with State's arrays, or an EnvInputs (its maps).");
     m.def(
         "encode_map_into",
         [](nb::handle maps, nb::handle rows, nb::handle encoded) {
             Kept kept;
-            const slam::MapState state = bindings::map_state_of(maps, kept);
+            const slam::MapState state = maps_of(maps, kept);
             auto r = rows_of(rows, state.counts.shape[0], nullptr);
             const env::Encoded e = encoded_of(encoded, state, r.shape[0], kept);
             nb::gil_scoped_release release;
@@ -569,7 +581,7 @@ void bind_env(nb::module_& m) {
         "encode_window",
         [](nb::handle maps, nb::handle rows, int64_t slots) {
             Kept kept;
-            const slam::MapState s = bindings::map_state_of(maps, kept);
+            const slam::MapState s = maps_of(maps, kept);
             auto r = rows_of(rows, s.counts.shape[0], nullptr);
             const int64_t size = r.shape[0], window = s.window_vertices.shape[1];
             if (slots < s.counts.shape[1]) value_error("slots must be at least the mapped landmarks");
@@ -606,7 +618,7 @@ void bind_env(nb::module_& m) {
         "encode_levels",
         [](nb::handle maps, nb::handle rows, int64_t slots) {
             Kept kept;
-            const slam::MapState s = bindings::map_state_of(maps, kept);
+            const slam::MapState s = maps_of(maps, kept);
             auto r = rows_of(rows, s.counts.shape[0], nullptr);
             const int64_t size = r.shape[0], levels = s.level_vertices.shape[2];
             const int64_t history = s.history_bearings.shape[1];

@@ -447,6 +447,19 @@ def test_potentials_and_the_robot_map_codec(fusion: str) -> None:
             tuple(map(str, range(13))),
             "encode_levels",
         )
+        # an EnvInputs stands for its map state (no arrays checked again)
+        assert_same_tuple(
+            _core.encode_window(tuple_state, rows, slots),
+            _core.encode_window(inputs, rows, slots),
+            tuple(map(str, range(10))),
+            "encode_window(inputs)",
+        )
+        assert_same_tuple(
+            _core.encode_levels(tuple_state, rows, slots),
+            _core.encode_levels(inputs, rows, slots),
+            tuple(map(str, range(13))),
+            "encode_levels(inputs)",
+        )
     # encode_map_into over arrays that held something else
     encoded = tuple(np.full_like(a, 7) for a in robot_map.encode_map(ref_state, rows, 5))
     native = tuple(a.copy() for a in encoded)
