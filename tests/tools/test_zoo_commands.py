@@ -302,7 +302,10 @@ def test_a_documented_training_command_evaluates_on_its_training_task(
     assert (folder / "evaluations.npz").is_file()  # the evaluation env did run
     # rl-zoo3 saves the entry with Python tags (an OrderedDict of pairs).
     saved = yaml.load((folder / env_id / "config.yml").read_text(), Loader=yaml.UnsafeLoader)
-    saved_kwargs = dict(dict(saved)["env_kwargs"])
+    # An entry keyed by a task id has no env_kwargs: the id's own kwargs are the settings.
+    import gymnasium as gym
+
+    saved_kwargs = {**gym.spec(env_id).kwargs, **dict(dict(saved).get("env_kwargs") or {})}
     assert repr(EnvConfig.create(**saved_kwargs)) == expected
 
 
