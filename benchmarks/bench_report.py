@@ -173,6 +173,10 @@ def machine_info() -> dict[str, Any]:
         if module in sys.modules:
             info[module] = getattr(sys.modules[module], "__version__", None)
     info["commit"] = source_commit()
+    with contextlib.suppress(OSError, AttributeError):
+        # Other jobs on the machine move every figure: the 1-minute load average at the
+        # time the JSON is written, for the reader of the results.
+        info["load_average_1min"] = round(os.getloadavg()[0], 2)
     return info
 
 
@@ -554,7 +558,13 @@ def markdown_machine(results: dict[str, Any]) -> str:
         f"({results['settings']['seconds']:g} s per figure) on {results['started'][:10]}, "
         f"{code}, on a {machine['cpu_count']}-core {machine['processor']} machine "
         f"(`{machine['platform']}`, Python {machine['python']}, numpy {machine['numpy']}, "
-        f"Gymnasium {machine['gymnasium']}); file `benchmarks/results/bench_env.json`. "
+        f"Gymnasium {machine['gymnasium']}"
+        + (
+            f"; load average {machine['load_average_1min']:g} as the run ended"
+            if "load_average_1min" in machine
+            else ""
+        )
+        + "); file `benchmarks/results/bench_env.json`. "
         "CartPole-v1's `env.step` measured in the same run: "
         + ", ".join(
             f"{ref['steps_per_s']:,.0f}" for ref in results["cartpole_references"]

@@ -109,6 +109,7 @@ def _blocks() -> dict[str, Block]:
         "bench-throughput": Block(bench, bench_report.markdown_throughput),
         "khepera-medians": Block(khepera, task_cards.markdown_medians),
         "fig11-fits": Block("docs/figures/figures.json", figures.markdown_fig11),
+        "robust-figure": Block("docs/figures/figures.json", figures.markdown_robust),
         "shipped-models": Block("agents/pretrained/*.json", shipped_models),
     }
 

@@ -866,3 +866,35 @@ def markdown_fig11(figures: dict[str, Any]) -> str:
         *(f"| {name} | {value} |" for name, value in rows),
     ]
     return "\n".join(lines)
+
+
+def markdown_robust(figures: dict[str, Any]) -> str:
+    """The robustness figure's numbers of ``figures.json`` as two Markdown tables:
+    containment (median total area) per fusion setting, against the outlier rate and
+    against the true noise bound."""
+    robust = figures["robust"]
+    parts = []
+    for key, name, label in (
+        ("outlier_rate", "outlier rate", lambda v: f"{100 * v:g}%"),
+        ("noise_factor", "true bound", lambda v: f"{v:g} ε"),
+    ):
+        section = robust[key]
+        settings = [s for s in section if s != "values"]
+        rows = [
+            "| " + " | ".join(
+                [label(value)]
+                + [
+                    f"{100 * section[s][i]['containment']:.1f}% "
+                    f"({section[s][i]['median_total_area']:.3g})"
+                    for s in settings
+                ]
+            ) + " |"
+            for i, value in enumerate(section["values"])
+        ]
+        parts += [
+            "| " + " | ".join([name, *settings]) + " |",
+            "|" + "---|" * (len(settings) + 1),
+            *rows,
+            "",
+        ]
+    return "\n".join(parts).rstrip("\n")
