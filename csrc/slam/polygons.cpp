@@ -167,15 +167,14 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
     return small_convex_hull(candidates, k, out, tolerance_of(extent, magnitude));
 }
 
-int64_t small_convex_hull(const cplx* points, int64_t n_points, cplx* out, double tol) {
-    check_capacity("small_convex_hull points", n_points, MAX_HULL_POINTS);
-    int64_t chosen[MAX_HULL_POINTS + 1];
-    const int64_t k = small_hull_indices(points, n_points, chosen, tol);
-    for (int64_t v = 0; v < k; ++v) out[v] = points[chosen[v]];
-    return k;
-}
+namespace {
 
-int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol) {
+// Andrew's monotone chain as numba's small_hull_indices runs it, into `out` of `capacity`
+// (2 * n_points suffices: when rounding makes the lower and upper chains disagree on
+// nearly collinear points, both keep a point, and the chain holds up to 2 * n_points - 1
+// indices before its last is dropped).
+int64_t hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol,
+                     int64_t capacity) {
     if (n_points <= 0) return 0;
     check_capacity("small_hull_indices points", n_points, MAX_HULL_POINTS);
     int64_t order[MAX_HULL_POINTS];
@@ -194,6 +193,7 @@ int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, d
     for (int64_t j = 0; j < n_points; ++j) {  // lower chain
         const cplx p = points[order[j]];
         while (k >= 2 && within_chord(points[out[k - 2]], points[out[k - 1]], p, tol)) k -= 1;
+        check_capacity("small_hull_indices chain", k + 1, capacity);
         out[k] = order[j];
         k += 1;
     }
@@ -201,12 +201,35 @@ int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, d
     for (int64_t j = n_points - 2; j > -1; --j) {  // upper chain
         const cplx p = points[order[j]];
         while (k >= lower && within_chord(points[out[k - 2]], points[out[k - 1]], p, tol)) k -= 1;
+        check_capacity("small_hull_indices chain", k + 1, capacity);
         out[k] = order[j];
         k += 1;
     }
     k -= 1;  // the last point repeats the first
     if (k == 2 && points[out[0]] == points[out[1]]) return 1;
     return std::max(k, int64_t{1});
+}
+
+}  // namespace
+
+// The chains of small_convex_hull and small_hull_indices run in a buffer of their own
+// (numba's kernels wrote past their n_points + 1 slots in the disagreeing case above,
+// corrupting the heap); only a hull of more than n_points + 1 vertices, which would
+// overflow the caller's `out`, raises CapacityError.
+int64_t small_convex_hull(const cplx* points, int64_t n_points, cplx* out, double tol) {
+    int64_t chosen[2 * MAX_HULL_POINTS];
+    const int64_t k = hull_indices(points, n_points, chosen, tol, 2 * MAX_HULL_POINTS);
+    check_capacity("small_convex_hull output", k, n_points + 1);
+    for (int64_t v = 0; v < k; ++v) out[v] = points[chosen[v]];
+    return k;
+}
+
+int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol) {
+    int64_t chosen[2 * MAX_HULL_POINTS];
+    const int64_t k = hull_indices(points, n_points, chosen, tol, 2 * MAX_HULL_POINTS);
+    check_capacity("small_hull_indices output", k, n_points + 1);
+    std::copy(chosen, chosen + k, out);
+    return k;
 }
 
 // --------------------------------------------------------------------------------------
