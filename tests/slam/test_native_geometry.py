@@ -592,6 +592,24 @@ def test_frames_hypothesis(seed: int) -> None:
         check_transfer(small_polygon(rng), frame)
 
 
+def test_frame_plan_extremes() -> None:
+    """Subnormal distances (ceil(inf) converted to an int, per_edge 0, 0 / 0) and huge
+    coordinates (infinite distances and edges)."""
+    cases = [
+        ([0, 1e308, -1e308 + 1e308j], [5e307]),
+        ([-1.7e308, 1.7e308], [1e300j]),
+        ([0, 1e-300], [1e-310j + 5e-311]),
+        ([0, 1], [1e-320j]),
+        ([0, 1, 1j], [1e-320j - 1e-320]),
+    ]
+    for p1, p2 in cases:
+        a1, a2 = np.array(p1, dtype=np.complex128), np.array(p2, dtype=np.complex128)
+        for conservative in (True, False):
+            for edge_samples in (-1, 0, 1, 3, 8):
+                agree("frame_plan", a1, a1.size, a2, a2.size, conservative, edge_samples)
+                agree("frame_plan", a2, a2.size, a1, a1.size, conservative, edge_samples)
+
+
 def test_sample_hypotheses_per_edge() -> None:
     """Every per_edge 1..8 on regions of 1..4 vertices (within MAX_SAMPLES)."""
     rng = np.random.default_rng(14)
@@ -709,6 +727,11 @@ def test_bad_frames_raise() -> None:
         _core.transfer_region(target, target.size, frame._replace(n1="4"), *buffers)
     with pytest.raises(ValueError, match="n_target"):
         _core.transfer_region(target, target.size + 1, frame, *buffers)
+    # no target: an empty hull, which the conservative bound cannot grow (numba would read
+    # the hull buffer's last slot); the paper transfer gives an empty region
+    with pytest.raises(ValueError, match="offset_outward"):
+        _core.transfer_region(target, 0, frame, *buffers)
+    assert _core.transfer_region(target, 0, frame._replace(conservative=False), *buffers) == 0
     with pytest.raises(ValueError, match="hull"):
         small = np.empty(target.size * frame.n_pairs, dtype=np.complex128)
         _core.transfer_region(target, target.size, frame, buffers[0], small, buffers[2])
