@@ -3,9 +3,10 @@
 
 Each case builds a batch the way :mod:`bearing_env.envs.core` does (reset, groups by
 landmark count, output arrays made once per group), copies the whole state (the envs'
-``BatchState`` and every map batch), steps one copy through ``core.step`` (numba's
-``step_rows``) and the other through ``_core.step_rows`` (made and called as the switch to
-the native core will: :class:`NativeGroups`), and compares every Report array, every
+``BatchState`` and every map batch), steps one copy through numba's ``step_rows`` (made
+and called as core.py did before the switch to the native core: :class:`NumbaGroups`)
+and the other through ``_core.step_rows`` (as the switch makes and calls it:
+:class:`NativeGroups`), and compares every Report array, every
 encoded robot-map array and every state array after each step; finished episodes are
 reset in both copies (and their reports after the reset compared too). Then the other
 kernels (potentials, decoding, the robot-map codec, the planner's) and bad arguments.
@@ -32,8 +33,8 @@ from bearing_env.envs.core import MapBank
 from bearing_env.envs.state import STATE_ARRAYS, BatchState
 from bearing_env.obstacles import box
 from bearing_env.slam import kernels as slam_kernels
+from bearing_env.slam.batch import PARALLEL_MIN_MAPS, BatchedPolygonSLAM
 from bearing_env.slam.batch import STATE_ARRAYS as MAP_STATE_ARRAYS
-from bearing_env.slam.batch import BatchedPolygonSLAM
 
 IntArray = np.ndarray
 
@@ -186,6 +187,109 @@ class NativeGroups:
         return {**info, **robot_map.as_info(names, more)}
 
 
+@dataclass
+class NumbaGroup:
+    inputs: Any  #: kernels.InputsRef
+    report: kernels.Report  #: the report's arrays, every row of the bank
+    encoded: robot_map.Buffers | None
+    batch: BatchedPolygonSLAM
+
+
+@dataclass
+class NumbaGroups:
+    """The numba reference, made and called as core.py made and called it before the
+    switch to the native core (kernels.inputs_ref, new_report, step_rows, report_rows and
+    robot_map's numba codec), so that the comparison stays one after the switch."""
+
+    groups: dict[tuple[int, EnvConfig], NumbaGroup] = field(default_factory=dict)
+
+    def group(
+        self, state: BatchState, maps: MapBank, rows: IntArray, config: EnvConfig
+    ) -> NumbaGroup:
+        n = int(state.n_landmarks[rows[0]])
+        kept = self.groups.get((n, config))
+        if kept is None:
+            batch = maps.batch(n, config)
+            inputs = kernels.inputs_ref(
+                kernels.Inputs(
+                    core.kernel_settings(n, config),
+                    batch._kernel_params(True),
+                    batch._kernel_state(),
+                    state.kernel_ref(),
+                )
+            )
+            every_row = np.arange(batch.num_maps)
+            encoded = None
+            if config.observations.robot_map_info:
+                slots = max(config.observations.max_landmarks - 2, n - 2)
+                encoded = robot_map.buffers(
+                    robot_map.encode_map(batch._kernel_state(), every_row, slots)
+                )
+            report = kernels.new_report(every_row.size, inputs)
+            kept = self.groups[n, config] = NumbaGroup(inputs, report, encoded, batch)
+        return kept
+
+    def step(
+        self,
+        state: BatchState,
+        maps: MapBank,
+        rows: IntArray,
+        config: EnvConfig,
+        turns: np.ndarray,
+        lengths: np.ndarray,
+    ) -> tuple[kernels.Report, dict[str, Any] | None]:
+        group = self.group(state, maps, rows, config)
+        n, size = int(state.n_landmarks[rows[0]]), rows.size
+        report, encoded = group.report, group.encoded
+        if size != report.rewards.size:
+            report = kernels.Report._make(values[:size] for values in report)
+            encoded = None if encoded is None else encoded.rows(size)
+        threads = slam_kernels.threads() if size >= PARALLEL_MIN_MAPS else 1
+        while True:
+            args = (rows, turns, lengths, group.inputs, state.trajectory, threads, report)
+            if encoded is not None:
+                status = kernels.step_rows(*args, encoded.kernel)
+            else:
+                status = kernels.step_rows_bare(*args)
+            if status == kernels.STEP_DONE:
+                break
+            if status == kernels.STEP_NEEDS_NOISE:
+                spent = state.noise_used[rows] + 2 * n > state.noise_filled[rows]
+                core.fill_noise(state, rows[spent], config)
+            else:
+                state.grow_trajectory()
+        if encoded is None:
+            return report, None
+        return report, self.with_fusion_arrays(group, dict(encoded.info), rows, config, n)
+
+    def report(
+        self, state: BatchState, maps: MapBank, rows: IntArray, config: EnvConfig
+    ) -> tuple[kernels.Report, dict[str, Any] | None]:
+        group = self.group(state, maps, rows, config)
+        slots = config.observations.max_landmarks - 2
+        report, encoded = kernels.report_rows(rows, group.inputs, slots)
+        if not config.observations.robot_map_info:
+            return report, None
+        n = int(state.n_landmarks[rows[0]])
+        info = robot_map.as_info(robot_map.MAP_ARRAYS, encoded)
+        return report, self.with_fusion_arrays(group, info, rows, config, n)
+
+    @staticmethod
+    def with_fusion_arrays(
+        group: NumbaGroup, info: dict[str, Any], rows: IntArray, config: EnvConfig, n: int
+    ) -> dict[str, Any]:
+        batch = group.batch
+        if batch.fusion == "intersect":
+            return info
+        slots = max(config.observations.max_landmarks - 2, n - 2)
+        if batch.fusion == "relaxed":
+            more = robot_map.encode_window(batch._kernel_state(), rows, slots)
+        else:
+            more = robot_map.encode_levels(batch._kernel_state(), rows, slots)
+        names = batch.state_names[len(robot_map.MAP_ARRAYS) :]
+        return {**info, **robot_map.as_info(names, more)}
+
+
 # ----------------------------------------------------------------------------------------
 # Twin batches
 # ----------------------------------------------------------------------------------------
@@ -238,7 +342,7 @@ def run_twins(
     core.reset_rows(state, np.arange(num_rows), config, rngs, maps)
     reference = (state, maps)
     native = copy.deepcopy(reference)
-    natives = NativeGroups(maps_form)
+    natives, numbas = NativeGroups(maps_form), NumbaGroups()
     rng = np.random.default_rng(seed)
     counts = {"steps": 0, "frame_changed": 0, "terminated": 0, "truncated": 0, "resets": 0}
     all_rows = np.arange(num_rows)
@@ -252,8 +356,7 @@ def run_twins(
         for _n, group_rows in core.group_rows(state, rows):
             group_rows = np.ascontiguousarray(group_rows, dtype=np.int64)
             turns, lengths = draw_actions(config, actions, group_rows.size, rng)
-            group = maps.group(state, group_rows, config)
-            expected, expected_map = core.step(state, group, turns, lengths)
+            expected, expected_map = numbas.step(*reference, group_rows, config, turns, lengths)
             got, got_map = natives.step(*native, group_rows, config, turns, lengths, threads)
             what = f"step {step}, rows {group_rows.tolist()}"
             assert_same_tuple(tuple(expected), tuple(got), kernels.Report._fields, what)
@@ -272,7 +375,7 @@ def run_twins(
                 core.reset_rows(twin_state, done, config, generators, twin_maps)
             assert_same_state(reference, native, f"after the resets of step {step}")
             for _n, group_rows in core.group_rows(state, done):
-                expected, expected_map = core.report(state, maps.group(state, group_rows, config))
+                expected, expected_map = numbas.report(*reference, group_rows, config)
                 got, got_map = natives.report(*native, group_rows, config)
                 what = f"report after reset, step {step}"
                 assert_same_tuple(tuple(expected), tuple(got), kernels.Report._fields, what)
@@ -413,7 +516,7 @@ def test_potentials_and_the_robot_map_codec(fusion: str) -> None:
     config = EnvConfig.create(n_landmarks=6, fusion=fusion, max_landmarks=9)
     state, maps = stepped(config, 6, seed=21, steps=7)
     rows = np.array([4, 0, 3])
-    group = maps.group(state, rows, config)
+    group = NumbaGroups().group(state, maps, rows, config)
     batch = group.batch
     tuple_state = map_state(batch)
     native_maps = _core.MapState(tuple_state)
@@ -483,9 +586,9 @@ def test_move_and_read_and_append_positions() -> None:
     config = EnvConfig.create(scenario="furnished_room", field_of_view_deg=90.0)
     state, maps = started(config, 3, seed=4)
     native_state, native_maps = copy.deepcopy((state, maps))
-    group = maps.group(state, np.arange(3), config)
+    group = NumbaGroups().group(state, maps, np.arange(3), config)
     native = NativeGroups().group(native_state, native_maps, np.arange(3), config)
-    n = group.n
+    n = int(state.n_landmarks[0])
     for row, turn, length in ((0, 0.3, 0.2), (2, -2.0, 5.0), (1, 1.0, 0.0)):
         a, b = np.empty(n), np.empty(n)
         c, d = np.empty(n), np.empty(n)
