@@ -174,6 +174,8 @@ int64_t transfer_region(const cplx* target, int64_t n_target, const FrameChange&
         // A relative margin far above rounding error keeps the bound a bound in floats.
         radius += 1e-9 * (1.0 + v1 / distance);
         n = drop_edges_outward(hull, n, SCRATCH - 8);
+        // (only a polygon no edge of which can be removed stays larger: not a convex one)
+        check_capacity("transfer_region out", n + 3, SCRATCH);
         n = offset_outward(hull, n, radius, out);
         return drop_edges_outward(out, n, CAPACITY);
     }
@@ -181,6 +183,7 @@ int64_t transfer_region(const cplx* target, int64_t n_target, const FrameChange&
     // in hull first and copying the result gives the same out (the same operations on
     // the same values) and keeps out within SCRATCH whatever the hull's size.
     n = drop_edges_outward(hull, n, CAPACITY);
+    check_capacity("transfer_region out", n, SCRATCH);
     for (int64_t i = 0; i < n; ++i) out[i] = hull[i];
     return n;
 }
