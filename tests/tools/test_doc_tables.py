@@ -53,10 +53,10 @@ def copy_of_the_docs(folder: Path) -> Path:
 
 
 def edit_a_number(path: Path, block: str | None = None) -> None:
-    """Change one digit of the first number in ``block`` (or in the file's first table
-    row with a decimal number)."""
+    """Change one digit of the first number in a table row of ``block`` (of a card: of
+    its baselines)."""
     text = path.read_text(encoding="utf-8")
-    start = 0 if block is None else text.index(f"<!-- docs-tables: {block} -->")
+    start = text.index("## Baselines" if block is None else f"<!-- docs-tables: {block} -->")
     match = re.compile(r"\| [^|\n]*?(\d)\.(\d)").search(text, start)
     assert match is not None
     digit = match.start(2)
