@@ -89,7 +89,9 @@ class NativeGroups:
     """Per (landmark count, config): the native inputs and outputs, made once (where
     core.MapBank.group and core._outputs make numba's)."""
 
-    maps_form: str = "native"  #: how the map state is handed over: native, tuple or batch
+    #: How the map state is handed over: native (MapState and Params), tuple (the numba
+    #: State and Params namedtuples) or batch (the BatchedPolygonSLAM, native Params).
+    maps_form: str = "native"
     groups: dict[tuple[int, EnvConfig], NativeGroup] = field(default_factory=dict)
 
     def group(
@@ -99,7 +101,10 @@ class NativeGroups:
         kept = self.groups.get((n, config))
         if kept is None:
             batch = maps.batch(n, config)
-            params = _core.Params(*batch._kernel_params(True))
+            # The native Params, or (with the State tuple) the numba namedtuple it mirrors.
+            params: Any = batch._kernel_params(True)
+            if self.maps_form != "tuple":
+                params = _core.Params(*params)
             if self.maps_form == "native":
                 map_arg: Any = _core.MapState(map_state(batch))
             elif self.maps_form == "tuple":
