@@ -48,6 +48,17 @@ inline bool separated(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q, cp
     return lo_q > hi_p || lo_p > hi_q;
 }
 
+// N points of stack storage left uninitialised (an array of cplx would be zero-filled by
+// cplx's default member initialisers: 70 KB per convex_hull call, for a few used slots).
+// Every slot is written before it is read.
+template <int64_t N>
+struct PointBuffer {
+    union {
+        cplx data[N];
+    };
+    PointBuffer() {}  // NOLINT: deliberately leaves data uninitialised
+};
+
 }  // namespace
 
 // --------------------------------------------------------------------------------------
@@ -161,10 +172,12 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
         chain_to[top + 2] = i_far;
         top += 3;
     }
-    cplx candidates[MAX_HULL_POINTS + 1];
-    std::copy(out, out + k, candidates);
-    const auto [extent, magnitude] = scale_of(candidates, k);
-    return small_convex_hull(candidates, k, out, tolerance_of(extent, magnitude));
+    // out[:k] is copied (the small hull writes out; the slots it does not rewrite keep
+    // the quickhull's vertices, as in numba) into storage not zero-filled first.
+    PointBuffer<MAX_HULL_POINTS + 1> candidates;
+    std::copy(out, out + k, candidates.data);
+    const auto [extent, magnitude] = scale_of(candidates.data, k);
+    return small_convex_hull(candidates.data, k, out, tolerance_of(extent, magnitude));
 }
 
 namespace {
