@@ -60,7 +60,8 @@ std::pair<int64_t, int64_t> cone_region(double a, double b, double epsilon, cplx
     cplx hull[7];
     int64_t count = small_convex_hull(candidates, n, hull, 0.0);
     for (int64_t i = 0; i < count; ++i) {
-        if (abs(hull[i]) > MAX_FR_EXTENT) return {0, FR_UNBOUNDED};
+        const int side = length_versus(hull[i], MAX_FR_EXTENT);  // abs(hull[i]) > MAX_FR_EXTENT
+        if (side > 0 || (side == 0 && abs(hull[i]) > MAX_FR_EXTENT)) return {0, FR_UNBOUNDED};
     }
     const auto [size, magnitude] = scale_of(hull, count);
     count = simplify(hull, count, tolerance_of(size, magnitude));
@@ -165,8 +166,16 @@ int64_t transfer_region(const cplx* target, int64_t n_target, const FrameChange&
         double v1 = 0.0;
         double v2 = 0.0;
         for (int64_t v = 0; v < n_target; ++v) {
-            for (int64_t j = 0; j < n1; ++j) v1 = std::max(v1, abs(target[v] - a1[j]));
-            for (int64_t j = 0; j < n2; ++j) v2 = std::max(v2, abs(target[v] - a2[j]));
+            // std::max(v, abs(d)) keeps v when abs(d) < v, which the squares can tell
+            // without hypot (length_versus); otherwise the original expression.
+            for (int64_t j = 0; j < n1; ++j) {
+                const cplx d = target[v] - a1[j];
+                if (length_versus(d, v1) >= 0) v1 = std::max(v1, abs(d));
+            }
+            for (int64_t j = 0; j < n2; ++j) {
+                const cplx d = target[v] - a2[j];
+                if (length_versus(d, v2) >= 0) v2 = std::max(v2, abs(d));
+            }
         }
         // distance**3 as numba unrolls it: (1.0 * d) * (d * d).
         const double cube = (1.0 * distance) * (distance * distance);

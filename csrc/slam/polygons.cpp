@@ -269,7 +269,7 @@ std::pair<double, cplx> area_centroid(const cplx* poly, int64_t n) {
 bool contains_point(const cplx* poly, int64_t n, cplx point, double relative) {
     const auto [size, magnitude] = scale_of(poly, n);
     const double tol = relative * size + 4e-16 * std::max(magnitude, abs(point));
-    if (n == 1) return abs(point - poly[0]) <= tol;
+    if (n == 1) return length_at_most(point - poly[0], tol);
     for (int64_t i = 0; i < n; ++i) {
         const cplx a = poly[i];
         const cplx edge = poly[py_mod(i + 1, n)] - a;
@@ -344,10 +344,15 @@ int64_t simplify(cplx* poly, int64_t n, double tol) {
             const cplx nxt = poly[py_mod(i + 1, n)];
             const cplx v = poly[i];
             const cplx chord = nxt - prev;
+            // (the chord's length, a pure function of chord, is needed only when the
+            // first test fails)
+            if (length_at_most(v - prev, tol)) {
+                changed = true;
+                continue;
+            }
             const double length = abs(chord);
-            if (abs(v - prev) <= tol ||
-                (length > 0.0 && std::fabs(cross(chord, v - prev)) <= tol * length &&
-                 dot(v - prev, chord) >= 0.0 && dot(nxt - v, chord) >= 0.0)) {
+            if (length > 0.0 && std::fabs(cross(chord, v - prev)) <= tol * length &&
+                dot(v - prev, chord) >= 0.0 && dot(nxt - v, chord) >= 0.0) {
                 changed = true;
                 continue;
             }
@@ -356,7 +361,7 @@ int64_t simplify(cplx* poly, int64_t n, double tol) {
         }
         n = k;
     }
-    if (n == 2 && abs(poly[1] - poly[0]) <= tol) n = 1;
+    if (n == 2 && length_at_most(poly[1] - poly[0], tol)) n = 1;
     return n;
 }
 
