@@ -552,9 +552,16 @@ def markdown_machine(results: dict[str, Any]) -> str:
         if commit
         else f"bearing_env {machine['bearing_env']}"
     )
-    sections = ",".join(results["settings"]["sections"])
+    from bearing_env.benchmarks.bench_timing import SECTIONS
+
+    sections = list(results["settings"]["sections"])
+    command = (
+        "bearing-env bench"
+        if sorted(sections) == sorted(SECTIONS)
+        else f"bearing-env bench --sections {','.join(sections)}"
+    )
     return (
-        f"Measured by `bearing-env bench --sections {sections}` "
+        f"Measured by `{command}` "
         f"({results['settings']['seconds']:g} s per figure) on {results['started'][:10]}, "
         f"{code}, on a {machine['cpu_count']}-core {machine['processor']} machine "
         f"(`{machine['platform']}`, Python {machine['python']}, numpy {machine['numpy']}, "

@@ -32,7 +32,7 @@ from bearing_env.envs.bearing_slam import (
 )
 from bearing_env.registration import register_envs
 from bearing_env.slam.batch import RELAXED_STATE_ARRAYS, ROBUST_STATE_ARRAYS, STATE_ARRAYS
-from bearing_env.tasks import TASKS_BY_ID
+from bearing_env.tasks import REGISTERED_TASKS_BY_ID
 from tests.extras import needs
 
 #: The base ids, one per action kind (the task ids built on them: tests/envs/test_tasks.py).
@@ -41,7 +41,7 @@ ENV_IDS = sorted(
     for spec in gym.registry.values()
     if isinstance(spec.entry_point, str)
     and spec.entry_point.startswith("bearing_env.")
-    and spec.id not in TASKS_BY_ID
+    and spec.id not in REGISTERED_TASKS_BY_ID
 )
 INFO_KEYS = {
     "landmark_area",
@@ -101,7 +101,7 @@ def test_registration_can_run_twice_silently() -> None:
         register_envs()
         bearing_env.register_envs()
     registered = sorted(i for i in gym.registry if i.startswith("BearingSLAM"))
-    assert registered == sorted([*ENV_IDS, *TASKS_BY_ID])
+    assert registered == sorted([*ENV_IDS, *REGISTERED_TASKS_BY_ID])
 
 
 def test_make_by_module_prefixed_id_without_importing_first() -> None:

@@ -70,7 +70,6 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
         (),
     ),
     "bearing-env play --env-kwargs n_landmarks=6 max_moves=30 --seed 3": ("parse", ()),
-    "bearing-env suite --episodes 50 --workers 2": ("parse", ()),
     "bearing-env compare --policies greedy pretrained:ppo_generalist": ("parse", ()),
     "bearing-env bench": ("parse", ()),
     "bearing-env bench --sections startup": ("parse", ()),
@@ -188,7 +187,6 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     'bearing-env bench --sections single,vector': ('parse', ()),
     'bearing-env compare --policies greedy oracle lookahead lookahead_oracle': ('parse', ()),
     'bearing-env docs-tables': ('parse', ()),
-    'bearing-env docs-tables --check': ('parse', ()),
     'bearing-env generalisation': ('help', ()),
     'bearing-env suite --tasks BearingSLAM-FurnishedRoom-v0 --workers 2': ('parse', ()),
     'bearing-env suite --tasks BearingSLAM-Khepera-v0 --workers 2': ('parse', ()),
@@ -199,6 +197,8 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
         "zoo",
         (),
     ),
+    'bearing-env suite --episodes 200 --workers 2': ('parse', ()),
+    'bearing-env docs-tables --check': ('parse', ()),
 }
 
 

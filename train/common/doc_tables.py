@@ -23,6 +23,7 @@ benchmarks/results/bench_env.json``, ``bearing-env suite``, ``bearing-env figure
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import re
 import sys
@@ -44,10 +45,19 @@ BLOCK = re.compile(
 
 @dataclass(frozen=True)
 class Block:
-    """A generated block: its results file (relative to the root) and its writer."""
+    """A generated block: its results file (relative to the root) and its writer, a
+    function of the file's JSON, or ``"module:function"`` (the benchmarks' writers are
+    named so: the tools never import the benchmarks, which may import the tools)."""
 
     source: str
-    render: Callable[[Any], str]
+    render: Callable[[Any], str] | str
+
+    def write(self, data: Any) -> str:
+        if callable(self.render):
+            return self.render(data)
+        module, _, name = self.render.partition(":")
+        function: Callable[[Any], str] = getattr(importlib.import_module(module), name)
+        return function(data)
 
 
 def _load(root: Path, source: str) -> Any:
@@ -95,18 +105,18 @@ def markdown_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
 
 
 def _blocks() -> dict[str, Block]:
-    from bearing_env.benchmarks import bench_report
     from bearing_env.train.compare import task_cards
     from bearing_env.train.studies import figures
 
     bench = "benchmarks/results/bench_env.json"
+    report = "bearing_env.benchmarks.bench_report"
     khepera = "docs/tasks/results/BearingSLAM-Khepera-v0.json"
     return {
-        "bench-machine": Block(bench, bench_report.markdown_machine),
-        "bench-goals": Block(bench, bench_report.markdown_goals),
-        "bench-env": Block(bench, bench_report.markdown_env_table),
-        "bench-startup": Block(bench, bench_report.markdown_startup),
-        "bench-throughput": Block(bench, bench_report.markdown_throughput),
+        "bench-machine": Block(bench, f"{report}:markdown_machine"),
+        "bench-goals": Block(bench, f"{report}:markdown_goals"),
+        "bench-env": Block(bench, f"{report}:markdown_env_table"),
+        "bench-startup": Block(bench, f"{report}:markdown_startup"),
+        "bench-throughput": Block(bench, f"{report}:markdown_throughput"),
         "khepera-medians": Block(khepera, task_cards.markdown_medians),
         "fig11-fits": Block("docs/figures/figures.json", figures.markdown_fig11),
         "robust-figure": Block("docs/figures/figures.json", figures.markdown_robust),
@@ -124,7 +134,7 @@ def pages(root: Path) -> list[Path]:
 def render_block(name: str, root: Path, blocks: Mapping[str, Block] | None = None) -> str:
     """The Markdown of block ``name`` from its results file under ``root``."""
     block = (blocks or _blocks())[name]
-    text = block.render(_load(root, block.source)).rstrip("\n")
+    text = block.write(_load(root, block.source)).rstrip("\n")
     return f"{text}\n"
 
 

@@ -352,6 +352,40 @@ def task_card(
         f'envs = gym.make_vec("bearing_env:{task.id}", num_envs=8)  # the batched vector env',
         "```",
         "",
+        *task_sections(task, resolved, observation_space, action_space),
+        *baselines_section(task, config, summary),
+    ]
+    if plot:
+        parts += [f"![total area versus moves, {task.id}]({area_plot_name(task)})", ""]
+    if frame:
+        parts += [
+            f"![a rendered frame of {task.id}]({frame_name(task)})",
+            "",
+            f"The first evaluation episode (seed {seeds[0]}) after {FRAME_MOVES} moves of "
+            "`greedy`: the true landmarks (stars), their uncertainty regions and centroids, the "
+            "latest bearing cones (±ε), the robot and its path.",
+            "",
+        ]
+    if command:
+        parts += [
+            "Measured with the command below; `bearing-env docs-tables` writes this card from "
+            f"its results file, `{RESULTS_DIR}/{task.id}.json`:",
+            "",
+            "```bash",
+            command,
+            "```",
+            "",
+        ]
+    parts += ["## Version history", "", *version_history(task), ""]
+    return "\n".join(parts)
+
+
+def task_sections(
+    task: Task, resolved: Any, observation_space: Any, action_space: Any
+) -> list[str]:
+    """The card's sections on what the agent faces: observation, action, reward,
+    starting state, episode end, info and settings."""
+    return [
         "## Observation",
         "",
         observation_text(resolved, observation_space),
@@ -384,31 +418,7 @@ def task_card(
         "",
         f"Every setting is described in [the environment's settings table]({ENV_PAGE}#settings).",
         "",
-        *baselines_section(task, config, summary),
     ]
-    if plot:
-        parts += [f"![total area versus moves, {task.id}]({area_plot_name(task)})", ""]
-    if frame:
-        parts += [
-            f"![a rendered frame of {task.id}]({frame_name(task)})",
-            "",
-            f"The first evaluation episode (seed {seeds[0]}) after {FRAME_MOVES} moves of "
-            "`greedy`: the true landmarks (stars), their uncertainty regions and centroids, the "
-            "latest bearing cones (±ε), the robot and its path.",
-            "",
-        ]
-    if command:
-        parts += [
-            "Measured with the command below; `bearing-env docs-tables` writes this card from "
-            f"its results file, `{RESULTS_DIR}/{task.id}.json`:",
-            "",
-            "```bash",
-            command,
-            "```",
-            "",
-        ]
-    parts += ["## Version history", "", *version_history(task), ""]
-    return "\n".join(parts)
 
 
 def baselines_section(task: Task, config: CompareConfig, summary: Mapping[str, Any]) -> list[str]:

@@ -46,7 +46,7 @@ import itertools
 import json
 import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -874,10 +874,17 @@ def markdown_robust(figures: dict[str, Any]) -> str:
     against the true noise bound."""
     robust = figures["robust"]
     parts = []
-    for key, name, label in (
-        ("outlier_rate", "outlier rate", lambda v: f"{100 * v:g}%"),
-        ("noise_factor", "true bound", lambda v: f"{v:g} ε"),
-    ):
+    def rate(value: float) -> str:
+        return f"{100 * value:g}%"
+
+    def bound(value: float) -> str:
+        return f"{value:g} ε"
+
+    labels: tuple[tuple[str, str, Callable[[float], str]], ...] = (
+        ("outlier_rate", "outlier rate", rate),
+        ("noise_factor", "true bound", bound),
+    )
+    for key, name, label in labels:
         section = robust[key]
         settings = [s for s in section if s != "values"]
         rows = [
