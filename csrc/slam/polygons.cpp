@@ -81,9 +81,19 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
     // Candidate indices, the lower side (right of a -> b) first, then the upper side.
     int64_t index[MAX_HULL_POINTS];
     int64_t n_lower = 0, n_upper = 0;
+    // The lower chain's task (a -> b) finds its farthest candidate here: its scan's
+    // expression bx * (p.im - ay) - by * (p.re - ax), with ax, ay = a and bx, by = b - a,
+    // is cross(b - a, p - a) operation for operation, and its candidates are these, in
+    // this order (the first minimum wins, as in the scan).
+    int64_t far_lower = -1;
+    double min_lower = 0.0;
     for (int64_t i = 0; i < n_points; ++i) {
         const double side = cross(b - a, points[i] - a);
         if (side < 0.0) {
+            if (side < min_lower) {
+                min_lower = side;
+                far_lower = n_lower;
+            }
             index[n_lower] = i;
             n_lower += 1;
         }
@@ -99,8 +109,12 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
     // candidates index[start:end]; a task with start < 0 emits point chain_from instead.
     constexpr int64_t MAX_TASKS = 2 * MAX_HULL_POINTS + 4;
     const int64_t size = 2 * n_points + 4;
+    // task_far: the slot of the task's farthest candidate when its parent found it while
+    // partitioning (-1: the task scans for it).
     int64_t task_start[MAX_TASKS], task_end[MAX_TASKS], chain_from[MAX_TASKS],
-        chain_to[MAX_TASKS];
+        chain_to[MAX_TASKS], task_far[MAX_TASKS];
+    task_far[0] = -1;
+    task_far[2] = far_lower;
     task_start[0] = n_lower;
     task_end[0] = n_lower + n_upper;
     chain_from[0] = last;
@@ -125,41 +139,64 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
         }
         if (end <= start) continue;
         const double ax = points[i_from].re, ay = points[i_from].im;
-        const double bx = points[i_to].re - ax, by = points[i_to].im - ay;
-        int64_t far = start;
-        double far_side = 0.0;
-        for (int64_t j = start; j < end; ++j) {
-            const cplx p = points[index[j]];
-            const double side = bx * (p.im - ay) - by * (p.re - ax);
-            if (side < far_side) {
-                far_side = side;
-                far = j;
+        int64_t far = task_far[top];
+        if (far < 0) {
+            const double bx = points[i_to].re - ax, by = points[i_to].im - ay;
+            far = start;
+            double far_side = 0.0;
+            for (int64_t j = start; j < end; ++j) {
+                const cplx p = points[index[j]];
+                const double side = bx * (p.im - ay) - by * (p.re - ax);
+                if (side < far_side) {
+                    far_side = side;
+                    far = j;
+                }
             }
         }
         const int64_t i_far = index[far];
         const double cx = points[i_far].re, cy = points[i_far].im;
         // Right of a -> c to the front, then right of c -> b; the rest is inside.
+        // Each partition's expression is, operation for operation, the scan its child
+        // task would run (the child a -> c has ax, ay = a and bx, by = c - a = ux, uy;
+        // the child c -> b has ax, ay = c and bx, by = b - c = vx, vy), and the selected
+        // candidates keep their order in the child's slots (each goes to the next slot
+        // as it is met; no later swap reaches them). So the farthest candidate of each
+        // child, the first minimum in its slots, is found here (`far_left`, `far_right`).
         const double ux = cx - ax, uy = cy - ay;
-        int64_t n_left = 0;
+        int64_t n_left = 0, far_left = -1;
+        double min_left = 0.0;
         for (int64_t j = start; j < end; ++j) {
             const cplx p = points[index[j]];
-            if (ux * (p.im - ay) - uy * (p.re - ax) < 0.0) {
+            const double side = ux * (p.im - ay) - uy * (p.re - ax);
+            if (side < 0.0) {
+                if (side < min_left) {
+                    min_left = side;
+                    far_left = start + n_left;
+                }
                 std::swap(index[start + n_left], index[j]);
                 n_left += 1;
             }
         }
         const double vx = points[i_to].re - cx, vy = points[i_to].im - cy;
-        int64_t n_right = 0;
+        int64_t n_right = 0, far_right = -1;
+        double min_right = 0.0;
         for (int64_t j = start + n_left; j < end; ++j) {
             const cplx p = points[index[j]];
-            if (vx * (p.im - cy) - vy * (p.re - cx) < 0.0) {
+            const double side = vx * (p.im - cy) - vy * (p.re - cx);
+            if (side < 0.0) {
                 const int64_t slot = start + n_left + n_right;
+                if (side < min_right) {
+                    min_right = side;
+                    far_right = slot;
+                }
                 std::swap(index[slot], index[j]);
                 n_right += 1;
             }
         }
         const int64_t mid = start + n_left;
         check_capacity("convex_hull task stack", top + 3, size);
+        task_far[top] = far_right;
+        task_far[top + 2] = far_left;
         task_start[top] = mid;
         task_end[top] = mid + n_right;
         chain_from[top] = i_far;
