@@ -85,10 +85,14 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
     // expression bx * (p.im - ay) - by * (p.re - ax), with ax, ay = a and bx, by = b - a,
     // is cross(b - a, p - a) operation for operation, and its candidates are these, in
     // this order (the first minimum wins, as in the scan).
+    // Each point's side is computed once (numba evaluated the same expression again for
+    // the upper side: the same value).
     int64_t far_lower = -1;
     double min_lower = 0.0;
+    double sides[MAX_HULL_POINTS];
     for (int64_t i = 0; i < n_points; ++i) {
         const double side = cross(b - a, points[i] - a);
+        sides[i] = side;
         if (side < 0.0) {
             if (side < min_lower) {
                 min_lower = side;
@@ -99,8 +103,7 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
         }
     }
     for (int64_t i = 0; i < n_points; ++i) {
-        const double side = cross(b - a, points[i] - a);
-        if (side > 0.0) {
+        if (sides[i] > 0.0) {
             index[n_lower + n_upper] = i;
             n_upper += 1;
         }
