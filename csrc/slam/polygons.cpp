@@ -17,10 +17,33 @@ namespace {
 // -1j as Python folds the literal: complex(-0.0, -1.0).
 constexpr cplx MINUS_I{-0.0, -1.0};
 
+// How x compares with tol * abs(d) (hypot), decided without hypot when that is
+// conclusive: -1 if certainly x <= tol * abs(d), +1 if certainly x > tol * abs(d), 0 if
+// not certain (the caller then evaluates the original expression). Only for tol > 0
+// finite and d finite (span = |d.re| + |d.im| finite):
+// - x <= 0: tol * abs(d) is in [+0, inf] (abs(d) is, tol finite > 0: no NaN), so x <= it.
+// - x > bound = tol * span * 2.0 with bound in [2^-1000, inf): the exact length r is at
+//   most |d.re| + |d.im| <= span (1 + u) (u = 2^-53), hypot within one ulp (2u relative)
+//   of r, and tol * abs(d) rounds by (1 + u) at most (it is normal: abs(d) >= span / 1.5,
+//   so tol * abs(d) >= bound / 3 >= 2^-1002), so tol * abs(d) <= tol * span (1 + 5u),
+//   while bound (its product normal, doubling exact) >= 2 tol span (1 - u). So
+//   x > bound > tol * abs(d).
+inline int versus_scaled_length(double x, double tol, cplx d) {
+    constexpr double INF = std::numeric_limits<double>::infinity();
+    const double span = std::fabs(d.re) + std::fabs(d.im);
+    if (!(tol > 0.0 && tol < INF && span < INF)) return 0;
+    if (x <= 0.0) return -1;
+    const double bound = tol * span * 2.0;
+    if (bound >= 0x1p-1000 && bound < INF && x > bound) return 1;
+    return 0;
+}
+
 // Whether b fails to turn left by more than tol on the way from a to c.
 inline bool within_chord(cplx a, cplx b, cplx c, double tol) {
     const double turn = cross(b - a, c - a);
     if (tol == 0.0) return turn <= 0.0;
+    const int side = versus_scaled_length(turn, tol, c - a);  // turn <= tol * abs(c - a)
+    if (side != 0) return side < 0;
     return turn <= tol * abs(c - a);
 }
 
@@ -390,11 +413,16 @@ int64_t simplify(cplx* poly, int64_t n, double tol) {
                 changed = true;
                 continue;
             }
-            const double length = abs(chord);
-            if (length > 0.0 && std::fabs(cross(chord, v - prev)) <= tol * length &&
-                dot(v - prev, chord) >= 0.0 && dot(nxt - v, chord) >= 0.0) {
-                changed = true;
-                continue;
+            // When fabs(cross) <= tol * length is certainly false (versus_scaled_length),
+            // so is the whole test, and the length is not needed.
+            const double off = std::fabs(cross(chord, v - prev));
+            if (versus_scaled_length(off, tol, chord) <= 0) {
+                const double length = abs(chord);
+                if (length > 0.0 && off <= tol * length && dot(v - prev, chord) >= 0.0 &&
+                    dot(nxt - v, chord) >= 0.0) {
+                    changed = true;
+                    continue;
+                }
             }
             poly[k] = v;
             k += 1;
