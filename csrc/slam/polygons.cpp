@@ -553,12 +553,15 @@ int64_t offset_outward(const cplx* poly, int64_t n, double radius, cplx* out) {
         return 4;
     }
     int64_t k = 0;
+    // Vertex i's incoming edge poly[i] - poly[i - 1] is vertex i - 1's outgoing edge (the
+    // same operands: i - 1 + 1 = i, and (n - 1) + 1 wraps to 0), so its unit tangent and
+    // normal are carried over instead of computed again (the same bits).
+    const cplx first_edge = poly[0] - poly[py_mod(-1, n)];
+    cplx t_in = first_edge / abs(first_edge);
+    cplx n_in = MINUS_I * t_in;  // outward normals (CCW polygon)
     for (int64_t i = 0; i < n; ++i) {
-        const cplx prev_edge = poly[i] - poly[py_mod(i - 1, n)];
         const cplx next_edge = poly[py_mod(i + 1, n)] - poly[i];
-        const cplx t_in = prev_edge / abs(prev_edge);
         const cplx t_out = next_edge / abs(next_edge);
-        const cplx n_in = MINUS_I * t_in;  // outward normals (CCW polygon)
         const cplx n_out = MINUS_I * t_out;
         const double cos_turn = dot(n_in, n_out);
         if (cos_turn >= 0.0) {
@@ -575,6 +578,8 @@ int64_t offset_outward(const cplx* poly, int64_t n, double radius, cplx* out) {
             out[k + 1] = poly[i] + radius * (n_out - quarter_tan * t_out);
             k += 2;
         }
+        t_in = t_out;
+        n_in = n_out;
     }
     return k;
 }

@@ -18,7 +18,8 @@ inline constexpr int64_t MAX_HULL_POINTS = MAX_CLOUD + SCRATCH;
 // at most n_points + 1 entries of out (a hull that would need more, possible only with
 // NaNs, raises CapacityError; the small hulls' chains run in a buffer of their own, see
 // polygons.cpp); clip_convex's out and work hold SCRATCH; offset_outward's out n + 3, and
-// it throws std::invalid_argument for n < 1 (numba read poly[-1]). Points: at most
+// it throws std::invalid_argument for n < 1 (numba read poly[-1]); its out must not
+// overlap poly (each edge's tangent is computed once and reused for the next vertex). Points: at most
 // MAX_HULL_POINTS, else CapacityError.
 int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out);
 int64_t small_convex_hull(const cplx* points, int64_t n_points, cplx* out, double tol);
