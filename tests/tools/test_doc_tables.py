@@ -45,10 +45,14 @@ def doc_tables_cards() -> dict[Path, str]:
 
 
 def copy_of_the_docs(folder: Path) -> Path:
-    """The README, the pages, the cards and the results files, under ``folder``."""
+    """The README, the pages, the cards and the results files (the bench's, the
+    shipped models' records), under ``folder``."""
     shutil.copy(ROOT / "README.md", folder / "README.md")
     shutil.copytree(ROOT / "docs", folder / "docs", ignore=shutil.ignore_patterns("_build"))
     shutil.copytree(ROOT / "benchmarks" / "results", folder / "benchmarks" / "results")
+    (folder / "agents" / "pretrained").mkdir(parents=True)
+    for record in (ROOT / "agents" / "pretrained").glob("*.json"):
+        shutil.copy(record, folder / "agents" / "pretrained" / record.name)
     return folder
 
 
