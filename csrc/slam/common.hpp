@@ -20,6 +20,17 @@ inline double tolerance_of(double size, double magnitude) {
     return RELATIVE_TOLERANCE * size + 4e-16 * magnitude;
 }
 
+// N points of stack storage left uninitialised (an array of cplx would be zero-filled by
+// cplx's default member initialisers: 70 KB per convex_hull call, for a few used slots).
+// Every slot used is written before it is read.
+template <int64_t N>
+struct PointBuffer {
+    union {
+        cplx data[N];
+    };
+    PointBuffer() {}  // NOLINT: deliberately leaves data uninitialised
+};
+
 // How hypot(d.re, d.im) (abs(d)) compares with `limit`, decided on squared lengths when
 // that is conclusive: -1 if certainly abs(d) < limit, +1 if certainly abs(d) > limit,
 // 0 if the squares cannot tell (then the caller evaluates its original expression on

@@ -102,18 +102,25 @@ FramePlan frame_plan(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2, boo
 
 int64_t sample_hypotheses(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2,
                           int64_t per_edge, cplx* h1, cplx* inv_d) {
-    cplx s1[MAX_SAMPLES], s2[MAX_SAMPLES];
+    // Buffers not zero-filled (PointBuffer): every slot read was written first.
+    PointBuffer<MAX_SAMPLES> s1_buffer, s2_buffer, column_buffer;
+    cplx* s1 = s1_buffer.data;
+    cplx* s2 = s2_buffer.data;
+    cplx* column = column_buffer.data;
     if (per_edge > 0) {
         check_capacity("sample_hypotheses samples of a1", n1 * per_edge, MAX_SAMPLES);
         check_capacity("sample_hypotheses samples of a2", n2 * per_edge, MAX_SAMPLES);
     }
     const int64_t m1 = boundary_samples(a1, n1, per_edge, s1);
     const int64_t m2 = boundary_samples(a2, n2, per_edge, s2);
-    cplx inverses[MAX_SAMPLES][MAX_SAMPLES];
+    union Inverses {
+        cplx rows[MAX_SAMPLES][MAX_SAMPLES];
+        Inverses() {}  // NOLINT: deliberately uninitialised (16 KB)
+    } inverse_buffer;
+    auto& inverses = inverse_buffer.rows;
     for (int64_t i = 0; i < m1; ++i) {
         for (int64_t j = 0; j < m2; ++j) inverses[i][j] = 1.0 / (s2[j] - s1[i]);
     }
-    cplx column[MAX_SAMPLES];
     int64_t extreme[MAX_SAMPLES + 1];
     // column_extreme[i][j]: h1 = s1[i] gives a hull vertex among the pairs with h2 = s2[j].
     bool column_extreme[MAX_SAMPLES][MAX_SAMPLES] = {};

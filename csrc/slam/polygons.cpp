@@ -71,17 +71,6 @@ inline bool separated(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q, cp
     return lo_q > hi_p || lo_p > hi_q;
 }
 
-// N points of stack storage left uninitialised (an array of cplx would be zero-filled by
-// cplx's default member initialisers: 70 KB per convex_hull call, for a few used slots).
-// Every slot is written before it is read.
-template <int64_t N>
-struct PointBuffer {
-    union {
-        cplx data[N];
-    };
-    PointBuffer() {}  // NOLINT: deliberately leaves data uninitialised
-};
-
 }  // namespace
 
 // --------------------------------------------------------------------------------------
