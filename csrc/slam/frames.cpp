@@ -34,16 +34,27 @@ std::pair<int64_t, int64_t> cone_region(double a, double b, double epsilon, cplx
     if (std::fabs(wrap(b - a)) <= 2.0 * epsilon) return {0, FR_UNBOUNDED};
     cplx candidates[6];
     int64_t n = 0;
-    for (const double sign_a : {-1.0, 1.0}) {
+    // The two beta = b + sign_b * epsilon and their sines are computed once, not once per
+    // alpha, and each alpha's sine and cosine once, not per beta (the same expressions on
+    // the same values: the same bits; sin and cos are pure).
+    const double signs[2] = {-1.0, 1.0};
+    double betas[2], sin_betas[2];
+    for (int64_t kb = 0; kb < 2; ++kb) {
+        betas[kb] = b + signs[kb] * epsilon;
+        sin_betas[kb] = std::sin(betas[kb]);
+    }
+    for (const double sign_a : signs) {
         const double alpha = a + sign_a * epsilon;
-        for (const double sign_b : {-1.0, 1.0}) {
-            const double beta = b + sign_b * epsilon;
+        const double sin_alpha = std::sin(alpha);
+        const double cos_alpha = std::cos(alpha);
+        for (int64_t kb = 0; kb < 2; ++kb) {
+            const double beta = betas[kb];
             const double sin_gap = std::sin(beta - alpha);
             if (std::fabs(sin_gap) <= 1e-12) continue;
-            const double t = std::sin(beta) / sin_gap;
-            const double s = std::sin(alpha) / sin_gap;
+            const double t = sin_betas[kb] / sin_gap;
+            const double s = sin_alpha / sin_gap;
             if (t >= 0.0 && s >= 0.0) {
-                candidates[n] = t * cplx(std::cos(alpha), std::sin(alpha));
+                candidates[n] = t * cplx(cos_alpha, sin_alpha);
                 n += 1;
             }
         }
