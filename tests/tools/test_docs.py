@@ -92,6 +92,8 @@ def test_measured_facts_are_the_documentation_pages_numbers() -> None:
     facts = _section(design, "## 4. Measured facts") + _section(design, "## 5. Reference runs")
     numbers = set(re.findall(r"(?<![\w.])\d[\d,]*\.\d+|(?<![\w.])\d{1,3}(?:,\d{3})+", facts))
     numbers -= {"1.05", "0.68", "0.05", "0.30", "0.25"}  # settings, not measurements
-    assert len(numbers) > 15
+    # The design document links the pages for the figures that have a generated home
+    # (the cards, the performance page, the figures' fits); it still quotes these.
+    assert len(numbers) > 10
     missing = sorted(n for n in numbers if n not in reported)
     assert missing == []

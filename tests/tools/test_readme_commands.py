@@ -199,6 +199,10 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     ),
     'bearing-env suite --episodes 200 --workers 2': ('parse', ()),
     'bearing-env docs-tables --check': ('parse', ()),
+    "cp outputs/compare_khepera_25cm/summary.json docs/compare/results/khepera_25cm.json": (
+        "copy",
+        (),
+    ),
 }
 
 

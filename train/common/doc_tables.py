@@ -104,6 +104,23 @@ def markdown_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     return "\n".join(lines)
 
 
+def compare_medians(summary: Mapping[str, Any]) -> str:
+    """A comparison's median table, from its ``summary.json`` (``bearing-env compare``
+    writes it in ``--out``; the docs keep a copy under ``docs/compare/results/``)."""
+    from bearing_env.train.compare.report import area_median_rows
+    from bearing_env.train.compare.task_cards import config_of
+
+    config = config_of(summary)
+    seeds = config.seeds
+    kwargs = ", ".join(f"{key}={value!r}" for key, value in config.env_kwargs.items())
+    header, rows = area_median_rows(summary, config)
+    return (
+        f"Median total area, {config.episodes} evaluation episodes per policy (seeds "
+        f"{seeds[0]}..{seeds[-1]}), `{config.env_id.rpartition(':')[2]}` with `{kwargs}`:"
+        "\n\n" + markdown_table(header, rows)
+    )
+
+
 def _blocks() -> dict[str, Block]:
     from bearing_env.train.compare import task_cards
     from bearing_env.train.studies import figures
@@ -121,6 +138,7 @@ def _blocks() -> dict[str, Block]:
         "fig11-fits": Block("docs/figures/figures.json", figures.markdown_fig11),
         "robust-figure": Block("docs/figures/figures.json", figures.markdown_robust),
         "shipped-models": Block("agents/pretrained/*.json", shipped_models),
+        "khepera-25cm": Block("docs/compare/results/khepera_25cm.json", compare_medians),
     }
 
 
