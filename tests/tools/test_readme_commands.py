@@ -203,6 +203,10 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
         "copy",
         (),
     ),
+    "cp outputs/compare_khepera_discrete/summary.json "
+    "docs/compare/results/settings_discrete.json": ("copy", ()),
+    "cp outputs/compare_random6/summary.json "
+    "docs/compare/results/settings_random6.json": ("copy", ()),
 }
 
 

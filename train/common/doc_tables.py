@@ -121,6 +121,48 @@ def compare_medians(summary: Mapping[str, Any]) -> str:
     )
 
 
+def compare_settings(summaries: Mapping[str, Any]) -> str:
+    """Comparisons on other settings, one row each (``docs/compare/results/settings_*.json``,
+    copies of their ``summary.json``): the median total area after 10 moves (random
+    polygonal's over each policy's in brackets), then the success rates."""
+    from bearing_env.train.compare.task_cards import config_of
+
+    labels: list[str] = []
+    for summary in summaries.values():
+        labels += [label for label in summary["policies"] if label not in labels]
+    medians, successes = [], []
+    for summary in summaries.values():
+        config = config_of(summary)
+        kwargs = ", ".join(f"{key}={value!r}" for key, value in config.env_kwargs.items())
+        setting = f"`{config.env_id.rpartition(':')[2]}` `{kwargs}`, {config.episodes} episodes"
+        policies = summary["policies"]
+        reference = policies.get("random_polygonal", {}).get("area_after", {}).get("10", {})
+        median_cells, success_cells = [setting], [setting]
+        for label in labels:
+            stats = policies.get(label)
+            if stats is None:
+                median_cells.append("-")
+                success_cells.append("-")
+                continue
+            median = stats["area_after"]["10"]["median"]
+            ratio = reference.get("median")
+            shown = f"{median:.3g}"
+            if ratio and label != "random_polygonal" and median:
+                shown += f" ({ratio / median:.1f}x)"
+            median_cells.append(shown)
+            moves = stats.get("moves_to_success_median")
+            success = f"{100 * stats['success_rate']:.0f}%"
+            success_cells.append(success + (f" ({moves:g})" if moves is not None else ""))
+        medians.append(median_cells)
+        successes.append(success_cells)
+    return (
+        "Median total area after 10 moves (random ÷ policy in brackets):\n\n"
+        + markdown_table(["setting", *labels], medians)
+        + "\n\nSuccess within the episode (median moves to success in brackets):\n\n"
+        + markdown_table(["setting", *labels], successes)
+    )
+
+
 def _blocks() -> dict[str, Block]:
     from bearing_env.train.compare import task_cards
     from bearing_env.train.studies import figures
@@ -139,6 +181,7 @@ def _blocks() -> dict[str, Block]:
         "robust-figure": Block("docs/figures/figures.json", figures.markdown_robust),
         "shipped-models": Block("agents/pretrained/*.json", shipped_models),
         "khepera-25cm": Block("docs/compare/results/khepera_25cm.json", compare_medians),
+        "other-settings": Block("docs/compare/results/settings_*.json", compare_settings),
     }
 
 
