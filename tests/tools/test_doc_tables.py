@@ -148,7 +148,6 @@ HAND_WRITTEN_TABLES: frozenset[tuple[str, str]] = frozenset(
     {
         ("docs/environment.md", "| kwarg | default | meaning |"),
         ("docs/environment.md", "| layout | field of view | movements that change frames |"),
-        ("docs/results.md", "| policy | median after 5 | median after 10 | median after 20 |"),
         ("docs/results.md", "| layout | policy | clean: robust | 5% outliers: strict |"),
         ("docs/scaling.md", "| run | wall time | over `--workers 1` | over `--workers 2` |"),
     }

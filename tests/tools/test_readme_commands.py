@@ -207,6 +207,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "docs/compare/results/settings_discrete.json": ("copy", ()),
     "cp outputs/compare_random6/summary.json "
     "docs/compare/results/settings_random6.json": ("copy", ()),
+    'cp outputs/compare_lookahead/summary.json docs/compare/results/lookahead.json': ('copy', ()),
 }
 
 

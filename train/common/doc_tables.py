@@ -163,6 +163,37 @@ def compare_settings(summaries: Mapping[str, Any]) -> str:
     )
 
 
+def compare_outcomes(summary: Mapping[str, Any]) -> str:
+    """A comparison's medians after 5, 10 and 20 moves, mean after 10 with its 95%
+    bootstrap CI, and success rate, one row per policy (its ``summary.json``)."""
+    from bearing_env.train.compare.task_cards import config_of
+
+    config = config_of(summary)
+    rows = []
+    for label, stats in summary["policies"].items():
+        after = stats["area_after"]
+        ten = after["10"]
+        rows.append(
+            [
+                label,
+                *(f"{after[str(k)]['median']:.3g}" for k in (5, 10, 20)),
+                f"{ten['mean']:.3g} [{ten['ci_low']:.3g}, {ten['ci_high']:.3g}]",
+                f"{100 * stats['success_rate']:.1f}%",
+            ]
+        )
+    header = [
+        "policy", "median after 5", "median after 10", "median after 20",
+        "mean after 10 [95% CI]", "success",
+    ]  # fmt: skip
+    return (
+        f"Total area, {config.episodes} evaluation episodes per policy, "
+        f"`{config.env_id.rpartition(':')[2]}` "
+        + ", ".join(f"`{k}={v!r}`" for k, v in config.env_kwargs.items())
+        + ":\n\n"
+        + markdown_table(header, rows)
+    )
+
+
 def _blocks() -> dict[str, Block]:
     from bearing_env.train.compare import task_cards
     from bearing_env.train.studies import figures
@@ -182,6 +213,7 @@ def _blocks() -> dict[str, Block]:
         "shipped-models": Block("agents/pretrained/*.json", shipped_models),
         "khepera-25cm": Block("docs/compare/results/khepera_25cm.json", compare_medians),
         "other-settings": Block("docs/compare/results/settings_*.json", compare_settings),
+        "lookahead": Block("docs/compare/results/lookahead.json", compare_outcomes),
     }
 
 
