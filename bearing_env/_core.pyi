@@ -133,6 +133,16 @@ def contains_points(
     out: NDArray[np.bool_],
 ) -> None: ...
 def binomial_q(n: int, p: float, risk: float, q_cap: int) -> int: ...
+def relaxed_region(
+    state: MapState,
+    row: int,
+    j: int,
+    slots: NDArray[np.int64],
+    use_base: bool,
+    max_outliers: int,
+    out: NDArray[np.complex128],
+) -> tuple[int, int]: ...
+def update_levels(state: MapState, row: int, j: int, fresh: NDArray[np.complex128]) -> None: ...
 
 # ---- The polygon and frame kernels (csrc/bindings/bind_slam_geometry.cpp; keep in step) ----
 # Same signatures and return conventions as bearing_env.slam.kernels' numba kernels: `out`

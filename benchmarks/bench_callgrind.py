@@ -99,7 +99,7 @@ def count(driver: str, entry: str, arguments: Sequence[str], top: int = 12) -> d
             text=True,
             check=True,
         ).stdout
-    functions = []
+    functions: list[dict[str, Any]] = []
     for line in annotate.splitlines():
         match = re.match(r"\s*([\d,]+)\s+\(\s*([\d.]+)%\)\s+\S*:(.+?)(?: \[.*\])?$", line)
         if match and len(functions) < top:

@@ -14,6 +14,7 @@
 
 #include "bindings/arrays.hpp"
 #include "core/errors.hpp"
+#include "slam/fusion.hpp"
 #include "slam/robust.hpp"
 #include "slam/scratch.hpp"
 #include "slam/state.hpp"
@@ -361,6 +362,48 @@ void contains_points_binding(nb::handle vertices, nb::handle counts, nb::handle 
     slam::contains_points(v, c, r, p, relative, o);
 }
 
+// The relaxed fusion's region of landmark j of map `row` over the window slots `slots`
+// (int64, k of them), with the bases if use_base: (n, q), the region in out[:n]
+// (bearing_env.slam.geometry.relaxed_intersection's kernel; not the per-step path).
+nb::tuple relaxed_region_binding(const PyMapState& s, int64_t row, int64_t j, nb::handle slots,
+                                 bool use_base, int64_t max_outliers, nb::handle out) {
+    auto k_slots = bearing::bindings::view_of<const int64_t, 1>(slots, "slots");
+    auto o = bearing::bindings::view_of<cplx, 1>(out, "out");
+    require(0 <= row && row < s.maps, "row must be a map index in [0, " +
+                                          std::to_string(s.maps) + ")");
+    require(0 <= j && j < s.mapped, "j must be a landmark slot in [0, " +
+                                        std::to_string(s.mapped) + ")");
+    require(1 <= k_slots.shape[0] && k_slots.shape[0] <= s.window,
+            "slots must hold 1.." + std::to_string(s.window) + " window slots");
+    for (int64_t i = 0; i < k_slots.shape[0]; ++i) {
+        require(0 <= k_slots(i) && k_slots(i) < s.window, "slots must index the window");
+    }
+    require(0 <= max_outliers && max_outliers < slam::MAX_WINDOW, "max_outliers out of range");
+    require(o.shape[0] >= slam::SCRATCH, "out must hold SCRATCH points");
+    auto scratch = std::make_unique<slam::Scratch>();
+    for (int64_t i = 0; i < k_slots.shape[0]; ++i) scratch->slots[i] = k_slots(i);
+    auto [n, q] = slam::relaxed_region(s.views, row, j, k_slots.shape[0], use_base, max_outliers,
+                                       *scratch);
+    for (int64_t v = 0; v < n; ++v) o(v) = scratch->acc[v];
+    return nb::make_tuple(n, q);
+}
+
+// Fuse the region `fresh` (complex128, 3..CAPACITY vertices) into landmark j's robust
+// levels of map `row` (bearing_env.slam.geometry.robust_levels' kernel).
+void update_levels_binding(const PyMapState& s, int64_t row, int64_t j, nb::handle fresh) {
+    auto f = bearing::bindings::view_of<const cplx, 1>(fresh, "fresh");
+    require(0 <= row && row < s.maps, "row must be a map index in [0, " +
+                                          std::to_string(s.maps) + ")");
+    require(0 <= j && j < s.mapped, "j must be a landmark slot in [0, " +
+                                        std::to_string(s.mapped) + ")");
+    require(s.levels > 0, "the state has no robust levels (fusion must be 'robust')");
+    require(3 <= f.shape[0] && f.shape[0] <= slam::CAPACITY,
+            "fresh must have 3.." + std::to_string(slam::CAPACITY) + " vertices");
+    auto scratch = std::make_unique<slam::Scratch>();
+    for (int64_t v = 0; v < f.shape[0]; ++v) scratch->fresh[v] = f(v);
+    slam::update_levels(s.views, row, j, f.shape[0], *scratch);
+}
+
 }  // namespace
 
 void bind_slam_update(nb::module_& m) {
@@ -408,6 +451,11 @@ void bind_slam_update(nb::module_& m) {
     m.def("contains_points", &contains_points_binding, "vertices"_a, "counts"_a, "rows"_a,
           "points"_a, "relative"_a, "out"_a,
           "out[i, j]: region j of map rows[i] contains points[i, j].");
+    m.def("relaxed_region", &relaxed_region_binding, "state"_a, "row"_a, "j"_a, "slots"_a,
+          "use_base"_a, "max_outliers"_a, "out"_a,
+          "(n, q): landmark j's q-relaxed region over the window slots, into out[:n].");
+    m.def("update_levels", &update_levels_binding, "state"_a, "row"_a, "j"_a, "fresh"_a,
+          "Fuse the region `fresh` into landmark j's robust levels of map `row`.");
     m.def("binomial_q", &slam::binomial_q, "n"_a, "p"_a, "risk"_a, "q_cap"_a,
           "The smallest q (at most q_cap) with P(Bin(n, p) > q) < risk.");
 

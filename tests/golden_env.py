@@ -1,0 +1,81 @@
+"""Golden env steps at full precision, recorded from the numba env step before the switch.
+
+``tests/golden_traces.py`` hashes floats as float32; this corpus hashes the env traces
+(not the policies') with every float64 bit (NaN canonicalised), so the native env step is
+held to the numba step's exact numbers. ``tests/golden/env_steps.json`` holds the hashes;
+``tests/envs/test_golden_env.py`` compares.
+
+    python -m tests.golden_env [--update]
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tests.golden_traces import TRACES
+
+GOLDEN_FILE = Path(__file__).parent / "golden" / "env_steps.json"
+#: The traces of the envs themselves (the policies' traces need the train extra).
+NAMES = sorted(name for name in TRACES if not name.startswith("policy-"))
+
+
+def feed_exact(digest: Any, value: Any) -> None:
+    """Like ``golden_traces.feed``, without rounding floats to float32."""
+    if isinstance(value, dict):
+        for key in sorted(value):
+            digest.update(f"<{key}>".encode())
+            feed_exact(digest, value[key])
+    elif isinstance(value, (list, tuple)):
+        digest.update(f"[{len(value)}".encode())
+        for item in value:
+            feed_exact(digest, item)
+    elif value is None or isinstance(value, str):
+        digest.update(repr(value).encode())
+    else:
+        array = np.asarray(value)
+        if array.dtype.kind == "O":
+            digest.update(f"O{array.shape}".encode())
+            for item in array.ravel():
+                feed_exact(digest, item)
+            return
+        if array.dtype.kind == "c":
+            array = np.stack([array.real, array.imag], axis=-1)
+        if array.dtype.kind == "f":
+            array = np.where(np.isnan(array), np.nan, array).astype(array.dtype)
+        digest.update(f"{array.dtype.str}{array.shape}".encode())
+        digest.update(np.ascontiguousarray(array).tobytes())
+
+
+def exact_hash(name: str) -> str:
+    digest = hashlib.sha256()
+    for item in TRACES[name]():
+        feed_exact(digest, item)
+    return digest.hexdigest()
+
+
+def recorded() -> dict[str, str]:
+    return dict(json.loads(GOLDEN_FILE.read_text(encoding="utf-8")))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--update", action="store_true", help="record the current hashes")
+    args = parser.parse_args(argv)
+    current = {name: exact_hash(name) for name in NAMES}
+    old = recorded() if GOLDEN_FILE.exists() else {}
+    changed = [name for name in NAMES if old.get(name) != current[name]]
+    print(f"{len(NAMES)} traces, {len(changed)} differ: {changed}")
+    if args.update:
+        GOLDEN_FILE.write_text(json.dumps(current, indent=1, sort_keys=True) + "\n")
+    return 1 if changed and not args.update else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
