@@ -13,12 +13,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from bearing_env import _core
 from bearing_env.envs.config import AREA_FLOOR
-from bearing_env.envs.kernels import potential_of
-from bearing_env.numerics import JIT_OPTIONS, wrap_angle
+from bearing_env.numerics import wrap_angle
 from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
 
 FloatArray = NDArray[np.float64]
@@ -39,24 +38,11 @@ def uncertainty_potential(
     return potentials.reshape(values.shape[:-1])
 
 
-@njit(**JIT_OPTIONS)
-def _potentials_of_rows(
-    rows: np.ndarray, log_area: bool, floor: float, cap: float, out: np.ndarray
-) -> None:
-    """``potential_of`` of every row, in one compiled call (no Python per map)."""
-    for i in range(rows.shape[0]):
-        out[i] = potential_of(rows[i], rows.shape[1], log_area, floor, cap)
-
-
-@njit(**JIT_OPTIONS)
-def _move_ends(
-    start: complex, headings: np.ndarray, distances: np.ndarray, out: np.ndarray
-) -> None:
-    """``out[k]``: where candidate ``k`` ends, in one compiled loop. math.cos and math.sin
-    (libm's, as Python's math module calls them), so the ends are the same bit for bit
-    as when they were computed one candidate at a time in Python."""
-    for k in range(headings.size):
-        out[k] = start + distances[k] * complex(math.cos(headings[k]), math.sin(headings[k]))
+#: ``potential_of`` of every row of areas (rows, m) into ``out``, and ``out[k]``: where
+#: candidate ``k`` ends (``start + distances[k] * (cos + i sin)(headings[k])``), each in
+#: one native call (csrc/env/planning.cpp, the same bits as the numba loops they were).
+_potentials_of_rows = _core._potentials_of_rows
+_move_ends = _core._move_ends
 
 
 def bearings_from(

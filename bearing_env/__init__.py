@@ -1,6 +1,6 @@
 """bearing_env: active exploration in bearing-only polygon SLAM.
 
-The world model (:mod:`bearing_env.slam`) is compiled with numba and imports neither gymnasium
+The world model (:mod:`bearing_env.slam`) runs on a native C++ core and imports neither gymnasium
 nor pygame. Importing this package registers the Gymnasium ids ``BearingSLAM-v0`` and
 ``BearingSLAMDiscrete-v0`` when gymnasium is installed.
 """

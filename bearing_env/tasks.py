@@ -8,7 +8,7 @@ The ids follow :data:`NAMING_RULE`.
 
 A task's settings are ``gym.make`` keyword arguments on top of the env's defaults;
 ``gym.make(task_id, **more)`` overrides them as for any id. Importing this module is
-cheap (no numba, no env modules).
+cheap (no native core, no env modules).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The simulated world: arena, true landmarks, robot pose, motion and the bearing sensor.
 
-numpy, with the motion and the noise-free bearings compiled by numba (no gymnasium, no
+numpy, with the motion and the noise-free bearings in the native core (no gymnasium, no
 pygame), so it can be reused by planners and benchmarks.
 
 Units: lengths are in **metres**, angles in **radians** (the public constructor arguments
@@ -20,12 +20,17 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
-from bearing_env.numerics import JIT_OPTIONS, wrap, wrap_angle
+from bearing_env._core import _add_wrapped as _add_wrapped
+from bearing_env._core import _add_wrapped_with_outliers as _add_wrapped_with_outliers
+from bearing_env._core import _true_bearings_into as _true_bearings_into
+from bearing_env._core import bearing as bearing
+from bearing_env._core import obstructed_move as obstructed_move
+from bearing_env._core import straight_move as straight_move
+from bearing_env.numerics import wrap_angle
 from bearing_env.obstacles import Obstacle, box
-from bearing_env.sensing import Packed, clearance, free_length, landmarks_seen, pack_polygons
+from bearing_env.sensing import Packed, clearance, landmarks_seen, pack_polygons
 from bearing_env.validation import float_in, non_negative_float, positive_float
 
 FloatArray = NDArray[np.float64]
@@ -308,27 +313,6 @@ def apply_noise(true_bearings: FloatArray, draws: NoiseDraws, out: FloatArray) -
         )
 
 
-@njit(**JIT_OPTIONS)
-def _add_wrapped(true_bearings: FloatArray, offsets: FloatArray, out: FloatArray) -> None:
-    for i in range(true_bearings.shape[0]):
-        for j in range(true_bearings.shape[1]):
-            out[i, j] = wrap(true_bearings[i, j] + offsets[i, j])
-
-
-@njit(**JIT_OPTIONS)
-def _add_wrapped_with_outliers(
-    true_bearings: FloatArray,
-    offsets: FloatArray,
-    is_outlier: NDArray[np.bool_],
-    replacement: FloatArray,
-    out: FloatArray,
-) -> None:
-    for i in range(true_bearings.shape[0]):
-        for j in range(true_bearings.shape[1]):
-            value = replacement[i, j] if is_outlier[i, j] else true_bearings[i, j] + offsets[i, j]
-            out[i, j] = wrap(value)
-
-
 # --------------------------------------------------------------------------------------
 # Scenarios and layouts
 # --------------------------------------------------------------------------------------
@@ -592,83 +576,6 @@ class World:
 # --------------------------------------------------------------------------------------
 # Many worlds at once (the envs' core, bearing_env.envs.core; a World is a batch of one)
 # --------------------------------------------------------------------------------------
-
-
-@njit(**JIT_OPTIONS)
-def bearing(landmark_x: float, landmark_y: float, x: float, y: float, heading: float) -> float:
-    """The noise-free bearing of a landmark from a pose, radians CCW from the heading."""
-    return wrap(math.atan2(landmark_y - y, landmark_x - x) - heading)
-
-
-@njit(**JIT_OPTIONS)
-def straight_move(
-    x: float,
-    y: float,
-    heading: float,
-    length: float,
-    width: float,
-    height: float,
-    margin: float,
-    min_baseline: float,
-) -> tuple[float, float, float, bool]:
-    """One straight move stopped at the wall margin: ``(new x, new y, travelled, blocked)``.
-
-    A robot that could not move at least ``min_baseline`` (against the wall, up to
-    rounding) does not move at all.
-    """
-    dx, dy = math.cos(heading), math.sin(heading)
-    # Per axis, the wall the heading points at is the only one that can stop it.
-    room_x = (width - margin - x) / dx if dx > 0.0 else (margin - x) / dx if dx < 0.0 else np.inf
-    room_y = (height - margin - y) / dy if dy > 0.0 else (margin - y) / dy if dy < 0.0 else np.inf
-    free = max(0.0, min(room_x, room_y))
-    if free < min_baseline:
-        free = 0.0
-    travelled = min(length, free)
-    # Rounding can leave the robot a hair outside the margin; clamp so the invariant
-    # "always inside the margin" holds exactly.
-    new_x = min(max(x + travelled * dx, margin), width - margin)
-    new_y = min(max(y + travelled * dy, margin), height - margin)
-    return new_x, new_y, travelled, free < length
-
-
-@njit(**JIT_OPTIONS)
-def obstructed_move(
-    x: float,
-    y: float,
-    heading: float,
-    length: float,
-    settings: tuple[float, float, float, float],
-    vertices: FloatArray,
-    starts: NDArray[np.int64],
-) -> tuple[float, float, float, bool]:
-    """:func:`straight_move` that also stops ``margin`` short of the obstacles (packed,
-    see :mod:`bearing_env.sensing`); ``settings`` is (width, height, margin,
-    min_baseline). Without obstacles it is :func:`straight_move`, bit for bit."""
-    width, height, margin, min_baseline = settings
-    room = free_length(x, y, heading, vertices, starts, margin)
-    if room >= length:
-        return straight_move(x, y, heading, length, width, height, margin, min_baseline)
-    if room < min_baseline:
-        room = 0.0
-    new_x, new_y, travelled, _ = straight_move(
-        x, y, heading, room, width, height, margin, min_baseline
-    )
-    return new_x, new_y, travelled, True
-
-
-@njit(**JIT_OPTIONS)
-def _true_bearings_into(
-    landmarks: FloatArray, positions: FloatArray, headings: FloatArray, out: FloatArray
-) -> None:
-    for i in range(landmarks.shape[0]):
-        for j in range(landmarks.shape[1]):
-            out[i, j] = bearing(
-                landmarks[i, j, 0],
-                landmarks[i, j, 1],
-                positions[i, 0],
-                positions[i, 1],
-                headings[i],
-            )
 
 
 def true_bearings(landmarks: FloatArray, positions: FloatArray, headings: FloatArray) -> FloatArray:

@@ -22,6 +22,7 @@ import numpy as np
 from gymnasium import spaces
 from numpy.typing import NDArray
 
+from bearing_env import _core
 from bearing_env.envs import kernels
 from bearing_env.envs.config import EnvConfig
 from bearing_env.numerics import wrap, wrap_angle
@@ -72,12 +73,13 @@ class ContinuousActions:
         if values.ndim != 2 or values.shape[1] != 2:
             raise ValueError(f"actions must have shape (N, 2), got shape {values.shape}")
         if values.dtype != np.float32 and values.dtype != np.float64:
-            # float16, longdouble and integer actions: the compiled decoder takes float32 or
-            # float64 only (numba has no float16 or longdouble). Cast; the range check follows.
+            # float16, longdouble and integer actions: the native decoder takes float32 or
+            # float64 only. Cast; the range check follows.
             values = values.astype(np.float64)
         turns, lengths = np.empty(values.shape[0]), np.empty(values.shape[0])
         lo, hi = config.actions.move_length
-        outcome = kernels.decode_continuous(values, lo, hi, turns, lengths)
+        values = np.ascontiguousarray(values)  # the native decoder takes C-contiguous arrays
+        outcome = _core.decode_continuous(values, lo, hi, turns, lengths)
         if outcome == kernels.ACTIONS_NOT_FINITE:
             raise ValueError(f"actions must be finite, got {actions!r}")
         if outcome == kernels.ACTIONS_OUTSIDE:

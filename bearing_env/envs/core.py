@@ -9,8 +9,8 @@ compute on a group of rows at once:
   draws from the row's generator), and draws each row's first block of movement noise
   ahead (:func:`fill_noise`);
 - :func:`step` moves the robots, reads the sensors, updates the maps and computes the
-  rewards, terminations, truncations, observations and infos, in one compiled call
-  (``kernels.step_rows``); :func:`report` gives the observations and infos alone;
+  rewards, terminations, truncations, observations and infos, in one native call
+  (``_core.step_rows``); :func:`report` gives the observations and infos alone;
 - :func:`infos` and :func:`single_info` make the info dicts of the step's arrays.
 
 ``BearingSLAMEnv`` is a batch of one; ``BearingSLAMVectorEnv`` steps the whole batch.
@@ -35,6 +35,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from bearing_env import _core
 from bearing_env.envs import kernels, robot_map
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig
 from bearing_env.envs.kernels import Settings
@@ -48,6 +49,7 @@ from bearing_env.slam import kernels as slam_kernels
 from bearing_env.slam.batch import (
     CONTAINMENT_TOLERANCE,
     PARALLEL_MIN_MAPS,
+    STATE_ARRAYS,
     BatchedPolygonSLAM,
 )
 from bearing_env.world import (
@@ -84,36 +86,35 @@ class MapBank:
         self.num_rows = num_rows
         self.batches: dict[tuple[int, MapSettings], BatchedPolygonSLAM] = {}
         self._views: dict[tuple[int, MapSettings, int], PolygonSLAM] = {}
-        #: Each (landmark count, config)'s kernel inputs (an ``InputsRef``), with the
-        #: state and map references they were made of, and what its steps reuse (the
-        #: step kernels' compiled functions and output arrays: see :func:`step`).
-        self._inputs: dict[
-            tuple[int, EnvConfig], tuple[Any, Any, kernels.Inputs, dict[Any, Any]]
-        ] = {}
+        #: Each (landmark count, config)'s native kernel inputs (``_core.EnvInputs``),
+        #: with the state and map batch they were made of, and what its steps reuse (the
+        #: step's output arrays: see :func:`step`).
+        self._inputs: dict[tuple[int, EnvConfig], tuple[Any, Any, Any, dict[Any, Any]]] = {}
 
     def group(self, state: BatchState, rows: IntArray, config: EnvConfig) -> Group:
         """The group of ``rows`` (all with ``config`` and one landmark count), with its
         kernel inputs: made once per (config, count) and state, then reused."""
         n = int(state.n_landmarks[rows[0]])
-        state_ref = state.kernel_ref()
         last = self.__dict__.get("_last")
-        if last is None or last[0] is not config or last[1] != n or last[2] is not state_ref:
-            last = self._last = (config, n, state_ref, *self._inputs_for(n, config, state_ref))
+        if last is None or last[0] is not config or last[1] != n or last[2] is not state:
+            last = self._last = (config, n, state, *self._inputs_for(n, config, state))
         return Group(rows, config, n, last[3], last[4], last[5])
 
     def batch(self, n_landmarks: int, config: EnvConfig) -> BatchedPolygonSLAM:
         return self._batch_for(int(n_landmarks), config.map_settings)
 
     def _inputs_for(
-        self, n: int, config: EnvConfig, state_ref: BatchState
-    ) -> tuple[BatchedPolygonSLAM, kernels.Inputs, dict[Any, Any]]:
+        self, n: int, config: EnvConfig, state: BatchState
+    ) -> tuple[BatchedPolygonSLAM, Any, dict[Any, Any]]:
         batch = self._batch_for(n, config.map_settings)
-        maps_ref = batch._kernel_state()
         kept = self._inputs.get((n, config))
-        if kept is None or kept[0] is not state_ref or kept[1] is not maps_ref:
-            settings, params = kernel_settings(n, config), batch._kernel_params(True)
-            inputs = kernels.inputs_ref(kernels.Inputs(settings, params, maps_ref, state_ref))
-            kept = self._inputs[n, config] = (state_ref, maps_ref, inputs, {})
+        if kept is None or kept[0] is not state or kept[1] is not batch:
+            # The batch's arrays are only ever written in place (a new batch, after a
+            # pickle, has new ones): the inputs hold views of them and of the state's.
+            maps = _core.MapState(slam_kernels.State(*(batch.__dict__[k] for k in STATE_ARRAYS)))
+            params = batch._kernel_params(True)
+            inputs = _core.EnvInputs(kernel_settings(n, config), params, maps, state)
+            kept = self._inputs[n, config] = (state, batch, inputs, {})
         return batch, kept[2], kept[3]
 
     def _batch_for(self, n_landmarks: int, settings: MapSettings) -> BatchedPolygonSLAM:
@@ -132,7 +133,7 @@ class MapBank:
         return self._views[key]
 
     def __getstate__(self) -> dict[str, Any]:
-        # The kernel inputs (structrefs) cannot be pickled; they are made again.
+        # The native kernel inputs hold views, not arrays: they are made again.
         state = {key: value for key, value in self.__dict__.items() if key != "_last"}
         state["_inputs"] = {}
         return state
@@ -146,9 +147,8 @@ class Group(NamedTuple):
     config: EnvConfig
     n: int  #: the rows' landmark count
     batch: BatchedPolygonSLAM  #: their maps
-    inputs: kernels.Inputs  #: what the kernels take (an ``InputsRef``)
-    #: What the group's steps reuse: the step kernels' compiled functions for these
-    #: inputs (:func:`_call`) and their output arrays (:func:`_outputs`).
+    inputs: Any  #: what the kernels take (a ``_core.EnvInputs``)
+    #: What the group's steps reuse: their output arrays (:func:`_outputs`).
     reused: dict[Any, Any]
 
 
@@ -427,16 +427,15 @@ def step(
     """
     config, inputs = group.config, group.inputs
     rows, turns, lengths = _owned(group.rows, np.int64), _owned(turns), _owned(lengths)
-    # Small batches stay on one thread (see PARALLEL_MIN_MAPS): asking numba costs ~2 us.
+    # Small batches stay on one thread (see PARALLEL_MIN_MAPS).
     threads = slam_kernels.threads() if rows.size >= PARALLEL_MIN_MAPS else 1
-    report, encoded = _outputs(group, rows.size)
+    report, encoded, outputs = _outputs(group, rows.size)
+    with_map = encoded is not None
     while True:
         # The trajectory array is replaced when it grows: read it on every try.
-        args = (rows, turns, lengths, inputs, state.trajectory, threads, report)
-        if encoded is not None:
-            status = _call(group, kernels.step_rows, (*args, encoded.kernel))
-        else:
-            status = _call(group, kernels.step_rows_bare, args)
+        status = _core.step_rows(
+            rows, turns, lengths, inputs, state.trajectory, threads, outputs, with_map
+        )
         if status == kernels.STEP_DONE:
             return report, _robot_map_of(group, encoded)
         if status == kernels.STEP_NEEDS_NOISE:
@@ -446,30 +445,33 @@ def step(
             state.grow_trajectory()
 
 
-def _outputs(group: Group, size: int) -> tuple[kernels.Report, robot_map.Buffers | None]:
+def _outputs(group: Group, size: int) -> tuple[kernels.Report, robot_map.Buffers | None, Any]:
     """The step kernels' output arrays for ``size`` of the group's rows: made once per
     group (for every row of the bank), then reused, so that a step hands nothing new out
     of its compiled call (see :mod:`bearing_env.envs.kernels`); the robot map's encoded
     arrays are None with ``robot_map_info`` off. Whoever keeps what a step wrote copies
-    it (:func:`infos`, :func:`single_info`)."""
+    it (:func:`infos`, :func:`single_info`). The third is the native ``StepOutputs``
+    over the arrays of every row (with the step's buffers): a step of ``size`` rows
+    writes their first ``size`` rows."""
     outputs = group.reused.get(_OUTPUTS)
     if outputs is None:
         every_row = np.arange(group.batch.num_maps)
         encoded = None
         if group.config.observations.robot_map_info:
             slots = max(group.config.observations.max_landmarks - 2, group.n - 2)
-            maps = group.batch._kernel_state()
-            encoded = robot_map.buffers(robot_map.encode_map(maps, every_row, slots))
-        outputs = group.reused[_OUTPUTS] = (
-            kernels.new_report(every_row.size, group.inputs),
-            encoded,
+            encoded = robot_map.buffers(_core.encode_map(group.inputs, every_row, slots))
+        report = kernels.Report._make(_core.new_report(every_row.size, group.inputs))
+        native = _core.StepOutputs(
+            group.inputs, report, None if encoded is None else encoded.kernel
         )
-    report, encoded = outputs
+        outputs = group.reused[_OUTPUTS] = (report, encoded, native)
+    report, encoded, native = outputs
     if size == report.rewards.size:
-        return report, encoded
+        return report, encoded, native
     return (
         kernels.Report._make(values[:size] for values in report),
         None if encoded is None else encoded.rows(size),
+        native,
     )
 
 
@@ -479,31 +481,19 @@ _OUTPUTS = "outputs"
 
 def _owned(values: NDArray[Any], dtype: type = np.float64) -> NDArray[Any]:
     """``values`` as a C-contiguous, writeable array of ``dtype`` (itself if it is one):
-    the one array type the step kernels' compiled functions are resolved for."""
+    the one array type the native step takes."""
     flags = values.flags
     if values.dtype == dtype and values.ndim == 1 and flags.c_contiguous and flags.writeable:
         return values
     return np.require(np.array(values, dtype=dtype, ndmin=1), requirements=["C", "W"])
 
 
-def _call(group: Group, kernel: Any, args: tuple[Any, ...]) -> Any:
-    """``kernel(*args)`` through its compiled function for the group's inputs, resolved at
-    the first call (:func:`bearing_env.slam.kernels.entry_point`): numba's dispatcher types
-    every argument in Python on each call, about 30 us of a single env's step. The arrays
-    are :func:`_owned` or the group's own outputs, so their types never change for one
-    inputs object."""
-    entry = group.reused.get(kernel)
-    if entry is None:
-        entry = group.reused[kernel] = slam_kernels.entry_point(kernel, args)
-    return entry(*args)
-
-
 def report(state: BatchState, group: Group) -> tuple[kernels.Report, dict[str, Any] | None]:
     """The group's observations and infos as they stand (after a reset: nothing moved,
     nothing earned), with the ``robot_map`` info (None with ``robot_map_info`` off)."""
     slots = group.config.observations.max_landmarks - 2
-    report, encoded = kernels.report_rows(group.rows, group.inputs, slots)
-    return report, _robot_map(group, encoded)
+    arrays, encoded = _core.report_rows(_owned(group.rows, np.int64), group.inputs, slots)
+    return kernels.Report._make(arrays), _robot_map(group, encoded)
 
 
 def _robot_map(group: Group, encoded: tuple[Any, ...] | None) -> dict[str, Any] | None:
@@ -527,10 +517,11 @@ def _with_fusion_arrays(group: Group, info: dict[str, Any]) -> dict[str, Any]:
     if batch.fusion == "intersect":
         return info
     slots = max(group.config.observations.max_landmarks - 2, group.n - 2)
+    rows = _owned(group.rows, np.int64)
     if batch.fusion == "relaxed":
-        more = robot_map.encode_window(batch._kernel_state(), group.rows, slots)
+        more = _core.encode_window(group.inputs, rows, slots)
     else:
-        more = robot_map.encode_levels(batch._kernel_state(), group.rows, slots)
+        more = _core.encode_levels(group.inputs, rows, slots)
     names = batch.state_names[len(robot_map.MAP_ARRAYS) :]
     return {**info, **robot_map.as_info(names, more)}
 
@@ -608,7 +599,7 @@ def release_noise(state: BatchState, row: int) -> None:
 def potentials(state: BatchState, group: Group) -> FloatArray:
     """The uncertainty potential Phi of the group's maps (see the env's Rewards section)."""
     out = np.empty(group.rows.size)
-    kernels.potentials(group.rows, group.inputs, out)
+    _core.potentials(_owned(group.rows, np.int64), group.inputs, out)
     return out
 
 

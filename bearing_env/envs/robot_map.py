@@ -23,10 +23,13 @@ from collections.abc import Mapping
 from typing import Any, NamedTuple
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
-from bearing_env.numerics import JIT_OPTIONS
+from bearing_env._core import _known as _known
+from bearing_env._core import encode_levels as encode_levels
+from bearing_env._core import encode_map as encode_map
+from bearing_env._core import encode_map_into as encode_map_into
+from bearing_env._core import encode_window as encode_window
 from bearing_env.slam import MapSettings, PolygonSLAM
 from bearing_env.slam.batch import (
     LANDMARK_AXES,
@@ -52,10 +55,11 @@ def encode(batch: BatchedPolygonSLAM, rows: NDArray[np.int64], slots: int) -> di
     """The map state of the batch's ``rows``, as an info's data (arrays with the rows
     first), per-landmark arrays padded to ``slots`` landmark slots.
 
-    One compiled call gathers every array at once, already in the canonical form, into
+    One native call gathers every array at once, already in the canonical form, into
     arrays it makes (:func:`encode_map`, and :func:`encode_window` for the relaxed
     fusion's window and bases): a Python loop over the arrays costs several times more."""
     state, slots = batch._kernel_state(), max(int(slots), batch.n_landmarks - 2)
+    rows = np.ascontiguousarray(rows, dtype=np.int64)
     arrays = encode_map(state, rows, slots)
     if batch.fusion == "relaxed":
         arrays += encode_window(state, rows, slots)
@@ -108,178 +112,10 @@ def buffers(arrays: tuple[NDArray[Any], ...]) -> Buffers:
     return Buffers(info, tuple(kernel))
 
 
-@njit(**JIT_OPTIONS)
-def _known(value: complex) -> complex:  # pragma: no cover  (compiled)
-    """A complex point, inf + inf j if unknown (NaN in either part)."""
-    if np.isnan(value.real) or np.isnan(value.imag):
-        return complex(np.inf, np.inf)
-    return value
-
-
-@njit(**JIT_OPTIONS)
-def encode_map(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
-    """The arrays every fusion uses (``STATE_ARRAYS`` up to ``n_inconsistent``), in
-    their order, for ``rows``: landmark slots padded to ``slots`` (see the module doc)."""
-    size, capacity = rows.size, state.vertices.shape[2]
-    encoded = (
-        np.zeros((size, slots, capacity), np.complex128),
-        np.zeros((size, slots), np.int64),
-        np.full((size, slots), np.inf),
-        np.full((size, slots), complex(np.inf, np.inf)),
-        np.zeros((size, capacity), np.complex128),
-        np.empty(size, np.int64),
-        np.empty(size),
-        np.empty(size, np.complex128),
-        np.empty(size),
-        np.empty(size, np.int64),
-        np.empty(size, np.int64),
-        np.empty(size, np.int64),
-    )
-    encode_map_into(state, rows, encoded)
-    return encoded
-
-
-@njit(**JIT_OPTIONS)
-def encode_map_into(state: Any, rows: Any, encoded: Any) -> None:  # pragma: no cover
-    """:func:`encode_map` into its arrays ``encoded`` (of ``len(rows)`` rows, its slot
-    count theirs), whatever they held: the env step reuses them from step to step."""
-    (
-        vertices,
-        counts,
-        areas,
-        centroids,
-        robot_vertices,
-        robot_counts,
-        robot_area,
-        robot_centroid,
-        robot_heading,
-        n_updates,
-        n_frame_changes,
-        n_inconsistent,
-    ) = encoded
-    mapped = state.counts.shape[1]
-    for i in range(rows.size):
-        row = rows[i]
-        for j in range(mapped):
-            count = state.counts[row, j]
-            counts[i, j] = count
-            vertices[i, j, :count] = state.vertices[row, j, :count]
-            vertices[i, j, count:] = 0.0
-            areas[i, j] = state.areas[row, j]
-            centroids[i, j] = _known(state.centroids[row, j])
-        count = state.robot_counts[row]
-        robot_counts[i] = count
-        robot_vertices[i, :count] = state.robot_vertices[row, :count]
-        robot_vertices[i, count:] = 0.0
-        robot_area[i] = state.robot_area[row]
-        robot_centroid[i] = _known(state.robot_centroid[row])
-        heading = state.robot_heading[row]
-        robot_heading[i] = np.inf if np.isnan(heading) else heading
-        n_updates[i] = state.n_updates[row]
-        n_frame_changes[i] = state.n_frame_changes[row]
-        n_inconsistent[i] = state.n_inconsistent[row]
-
-
-@njit(**JIT_OPTIONS)
-def encode_window(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
-    """The relaxed fusion's arrays (``RELAXED_STATE_ARRAYS``), as :func:`encode_map`."""
-    size, mapped = rows.size, state.counts.shape[1]
-    window, capacity = state.window_vertices.shape[1], state.window_vertices.shape[3]
-    base_capacity = state.base_vertices.shape[2]
-    window_vertices = np.zeros((size, window, slots, capacity), np.complex128)
-    window_counts = np.zeros((size, window, slots), np.int64)
-    window_inlier = np.zeros((size, window, slots), np.bool_)
-    window_rejected = np.empty((size, window), np.bool_)
-    window_length = np.empty(size, np.int64)
-    window_next = np.empty(size, np.int64)
-    base_vertices = np.zeros((size, slots, base_capacity), np.complex128)
-    base_counts = np.zeros((size, slots), np.int64)
-    n_dropped = np.zeros((size, slots), np.int64)
-    outliers = np.zeros((size, slots), np.int64)
-    for i in range(size):
-        row = rows[i]
-        for k in range(window):
-            window_rejected[i, k] = state.window_rejected[row, k]
-            for j in range(mapped):
-                count = state.window_counts[row, k, j]
-                window_counts[i, k, j] = count
-                window_vertices[i, k, j, :count] = state.window_vertices[row, k, j, :count]
-                window_inlier[i, k, j] = state.window_inlier[row, k, j]
-        window_length[i] = state.window_length[row]
-        window_next[i] = state.window_next[row]
-        for j in range(mapped):
-            count = state.base_counts[row, j]
-            base_counts[i, j] = count
-            base_vertices[i, j, :count] = state.base_vertices[row, j, :count]
-            n_dropped[i, j] = state.n_dropped[row, j]
-            outliers[i, j] = state.outliers[row, j]
-    return (
-        window_vertices,
-        window_counts,
-        window_inlier,
-        window_rejected,
-        window_length,
-        window_next,
-        base_vertices,
-        base_counts,
-        n_dropped,
-        outliers,
-    )
-
-
-@njit(**JIT_OPTIONS)
-def encode_levels(state: Any, rows: Any, slots: int) -> Any:  # pragma: no cover  (compiled)
-    """The robust fusion's arrays (``ROBUST_STATE_ARRAYS``), as :func:`_encode_map`."""
-    size, mapped = rows.size, state.counts.shape[1]
-    levels, capacity = state.level_vertices.shape[2], state.level_vertices.shape[3]
-    history = state.history_bearings.shape[1]
-    outliers = np.zeros((size, slots), np.int64)
-    level_vertices = np.zeros((size, slots, levels, capacity), np.complex128)
-    level_counts = np.zeros((size, slots, levels), np.int64)
-    n_regions = np.zeros((size, slots), np.int64)
-    robot_fixed_at = np.empty(size, np.int64)
-    noise_scale = np.empty(size)
-    bound_events = np.empty(size, np.int64)
-    probe_vertices = np.zeros((size, slots, state.probe_vertices.shape[2]), np.complex128)
-    probe_counts = np.zeros((size, slots), np.int64)
-    history_frame_bearings = np.empty((size, history, 2, 2))
-    history_bearings = np.zeros((size, history, 2, slots))
-    history_length = np.empty(size, np.int64)
-    history_next = np.empty(size, np.int64)
-    for i in range(size):
-        row = rows[i]
-        robot_fixed_at[i] = state.robot_fixed_at[row]
-        noise_scale[i] = state.noise_scale[row]
-        bound_events[i] = state.bound_events[row]
-        history_frame_bearings[i] = state.history_frame_bearings[row]
-        history_length[i] = state.history_length[row]
-        history_next[i] = state.history_next[row]
-        for j in range(mapped):
-            outliers[i, j] = state.outliers[row, j]
-            n_regions[i, j] = state.n_regions[row, j]
-            for k in range(levels):
-                count = state.level_counts[row, j, k]
-                level_counts[i, j, k] = count
-                level_vertices[i, j, k, :count] = state.level_vertices[row, j, k, :count]
-            count = state.probe_counts[row, j]
-            probe_counts[i, j] = count
-            probe_vertices[i, j, :count] = state.probe_vertices[row, j, :count]
-            history_bearings[i, :, :, j] = state.history_bearings[row, :, :, j]
-    return (
-        outliers,
-        level_vertices,
-        level_counts,
-        n_regions,
-        robot_fixed_at,
-        noise_scale,
-        bound_events,
-        probe_vertices,
-        probe_counts,
-        history_frame_bearings,
-        history_bearings,
-        history_length,
-        history_next,
-    )
+# The codec's kernels are native (csrc/env/robot_map.cpp): ``encode_map`` (a map
+# batch's arrays for ``rows``, with ``slots`` landmark slots), ``encode_map_into`` (the
+# same into arrays made once), ``encode_window`` and ``encode_levels`` (the relaxed and
+# robust fusions' arrays); each takes a native MapState, a State or an EnvInputs.
 
 
 def decode(data: Mapping[str, Any], n_landmarks: int, settings: MapSettings) -> PolygonSLAM:

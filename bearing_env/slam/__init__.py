@@ -14,11 +14,11 @@ Public API:
 * :func:`transfer_polygon` / :func:`transfer_point`: the FR -> FL transfer of a region
   or a point, as shapely geometry (one movement, for inspection and tests).
 * :func:`world_to_fl` / :func:`fl_to_world`: frame conversions given L1 and L2.
-* :mod:`bearing_env.slam.kernels`: the compiled kernels underneath (numba), a package
-  of topical modules (``common``, ``polygons``, ``frames``, ``state``, ``fusion``,
-  ``update``) whose names it re-exports; the update takes the map's state as a
-  ``State`` (22 arrays, passed as a ``StateRef`` structref), its settings as ``Params``
-  and returns statuses in ``Outputs``. :mod:`bearing_env.slam.geometry`: their entry
+* :mod:`bearing_env.slam.kernels`: the native kernels underneath (C++17, ``csrc/slam/``),
+  a package of topical modules (``common``, ``polygons``, ``frames``, ``state``,
+  ``fusion``, ``robust``, ``update``) whose names it re-exports; the update takes the
+  map's state as a ``State`` (34 arrays, passed as a native ``MapState``), its settings
+  as ``Params`` and returns statuses in ``Outputs``. :mod:`bearing_env.slam.geometry`: their entry
   points for one-off polygon geometry.
 """
 

@@ -1,8 +1,8 @@
-"""Many maps updated in one compiled call: the engine under every PolygonSLAM.
+"""Many maps updated in one native call: the engine under every PolygonSLAM.
 
 :class:`BatchedPolygonSLAM` holds ``num_maps`` independent maps with the same number of
 landmarks and the same settings, as arrays with a leading map axis, and fuses one
-movement per map in one call of the compiled kernel
+movement per map in one call of the native kernel
 :func:`~bearing_env.slam.kernels.update_maps`. :class:`~bearing_env.slam.PolygonSLAM`
 is a batch of one; the batched vector environment steps all its sub-environments'
 maps at once.
@@ -16,7 +16,6 @@ environment reproduce the single environment bit for bit.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,7 +23,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.slam import kernels
-from bearing_env.slam.compile_notice import announce_compile_once
 from bearing_env.slam.settings import (
     DEFAULT_MAX_OUTLIERS,
     DEFAULT_RISK,
@@ -77,11 +75,9 @@ LANDMARK_STATUSES: tuple[str, ...] = _names_by_code(
 LANDMARK_CODE = {name: code for code, name in enumerate(LANDMARK_STATUSES)}
 
 
-#: Batches of at least this many maps are updated on all of numba's threads
-#: (``NUMBA_NUM_THREADS``; see :func:`bearing_env.slam.kernels.threads`). Below it, handing
-#: the work to the threads costs more than it saves: on the 2-core development VM, a
-#: 16-env batched step took 65 against 46 us per sub-env (two threads against one, best of
-#: five rounds), level at 32-48 envs, and 9-12% faster from 64 envs.
+#: Batches of at least this many maps are updated on :func:`bearing_env.slam.kernels.threads`
+#: threads (``BEARING_ENV_NUM_THREADS``, else the CPUs the process may use). Below it,
+#: handing the work to threads costs more than it saves (see the performance page).
 PARALLEL_MIN_MAPS = 32
 
 #: How far outside a region a point may lie and still count as inside, relative to the
@@ -195,8 +191,7 @@ class BatchedPolygonSLAM(HasMapSettings):
         self.history_bearings = np.zeros((n, h, 2, m))
         self.history_length = np.zeros(n, dtype=np.int64)
         self.history_next = np.zeros(n, dtype=np.int64)
-        self._state_ref: kernels.State | None = None
-        announce_compile_once()
+        self._state_ref: kernels.MapState | None = None
         self.reset()
 
     @classmethod
@@ -310,17 +305,12 @@ class BatchedPolygonSLAM(HasMapSettings):
     def _run_update(
         self, b1: FloatArray, b2: FloatArray, rows: IntArray, robot: bool, out: kernels.Outputs
     ) -> None:
-        """The update kernel on checked input, writing what it did to ``out`` (arrays
-        over ``rows``): serial, or on all of numba's threads for a large batch."""
-        params = self._kernel_params(robot)
-        if rows.size >= PARALLEL_MIN_MAPS and (threads := kernels.threads()) > 1:
-            blocks = min(rows.size, threads)
-            _call(
-                kernels.update_maps_parallel,
-                (blocks, b1, b2, rows, params, self._kernel_state(), out),
-            )
-        else:
-            _call(kernels.update_maps, (b1, b2, rows, params, self._kernel_state(), out))
+        """The native update on checked input, writing what it did to ``out`` (arrays
+        over ``rows``): one thread, or blocks of maps on several for a large batch."""
+        threads = kernels.threads() if rows.size >= PARALLEL_MIN_MAPS else 1
+        kernels.update_maps(
+            b1, b2, rows, self._kernel_params(robot), self._kernel_state(), out, threads
+        )
 
     def contains(self, points: ArrayLike, maps: ArrayLike | None = None) -> NDArray[np.bool_]:
         """Whether region ``i`` of each map contains FL point ``i`` (boundary counts).
@@ -394,10 +384,11 @@ class BatchedPolygonSLAM(HasMapSettings):
             return common + ROBUST_STATE_ARRAYS
         return common
 
-    def _kernel_state(self) -> kernels.State:
-        """The state as the kernels take it: a :class:`kernels.StateRef` to this batch's
-        arrays, made on first use and kept (the arrays are only ever written in place)."""
-        ref: kernels.State | None = self._state_ref
+    def _kernel_state(self) -> kernels.MapState:
+        """The state as the kernels take it: a native :class:`kernels.MapState` of this
+        batch's arrays, made on first use and kept (the arrays are only ever written in
+        place)."""
+        ref: kernels.MapState | None = self._state_ref
         if ref is None:
             d = self.__dict__
             ref = kernels.state_ref(kernels.State(*(d[name] for name in STATE_ARRAYS)))
@@ -443,9 +434,11 @@ class BatchedPolygonSLAM(HasMapSettings):
         return check_bearings(bearings, (n_rows, self.n_landmarks), name)
 
     def __getstate__(self) -> dict[str, Any]:
-        # The kernels' reference to the arrays cannot be pickled; it is made again.
+        # The native reference to the arrays and the native settings are not pickled;
+        # they are made again on first use.
         state = self.__dict__.copy()
         state["_state_ref"] = None
+        state.pop("_params", None)  # native settings: made again from the batch's own
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -456,20 +449,6 @@ class BatchedPolygonSLAM(HasMapSettings):
                 state[key] = value.copy()
         state["_state_ref"] = None
         self.__dict__.update(state)
-
-
-#: Each update kernel's compiled function, resolved at its first call (see
-#: :func:`bearing_env.slam.kernels.entry_point`): every batch passes it arguments of the
-#: same types (checked float64 bearings, int64 rows, the kernels' own structures).
-_ENTRY_POINTS: dict[object, Callable[..., None]] = {}
-
-
-def _call(kernel: Callable[..., None], args: tuple[Any, ...]) -> None:
-    """``kernel(*args)`` through its compiled function, without numba's per-call typing."""
-    entry = _ENTRY_POINTS.get(kernel)
-    if entry is None:
-        entry = _ENTRY_POINTS[kernel] = kernels.entry_point(kernel, args)
-    entry(*args)
 
 
 #: The per-map state, every array with the map axis first: the fields of

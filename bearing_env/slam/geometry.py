@@ -104,10 +104,10 @@ def relaxed_intersection(
             )
         maps.window_vertices[0, i, 0, : vertices.size] = vertices
         maps.window_counts[0, i, 0] = vertices.size
-    scratch = kernels.new_scratch()
-    scratch.slots[:k] = np.arange(k)
-    n, q = kernels.relaxed_region(maps._kernel_state(), 0, 0, k, False, int(max_outliers), scratch)
-    return scratch.acc[:n].copy(), int(q), maps.window_inlier[0, :, 0].copy()
+    union = np.empty(kernels.SCRATCH, dtype=np.complex128)
+    slots = np.arange(k, dtype=np.int64)
+    n, q = kernels.relaxed_region(maps._kernel_state(), 0, 0, slots, False, max_outliers, union)
+    return union[:n].copy(), int(q), maps.window_inlier[0, :, 0].copy()
 
 
 def robust_levels(polygons: list[ArrayLike]) -> list[ComplexArray]:
@@ -118,15 +118,14 @@ def robust_levels(polygons: list[ArrayLike]) -> list[ComplexArray]:
     if not polygons:
         raise ValueError("robust_levels needs at least one polygon, got none")
     maps = BatchedPolygonSLAM(1, 3, 0.1, fusion="robust")
-    state, scratch = maps._kernel_state(), kernels.new_scratch()
+    state = maps._kernel_state()
     for i, polygon in enumerate(polygons):
         vertices = _polygon(polygon)
         if not 3 <= vertices.size <= kernels.CAPACITY:
             raise ValueError(
                 f"polygon {i} must have 3..{kernels.CAPACITY} vertices, got {vertices.size}"
             )
-        scratch.fresh[: vertices.size] = vertices
-        kernels.update_levels(state, 0, 0, vertices.size, scratch)
+        kernels.update_levels(state, 0, 0, vertices)
     levels = min(len(polygons), kernels.ROBUST_LEVELS)
     return [
         maps.level_vertices[0, 0, k, : maps.level_counts[0, 0, k]].copy() for k in range(levels)

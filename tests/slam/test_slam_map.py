@@ -761,10 +761,7 @@ def test_the_threaded_kernel_gives_the_serial_kernels_maps_bit_for_bit(transfer,
                 np.empty(16, dtype=np.int64),
             )
             arguments = (b1, b2, rows, batch._kernel_params(True), batch._kernel_state(), out)
-            if threads:
-                kernels.update_maps_parallel(threads, *arguments)  # 4 blocks, any cores
-            else:
-                kernels.update_maps(*arguments)
+            kernels.update_maps(*arguments, max(threads, 1))  # 4 blocks on threads, any cores
             frame, landmark, bad = out
             outputs.append((frame, landmark, bad))
         for mine, theirs in zip(*outputs, strict=True):

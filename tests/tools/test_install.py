@@ -11,11 +11,8 @@ from the repository's folders. Checked:
   wheel's venv shows holds for the sdist's;
 - ``import bearing_env; gym.make("BearingSLAM-v0")`` works in both; in the wheel's venv
   it also resets and steps;
-- the wheel's venv is a read-only install: numba may not write into the installed
-  package (``_read_only_package.py`` there refuses it, as a read-only site-packages
-  would; root ignores file modes), so the compiled core goes to numba's user cache
-  (``$XDG_CACHE_HOME/numba``), the first step says it compiles, and a second fresh
-  process loads the cache in silence, far sooner;
+- the native core comes compiled in the wheel: a fresh process steps at once, and no
+  JIT compiler (numba, llvmlite) is imported;
 - the README's quick start (its one Python block under "Quick start") runs as written
   from the wheel;
 - ``bearing-env compare --quick`` (3 episodes) runs the three heuristics, says it
@@ -27,9 +24,9 @@ from the repository's folders. Checked:
   with only pytest, hypothesis and pytest-xdist added: none fails, and every test that
   needs an extra skips, naming the extra and its install command (``tests/extras.py``).
 
-The numba core compiles from an empty cache once in the wheel's venv (its cache is keyed
-by the installed source path, so no venv can share another's), which is most of this
-module's cost without the ``slow`` test; the sdist's venv compiles only in that test.
+Building the wheel and installing the sdist each compile the native core (the sdist's in
+pip's isolated build environment, with scikit-build-core and nanobind from the index),
+which is most of this module's cost.
 """
 
 from __future__ import annotations
@@ -48,7 +45,6 @@ from typing import Any
 
 import pytest
 
-from bearing_env.slam import compile_notice
 from tests.extras import build_backend_missing
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -82,7 +78,7 @@ import bearing_env
 import sys
 env = gym.make("BearingSLAM-v0")
 report = {"observation_space": str(env.observation_space)}
-if "--step" in sys.argv:  # compiles the numba core
+if "--step" in sys.argv:
     observation, info = env.reset(seed=3)
     step = env.step(env.action_space.sample())
     report["in_space"] = bool(env.observation_space.contains(step[0]))
@@ -90,30 +86,12 @@ report["seconds"] = time.perf_counter() - start
 print(json.dumps({
     **report,
     "module": bearing_env.__file__,
+    "jit_modules": sorted(n for n in sys.modules if n.split(".")[0] in ("numba", "llvmlite")),
     "extras": [n for n in ("stable_baselines3", "torch", "pygame", "matplotlib")
                if importlib.util.find_spec(n) is not None],
 }))
 """
 
-#: Imported at the start of every Python process of the wheel's venv (by a ``.pth``
-#: file): numba may not create its cache folder inside the installed package, as when
-#: site-packages is read-only (root, which runs CI, ignores file modes).
-READ_ONLY_PACKAGE = """
-import os
-import numba.core.caching as caching
-
-_package = os.path.realpath(os.path.join(os.path.dirname(__file__), "bearing_env"))
-_in_tree = caching.InTreeCacheLocator.ensure_cache_path
-
-
-def _refuse_package_folder(self):
-    if os.path.realpath(self.get_cache_path()).startswith(_package):
-        raise PermissionError(f"read-only: {self.get_cache_path()}")
-    _in_tree(self)
-
-
-caching.InTreeCacheLocator.ensure_cache_path = _refuse_package_folder
-"""
 SITE_PACKAGES = "import sysconfig; print(sysconfig.get_paths()['purelib'])"
 
 
@@ -199,11 +177,11 @@ def _install(kind: str, dist: Path, base: Path) -> InstalledRun:
     env = {
         key: value
         for key, value in os.environ.items()
-        if key not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME", "NUMBA_CACHE_DIR")
+        if key not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME")
     }
     env.update(
         PATH=f"{venv / 'bin'}{os.pathsep}{env.get('PATH', '')}",
-        # numba's user cache, where a package that refuses writes has its compiled code
+        # an empty home cache: nothing may rely on a warm one
         XDG_CACHE_HOME=str(base / f"cache-{kind}"),
         SDL_VIDEODRIVER="dummy",
         PIP_DISABLE_PIP_VERSION_CHECK="1",
@@ -215,11 +193,7 @@ def _install(kind: str, dist: Path, base: Path) -> InstalledRun:
     if kind == "sdist":  # imports only: stepping compiles, which the slow test does
         run.run("gym_make", run.python, "-c", GYM_MAKE)
         return run
-    site_packages = _checked(_run([run.python, "-c", SITE_PACKAGES], work, env)).stdout.strip()
-    (Path(site_packages) / "_read_only_package.py").write_text(READ_ONLY_PACKAGE, encoding="utf-8")
-    (Path(site_packages) / "_read_only_package.pth").write_text("import _read_only_package\n")
-    run.run("gym_make", run.python, "-c", GYM_MAKE, "--step")  # compiles the core
-    run.run("gym_make_warm", run.python, "-c", GYM_MAKE, "--step")
+    run.run("gym_make", run.python, "-c", GYM_MAKE, "--step")
     _run_commands(run)
     quick_start = work / "quick_start.py"
     quick_start.write_text(readme_quick_start(), encoding="utf-8")
@@ -324,20 +298,17 @@ def _report(result: subprocess.CompletedProcess[str]) -> dict[str, Any]:
     return dict(json.loads(_checked(result).stdout.strip().splitlines()[-1]))
 
 
-def test_a_read_only_install_caches_its_compiled_code_in_the_user_cache(
+def test_the_installed_core_is_compiled_ahead_and_imports_no_jit_compiler(
     installed: dict[str, InstalledRun],
 ) -> None:
+    # The extension comes built in the wheel; a fresh process steps at once, and neither
+    # numba nor llvmlite is imported (nor installed: they are no dependency).
     run = installed["wheel"]
-    cold, warm = run.results["gym_make"], run.results["gym_make_warm"]
-    package = Path(_report(cold)["module"]).parent
-    assert not list(package.rglob("*.nbi")), "numba wrote into the read-only package"
-    user_cache = Path(run.env["XDG_CACHE_HOME"]) / "numba"
-    assert list(user_cache.rglob("*.nbi")), "numba wrote no cache index into the user cache"
-    # The first process says it compiles; the next loads the cache, silently and far sooner.
-    assert compile_notice.NOTICE in cold.stderr
-    assert compile_notice.NOTICE not in warm.stderr, warm.stderr
-    assert _report(warm)["in_space"] is True
-    assert _report(warm)["seconds"] < _report(cold)["seconds"] / 3
+    report = _report(run.results["gym_make"])
+    assert report["in_space"] is True
+    assert report["jit_modules"] == []
+    package = Path(report["module"]).parent
+    assert list(package.glob("_core.*.so")), "the wheel carries no compiled core"
 
 
 def test_the_readme_quick_start_runs_as_written_from_the_wheel(

@@ -1,33 +1,32 @@
-"""The compiled core of the world model (numba), one module per topic.
+"""The world model's kernels: the native core (C++17, ``csrc/slam/``, compiled into
+:mod:`bearing_env._core` by the package's build), one module per topic.
 
-* :mod:`~bearing_env.slam.kernels.common`: capacities, status codes, compile options,
-  the threading layer, and scalar helpers (``wrap``, ``cross``, tolerances).
+* :mod:`~bearing_env.slam.kernels.common`: capacities, status codes, scalar helpers
+  (``cross``, ``dot``, tolerances) and :func:`threads`.
 * :mod:`~bearing_env.slam.kernels.polygons`: convex polygons in fixed-capacity arrays:
   hulls, area and centroid, containment, distances, simplification, capacity
   reduction, clipping and outward offsets.
 * :mod:`~bearing_env.slam.kernels.frames`: a landmark's cone region in the robot frame
   FR, and the change of frames FR -> FL (frame plan, hypotheses, transfer).
 * :mod:`~bearing_env.slam.kernels.state`: the structures the update takes: ``State``
-  (the per-map state arrays, listed once; passed as a ``StateRef`` structref),
-  ``Params`` (the settings, with the transfer, inconsistency policy and fusion as
-  codes), ``Outputs`` (per-call statuses) and ``Scratch`` (a thread's buffers).
-* :mod:`~bearing_env.slam.kernels.fusion`: fusing a movement's region into a map: the
-  strict intersection, and the relaxed fusion's window and bases.
+  (the per-map state arrays, listed once; passed as a native ``MapState``), ``Params``
+  (the settings, with the transfer, inconsistency policy and fusion as codes) and
+  ``Outputs`` (per-call statuses).
+* :mod:`~bearing_env.slam.kernels.fusion`: the strict intersection and the relaxed
+  fusion's window and bases.
+* :mod:`~bearing_env.slam.kernels.robust`: the robust fusion's levels and noise bound.
 * :mod:`~bearing_env.slam.kernels.update`: one movement per map for a batch of maps, in
-  one compiled call (serial, or ``prange`` over blocks of maps), and batch helpers.
+  one native call (serial, or blocks of maps on threads), and batch helpers.
 
 Every public name of the topic modules is re-exported here, so callers import
-``bearing_env.slam.kernels`` and never a topic module.
-
-numba's cache (``cache=True``) checks only the source file of the function it
-compiled, not the modules whose kernels that function calls: after editing one topic
-module, delete ``bearing_env/slam/kernels/__pycache__`` (or the ``NUMBA_CACHE_DIR``)
-so that the callers in the other modules are compiled again.
+``bearing_env.slam.kernels`` and never a topic module. Each kernel checks its arrays'
+dtypes, shapes and contiguity and raises ``TypeError`` or ``ValueError`` naming the
+argument; a fixed capacity that would overflow raises ``CapacityError``.
 """
 
 from __future__ import annotations
 
-from bearing_env.numerics import JitOptions, wrap
+from bearing_env._core import CapacityError
 from bearing_env.slam.kernels.common import (
     CAPACITY,
     FR_BOUNDED,
@@ -51,14 +50,15 @@ from bearing_env.slam.kernels.common import (
     MAX_CLOUD,
     MAX_EDGE_SAMPLES,
     MAX_FR_EXTENT,
+    MAX_LANDMARKS,
     MAX_PAIRS,
     MAX_SAMPLES,
     MAX_WINDOW,
     RELATIVE_TOLERANCE,
     SCRATCH,
+    THREADS_VARIABLE,
     cross,
     dot,
-    entry_point,
     scale_of,
     threads,
     tolerance_of,
@@ -71,12 +71,7 @@ from bearing_env.slam.kernels.frames import (
     sample_hypotheses,
     transfer_region,
 )
-from bearing_env.slam.kernels.fusion import (
-    age_out_oldest,
-    intersect_landmark,
-    relaxed_movement,
-    relaxed_region,
-)
+from bearing_env.slam.kernels.fusion import relaxed_region
 from bearing_env.slam.kernels.polygons import (
     area_centroid,
     clip_convex,
@@ -88,15 +83,19 @@ from bearing_env.slam.kernels.polygons import (
     polygon_distance,
     simplify,
     small_convex_hull,
+    small_hull_indices,
 )
 from bearing_env.slam.kernels.robust import (
     BOUND_GROWTH,
     HISTORY,
+    MAX_BOUND,
     MAX_NOISE_SCALE,
+    PRIOR_CONTRADICTIONS,
+    PRIOR_REGIONS,
     PROBE_SHRINK,
     ROBUST_LEVELS,
+    UNSEEN_FACTOR,
     binomial_q,
-    contamination,
     update_levels,
 )
 from bearing_env.slam.kernels.state import (
@@ -107,13 +106,10 @@ from bearing_env.slam.kernels.state import (
     INCONSISTENCY_RESTART,
     TRANSFER_CONSERVATIVE,
     TRANSFER_PAPER,
+    MapState,
     Outputs,
     Params,
-    Scratch,
     State,
-    StateRef,
-    StateType,
-    new_scratch,
     state_ref,
 )
 from bearing_env.slam.kernels.update import (
@@ -124,7 +120,6 @@ from bearing_env.slam.kernels.update import (
     contains_points,
     none_infinite,
     update_maps,
-    update_maps_parallel,
 )
 
 __all__ = [
@@ -157,28 +152,31 @@ __all__ = [
     "LANDMARK_SKIPPED",
     "LANDMARK_UNBOUNDED",
     "LANDMARK_UPDATED",
+    "MAX_BOUND",
     "MAX_CLOUD",
     "MAX_EDGE_SAMPLES",
     "MAX_FR_EXTENT",
+    "MAX_LANDMARKS",
     "MAX_NOISE_SCALE",
     "MAX_PAIRS",
     "MAX_SAMPLES",
     "MAX_WINDOW",
+    "PRIOR_CONTRADICTIONS",
+    "PRIOR_REGIONS",
     "PROBE_SHRINK",
     "RELATIVE_TOLERANCE",
     "ROBUST_LEVELS",
     "SCRATCH",
+    "THREADS_VARIABLE",
     "TRANSFER_CONSERVATIVE",
     "TRANSFER_PAPER",
+    "UNSEEN_FACTOR",
+    "CapacityError",
     "FrameChange",
-    "JitOptions",
+    "MapState",
     "Outputs",
     "Params",
-    "Scratch",
     "State",
-    "StateRef",
-    "StateType",
-    "age_out_oldest",
     "area_centroid",
     "binomial_q",
     "boundary_samples",
@@ -187,31 +185,25 @@ __all__ = [
     "cone_region",
     "contains_point",
     "contains_points",
-    "contamination",
     "convex_hull",
     "cross",
     "dot",
     "drop_edges_outward",
-    "entry_point",
     "frame_plan",
-    "intersect_landmark",
     "longest_edge",
-    "new_scratch",
     "none_infinite",
     "offset_outward",
     "polygon_distance",
-    "relaxed_movement",
     "relaxed_region",
     "sample_hypotheses",
     "scale_of",
     "simplify",
     "small_convex_hull",
+    "small_hull_indices",
     "state_ref",
     "threads",
     "tolerance_of",
     "transfer_region",
     "update_levels",
     "update_maps",
-    "update_maps_parallel",
-    "wrap",
 ]
