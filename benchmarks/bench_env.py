@@ -35,10 +35,9 @@ Sections:
   as transitions.
 - ``slam``: ``PolygonSLAM.update`` alone (:mod:`bearing_env.benchmarks.bench_slam`'s readings), both
   transfers, 4 and 64 landmarks.
-- ``startup``: the compiled core's start-up, in fresh processes: compiling from an empty
-  numba cache (a new ``NUMBA_CACHE_DIR``), then, with that cache warm, the time from the
-  interpreter's start to the end of the first ``env.step`` (imports included), the
-  median of three processes. These are seconds, not ratios.
+- ``startup``: the time from the interpreter's start to the end of the first
+  ``env.step`` (imports included) in fresh processes: one with empty cache folders, then
+  the median of three more. These are seconds, not ratios.
 - ``planning``: ``agents.GreedyOneStep``'s planning time per move (its ``act()``, which
   scores 16 candidate moves on copies of the map), Khepera scenario, the median over the
   moves of several episodes. Seconds, not a ratio.
@@ -68,7 +67,7 @@ b. batched env, 64 sub-envs (Khepera, 4 landmarks): total env steps/s >= 30% of
 c. 64 landmarks at >= 1/16 of the 4-landmark single-env rate;
 d. PPO on the batched env >= 2x the env steps/s of PPO on SubprocVecEnv, same n_envs;
 e. ``PolygonSLAM.update``, 4 landmarks, conservative: >= 20% of CartPole-v1's step rate;
-f. first env step in a fresh process with a warm numba cache: <= 1.5 s;
+f. first env step in a fresh process: <= 1.5 s;
 g. ``GreedyOneStep`` plans a move in <= 0.2 ms (median);
 h. PPO on the batched env >= 0.5x the env steps/s of the same PPO on CartPole-v1, same
    n_envs (the throughput section).

@@ -324,8 +324,8 @@ def table_notes(results: dict[str, Any]) -> list[str]:
         lines += [
             "",
             f"Start-up (fresh processes): first env step {startup['cold_first_step_s']:.1f} s "
-            f"compiling from an empty numba cache; {startup['warm_first_step_s']:.2f} s with "
-            f"the cache warm (median of {warm} s).",
+            f"with empty cache folders; {startup['warm_first_step_s']:.2f} s in later "
+            f"processes (median of {warm} s).",
         ]
     planning = results.get("planning")
     if planning is not None:
@@ -609,9 +609,9 @@ def markdown_startup(results: dict[str, Any]) -> str:
     if startup is not None:
         warm = " / ".join(f"{t:.2f}" for t in startup["warm_runs_s"])
         lines.append(
-            f"- First env step in a fresh process, compiling the core from an empty numba "
-            f"cache: {startup['cold_first_step_s']:.1f} s (once per machine and version; "
-            "numba caches the result)."
+            f"- First env step in a fresh process with empty cache folders (imports "
+            f"included): {startup['cold_first_step_s']:.2f} s; the native core is compiled "
+            "when the package is built, never at run time."
         )
         lines.append(
             f"- The same with the cache warm: {startup['warm_first_step_s']:.2f} s "

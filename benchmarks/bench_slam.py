@@ -70,9 +70,8 @@ CARTPOLE_WARM_UP_STEPS = 2_000
 
 def warm_up(transfers: Sequence[str], counts: Sequence[int]) -> None:
     """Run, untimed, everything that is timed next: some CartPole steps and one pass of
-    each map's readings. The first ``update()`` of a map compiles (or loads from numba's
-    cache) its kernels, which inside a timed window made the first rate read 0.0% of
-    CartPole and the next ones hundreds of times the first."""
+    each map's readings, so that no first-call cost (a thread's buffers, CartPole's
+    wrappers) falls inside a timed window."""
     env = gym.make("CartPole-v1")
     env.reset(seed=0)
     for step in range(CARTPOLE_WARM_UP_STEPS):

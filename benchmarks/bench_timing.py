@@ -266,7 +266,7 @@ print(time.perf_counter() - start)
 
 
 def first_step_seconds(cache_dir: str) -> float:
-    environment = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
+    environment = dict(os.environ, XDG_CACHE_HOME=cache_dir)
     done = subprocess.run(
         [sys.executable, "-c", FIRST_STEP_SCRIPT],
         capture_output=True,
@@ -279,12 +279,13 @@ def first_step_seconds(cache_dir: str) -> float:
 
 
 def bench_startup() -> dict[str, Any]:
-    """Compile from an empty cache once, then time fresh processes with it warm."""
-    with tempfile.TemporaryDirectory(prefix="bearing-env-numba-") as cache_dir:
-        log("  compiling from an empty numba cache (a fresh process) ...")
+    """Time the first step of fresh processes: once with empty cache folders, then again
+    (the native core is compiled at build time: the two should be alike)."""
+    with tempfile.TemporaryDirectory(prefix="bearing-env-cache-") as cache_dir:
+        log("  first step in a fresh process, empty cache folders ...")
         cold = first_step_seconds(cache_dir)
         warm = [first_step_seconds(cache_dir) for _ in range(STARTUP_WARM_RUNS)]
-    log(f"  first step: {cold:.2f} s with an empty cache, {np.median(warm):.2f} s warm")
+    log(f"  first step: {cold:.2f} s with empty caches, {np.median(warm):.2f} s after")
     return {
         "cold_first_step_s": cold,
         "warm_first_step_s": float(np.median(warm)),
