@@ -312,10 +312,12 @@ def test_quick_startup_times_one_cold_then_warm_runs_on_one_cache(
 
 
 @pytest.mark.slow
-def test_quick_startup_compiles_then_loads_the_cache(tmp_path: Path) -> None:
+def test_quick_startup_compiles_nothing_with_empty_caches(tmp_path: Path) -> None:
     startup = check_startup(run_quick(tmp_path, "--sections", "startup")[0])
-    # Compiling from an empty cache takes longer than loading it (by far: seconds vs ~1).
-    assert startup["cold_first_step_s"] > startup["warm_first_step_s"]
+    # Nothing compiles at run time: a process with empty cache folders starts in about a
+    # second, as later ones do (the numba core took 65-130 s there).
+    assert startup["cold_first_step_s"] < 10
+    assert startup["cold_first_step_s"] < 5 * startup["warm_first_step_s"] + 1
 
 
 def test_quick_planning(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
