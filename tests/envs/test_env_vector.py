@@ -130,7 +130,7 @@ def test_many_landmarks_reproduce_the_single_env_exactly() -> None:
 def test_a_batch_large_enough_for_the_threads_matches_single_envs() -> None:
     from bearing_env.slam.batch import PARALLEL_MIN_MAPS
 
-    # The map update is split over numba's threads from this size (when it has two).
+    # The map update is split over threads from this size (when there are two).
     batched, reference = make_pair(
         "BearingSLAM-v0", PARALLEL_MIN_MAPS, AutoresetMode.NEXT_STEP, scenario="khepera"
     )
