@@ -15,48 +15,18 @@ import hashlib
 import json
 import sys
 from pathlib import Path
-from typing import Any
 
-import numpy as np
-
-from tests.golden_traces import TRACES
+from tests.golden_traces import TRACES, feed
 
 GOLDEN_FILE = Path(__file__).parent / "golden" / "env_steps.json"
 #: The traces of the envs themselves (the policies' traces need the train extra).
 NAMES = sorted(name for name in TRACES if not name.startswith("policy-"))
 
 
-def feed_exact(digest: Any, value: Any) -> None:
-    """Like ``golden_traces.feed``, without rounding floats to float32."""
-    if isinstance(value, dict):
-        for key in sorted(value):
-            digest.update(f"<{key}>".encode())
-            feed_exact(digest, value[key])
-    elif isinstance(value, (list, tuple)):
-        digest.update(f"[{len(value)}".encode())
-        for item in value:
-            feed_exact(digest, item)
-    elif value is None or isinstance(value, str):
-        digest.update(repr(value).encode())
-    else:
-        array = np.asarray(value)
-        if array.dtype.kind == "O":
-            digest.update(f"O{array.shape}".encode())
-            for item in array.ravel():
-                feed_exact(digest, item)
-            return
-        if array.dtype.kind == "c":
-            array = np.stack([array.real, array.imag], axis=-1)
-        if array.dtype.kind == "f":
-            array = np.where(np.isnan(array), np.nan, array).astype(array.dtype)
-        digest.update(f"{array.dtype.str}{array.shape}".encode())
-        digest.update(np.ascontiguousarray(array).tobytes())
-
-
 def exact_hash(name: str) -> str:
     digest = hashlib.sha256()
     for item in TRACES[name]():
-        feed_exact(digest, item)
+        feed(digest, item, exact=True)
     return digest.hexdigest()
 
 

@@ -32,16 +32,17 @@ import bearing_env  # noqa: F401  (registers the ids)
 TRACES_FILE = Path(__file__).parent / "golden" / "traces.json"
 
 
-def feed(digest: Any, value: Any) -> None:
-    """Add ``value`` (arrays, numbers, bools, strings, None, dicts, lists) to ``digest``."""
+def feed(digest: Any, value: Any, exact: bool = False) -> None:
+    """Add ``value`` (arrays, numbers, bools, strings, None, dicts, lists) to ``digest``;
+    floats as float32, or with ``exact`` as they are (NaN canonicalised)."""
     if isinstance(value, dict):
         for key in sorted(value):
             digest.update(f"<{key}>".encode())
-            feed(digest, value[key])
+            feed(digest, value[key], exact)
     elif isinstance(value, (list, tuple)):
         digest.update(f"[{len(value)}".encode())
         for item in value:
-            feed(digest, item)
+            feed(digest, item, exact)
     elif value is None or isinstance(value, str):
         digest.update(repr(value).encode())
     else:
@@ -49,13 +50,15 @@ def feed(digest: Any, value: Any) -> None:
         if array.dtype.kind == "O":  # e.g. the vector env's final observations and infos
             digest.update(f"O{array.shape}".encode())
             for item in array.ravel():
-                feed(digest, item)
+                feed(digest, item, exact)
             return
         if array.dtype.kind == "c":
             array = np.stack([array.real, array.imag], axis=-1)
-        if array.dtype.kind == "f":
+        if array.dtype.kind == "f" and exact:
+            array = np.where(np.isnan(array), np.nan, array).astype(array.dtype)
+        elif array.dtype.kind == "f":
             array = array.astype(np.float32)
-        elif array.dtype.kind in "biu":
+        elif array.dtype.kind in "biu" and not exact:
             array = array.astype(np.int64)
         digest.update(f"{array.dtype.str}{array.shape}".encode())
         digest.update(np.ascontiguousarray(array).tobytes())
