@@ -1,10 +1,11 @@
 """The native core under AddressSanitizer and UBSan (slow: a build of its own).
 
 The core is built with ``-fsanitize=address,undefined`` into a temporary folder, and the
-world model's tests (``tests/slam``) and the native tests of ``tests/envs`` (the
-simulator, the env step and the fuzz test) run against that build, in
-a Python that preloads the ASan runtime. Any out-of-bounds access, use after free or
-undefined behaviour aborts the run, and the test fails with the sanitizer's report.
+world model's tests (``tests/slam``) and the env step's golden corpus
+(``tests/envs/test_golden_env.py``: the simulator, the map update and the step) run
+against that build, in a Python that preloads the ASan runtime. Any out-of-bounds
+access, use after free or undefined behaviour aborts the run, and the test fails with
+the sanitizer's report.
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ def test_the_world_model_tests_pass_under_asan_and_ubsan(tmp_path: Path) -> None
         str(p.relative_to(ROOT))
         for folder in ("slam", "envs")
         for p in (ROOT / "tests" / folder).glob("test_*.py")
-        if folder == "slam" or p.name.startswith("test_native_")
+        if folder == "slam" or p.name == "test_golden_env.py"
     )
     tests = [t for t in tests if not t.endswith("test_native_sanitizers.py")]
     result = subprocess.run(
