@@ -1,5 +1,5 @@
 // bearing_env/slam/kernels/update.py in C++: one movement per map for a batch of maps,
-// serial or on std::threads over contiguous blocks of rows (same branches, same order of
+// serial or on kept worker threads over contiguous blocks of rows (same branches, same order of
 // operations as the numba kernels, so the same bits).
 #include "slam/update.hpp"
 
@@ -9,11 +9,11 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "core/errors.hpp"
 #include "core/pymath.hpp"
+#include "core/worker_pool.hpp"
 #include "slam/frames.hpp"
 #include "slam/fusion.hpp"
 #include "slam/polygons.hpp"
@@ -395,34 +395,15 @@ void update_maps(View2<const double> bearings_start, View2<const double> bearing
                     thread_buffers());
         return;
     }
-    // Blocks as update_maps_parallel splits them; block 0 on the calling thread. Each
-    // map is computed by the same code, so the result does not depend on `threads`.
-    std::vector<std::exception_ptr> errors(static_cast<size_t>(blocks));
-    std::vector<std::thread> workers;
-    workers.reserve(static_cast<size_t>(blocks - 1));
-    auto run_block = [&](int64_t block) {
-        try {
-            const int64_t first = block * n_rows / blocks;
-            const int64_t stop = (block + 1) * n_rows / blocks;
-            update_rows(first, stop, bearings_start, bearings_end, rows, params, state, out,
-                        thread_buffers());
-        } catch (...) {
-            errors[static_cast<size_t>(block)] = std::current_exception();
-        }
-    };
-    for (int64_t block = 1; block < blocks; ++block) {
-        try {
-            workers.emplace_back(run_block, block);
-        } catch (...) {
-            // No thread to run it on: this thread does the block itself.
-            run_block(block);
-        }
-    }
-    run_block(0);
-    for (std::thread& worker : workers) worker.join();
-    for (const std::exception_ptr& error : errors) {
-        if (error) std::rethrow_exception(error);
-    }
+    // Blocks as update_maps_parallel splits them; block 0 on the calling thread, the
+    // others on the pool's kept workers (and their kept buffers). Each map is computed by
+    // the same code, so the result does not depend on `threads`.
+    core::WorkerPool::run(blocks, [&](int64_t block) {
+        const int64_t first = block * n_rows / blocks;
+        const int64_t stop = (block + 1) * n_rows / blocks;
+        update_rows(first, stop, bearings_start, bearings_end, rows, params, state, out,
+                    thread_buffers());
+    });
 }
 
 int64_t check_indices(const int64_t* indices, int64_t n, int64_t size, bool distinct,
