@@ -19,6 +19,10 @@ colours each start by how many landmarks its best movement maps within ``area_ca
 
     bearing-env observability --env BearingSLAM-Khepera-v0 --fov 360 180 90
     bearing-env observability --env BearingSLAM-FurnishedRoom-v0 --fov 360 90 --plot out.png
+
+``--json`` writes the figures with the command, commit, date and machine that measured
+them; the environment page's table is written from ``docs/figures/observability_*.json``
+by ``bearing-env docs-tables`` (:func:`markdown_observability`).
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -40,8 +44,10 @@ from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
 from bearing_env.slam.batch import LANDMARK_CODE
 from bearing_env.train.common.cli_parser import add_no_progress, command_parser, doc_summary
 from bearing_env.train.common.cli_values import COUNT, NON_NEGATIVE
+from bearing_env.train.common.doc_tables import markdown_table
 from bearing_env.train.common.files import write_json_atomically
 from bearing_env.train.common.progress import progress_bar
+from bearing_env.train.common.provenance import measured_here, measured_sentence
 from bearing_env.train.common.seeds import EVAL_SEED_START
 from bearing_env.train.common.tables import print_table
 from bearing_env.world import obstructed_moves, true_bearings
@@ -50,6 +56,8 @@ FloatArray = NDArray[np.float64]
 
 #: Movements fused per world-model call (bounds the memory of the batch of maps).
 CHUNK = 4096
+#: The results files of the environment page's table, one per layout (``--json``).
+RESULTS_FILES = "docs/figures/observability_*.json"
 #: The omniscient planner's headings (evenly over the circle), each with 3 lengths.
 ORACLE_HEADINGS = 24
 
@@ -297,6 +305,61 @@ def as_json(results: dict[float, dict[str, Any]]) -> dict[str, dict[str, Any]]:
     }
 
 
+def _percent(share: float) -> str:
+    """A share as the page shows it: 3 significant figures, at most 2 decimals."""
+    value = 100 * share
+    if value == 0:
+        return "0%"
+    decimals = min(2, max(0, 2 - math.floor(math.log10(value))))
+    return f"{value:.{decimals}f}%"
+
+
+def _area(value: float | None) -> str:
+    """An area to 3 significant figures, with a thousands comma; "-" if none updated."""
+    if value is None or not math.isfinite(value):
+        return "-"
+    rounded = float(f"{value:.3g}")
+    return f"{rounded:,.0f}" if rounded >= 100 else f"{rounded:.3g}"
+
+
+def _task_order(env_id: str) -> tuple[int, str]:
+    """The registry's order of the tasks (the Khepera arena first), other ids after."""
+    from bearing_env.tasks import TASKS
+
+    ids = [task.id for task in TASKS]
+    return (ids.index(env_id), env_id) if env_id in ids else (len(ids), env_id)
+
+
+def markdown_observability(runs: Mapping[str, Mapping[str, Any]]) -> str:
+    """The environment page's table from the ``--json`` files of several layouts
+    (``docs/figures/observability_*.json``, by file name): per layout and field of view
+    (widest first), the shares of movements that change frames, that update L3 and that
+    map it within ``area_cap``, the median area of an update and the share of starts
+    from which some movement maps a landmark within ``area_cap``; then each file's
+    command, commit and machine."""
+    header = (
+        "layout", "field of view", "movements that change frames", "that update L3",
+        "median area of an update (FL units²)", "that map L3 within `area_cap`",
+        "starts from which some movement maps a landmark within `area_cap`",
+    )  # fmt: skip
+    ordered = sorted(runs.items(), key=lambda item: _task_order(item[1]["env"]))
+    rows = []
+    for _, run in ordered:
+        fovs = sorted(run["fovs"].items(), key=lambda item: -float(item[0]))
+        for position, (fov, row) in enumerate(fovs):
+            layout = f"`{run['env']}` ({row['movements']:,} movements)" if position == 0 else ""
+            rows.append(
+                (
+                    layout, f"{float(fov):g}°", _percent(row["frame_changes"]),
+                    _percent(row["updates"][0]), _area(row["median_area"]),
+                    _percent(row["within_cap"][0]), _percent(row["starts_mapping_any"]),
+                )
+            )  # fmt: skip
+    folder = RESULTS_FILES.rpartition("/")[0]
+    sources = [measured_sentence(run["measured"], f"{folder}/{name}.json") for name, run in ordered]
+    return markdown_table(header, rows) + "\n\n" + "\n".join(f"- {line}" for line in sources)
+
+
 def print_results(env_id: str, results: dict[float, dict[str, Any]]) -> None:
     n_mapped = len(next(iter(results.values()))["updates"])
     names = [f"L{i + 3}" for i in range(n_mapped)]
@@ -398,7 +461,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     import gymnasium as gym
 
     parser = build_parser()
-    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    arguments = list(sys.argv[1:] if argv is None else argv)
+    args = parser.parse_args(arguments)
     env_id = args.env if ":" in args.env else f"bearing_env:{args.env}"
     grid = (args.per_side, args.headings, args.lengths)
     try:
@@ -419,7 +483,10 @@ def main(argv: Sequence[str] | None = None) -> None:
                 f"{low:.3g}-{high:.3g})"
             )
     if args.json is not None:
-        write_json_atomically(args.json, {"env": args.env, "fovs": as_json(results)})
+        measured = measured_here(parser.prog, arguments)
+        write_json_atomically(
+            args.json, {"env": args.env, "fovs": as_json(results), "measured": measured}
+        )
         print(f"wrote {args.json}")
     if args.plot is not None:
         print(f"wrote {plot(args.env, results, args.plot)}")
