@@ -247,7 +247,13 @@ class RobotBelief:
         samples = self._scale_samples or self._blocked_samples
         if not samples:
             return None
-        return float(np.median(samples))
+        # np.median's value (the middle sample, or the mean of the middle two), without
+        # its array overhead on a list of a few floats: it is read at every decision.
+        ordered = sorted(samples)
+        middle = len(ordered) // 2
+        if len(ordered) % 2:
+            return float(ordered[middle])
+        return float((ordered[middle - 1] + ordered[middle]) / 2)
 
     def pose(self, slam: PolygonSLAM) -> PoseBelief | None:
         """The believed pose, or None before the first movement that changed frames."""

@@ -69,15 +69,18 @@ class MapReader:
         if not self.available:
             raise RobotMapUnavailableError(user)
 
-    def read(self, info: Mapping[str, Any], n_landmarks: int) -> PolygonSLAM:
-        """The map of an info (an independent copy: the policy may update it)."""
+    def read(
+        self, info: Mapping[str, Any], n_landmarks: int, into: PolygonSLAM | None = None
+    ) -> PolygonSLAM:
+        """The map of an info: an independent copy (the policy may update it), written
+        into ``into`` (the map an earlier call returned) when it fits, else new."""
         if ROBOT_MAP_KEY not in info:
             raise KeyError(
                 f"the info has no {ROBOT_MAP_KEY!r} (keys: {sorted(info)}): pass the info "
                 "the env returned with this observation, from an env made with "
                 "robot_map_info=True (the default)"
             )
-        return robot_map.decode(info[ROBOT_MAP_KEY], n_landmarks, self.map_settings)
+        return robot_map.decode(info[ROBOT_MAP_KEY], n_landmarks, self.map_settings, into)
 
 
 class RobotMapUnavailableError(ValueError):

@@ -493,6 +493,8 @@ class GreedyOneStep(BeliefPolicy):
         self._lengths = np.array([c.length for c in self.candidates], dtype=np.float64)
         #: Copies of the map to score candidates on, by count, refilled at each decision.
         self._trials: dict[int, BatchedPolygonSLAM] = {}
+        #: The robot's map of the last decision, overwritten by the next info's.
+        self._map: PolygonSLAM | None = None
         self.area_cap = float(bearing_env_of(env).config.task.area_cap)
         # Score moves with the potential the env rewards (reward="log_area" or "area").
         self.log_area = bearing_env_of(env).config.task.reward == "log_area"
@@ -500,7 +502,8 @@ class GreedyOneStep(BeliefPolicy):
     def act(self, observation: NDArray[np.float32], info: dict[str, Any]) -> Action:
         view = self.reader.read(observation)
         self._observe(view)
-        movement = self._choose(view, self.maps.read(info, view.n_landmarks))
+        self._map = self.maps.read(info, view.n_landmarks, into=self._map)
+        movement = self._choose(view, self._map)
         self._commanded(movement, view)
         return movement.action
 

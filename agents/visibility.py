@@ -105,9 +105,11 @@ class VisibilityPredictor:
             seen &= np.abs(angles) <= self.half_fov
         if not math.isinf(self.max_range):
             seen &= np.abs(offsets) * metres_per_unit <= self.max_range
-        radius = BUMP_RADIUS / metres_per_unit
-        for bump in self.bumps if with_bumps else ():
-            seen &= _distance_to_segments(bump, positions, offsets) > radius
+        if with_bumps and self.bumps:
+            # Every bump at once, on a leading axis.
+            bumps = np.array(self.bumps, dtype=np.complex128).reshape(-1, *[1] * offsets.ndim)
+            clear = _distance_to_segments(bumps, positions, offsets) > BUMP_RADIUS / metres_per_unit
+            seen &= np.all(clear, axis=0)
         return np.asarray(seen | ~np.broadcast_to(known, seen.shape))
 
     def missed(
@@ -128,9 +130,12 @@ class VisibilityPredictor:
 
 
 def _distance_to_segments(
-    point: complex, starts: NDArray[np.complex128], offsets: NDArray[np.complex128]
+    point: complex | NDArray[np.complex128],
+    starts: NDArray[np.complex128],
+    offsets: NDArray[np.complex128],
 ) -> NDArray[np.float64]:
-    """Distances from ``point`` to the segments ``starts`` -> ``starts + offsets``."""
+    """Distances from ``point`` (or points, broadcast) to the segments ``starts`` ->
+    ``starts + offsets``."""
     squared = np.abs(offsets) ** 2
     relative = point - starts
     along = np.where(

@@ -118,23 +118,38 @@ def buffers(arrays: tuple[NDArray[Any], ...]) -> Buffers:
 # robust fusions' arrays); each takes a native MapState, a State or an EnvInputs.
 
 
-def decode(data: Mapping[str, Any], n_landmarks: int, settings: MapSettings) -> PolygonSLAM:
-    """A new map (an independent copy) holding one env's ``info[KEY]`` data, for
-    ``n_landmarks`` landmarks and the world model's ``settings``
-    (``EnvConfig.map_settings``)."""
-    slam = PolygonSLAM.from_settings(int(n_landmarks), settings)
-    batch, mapped = slam.batch, int(n_landmarks) - 2
+def decode(
+    data: Mapping[str, Any],
+    n_landmarks: int,
+    settings: MapSettings,
+    into: PolygonSLAM | None = None,
+) -> PolygonSLAM:
+    """The map holding one env's ``info[KEY]`` data, for ``n_landmarks`` landmarks and the
+    world model's ``settings`` (``EnvConfig.map_settings``): a new map (an independent
+    copy), or ``into``, overwritten in place, when it has those landmarks and settings (a
+    policy's map from its last decision: no new arrays for every info)."""
+    n_landmarks = int(n_landmarks)
+    if (
+        into is not None
+        and into.batch.num_maps == 1
+        and into.n_landmarks == n_landmarks
+        and into.settings == settings
+    ):
+        slam = into
+    else:
+        slam = PolygonSLAM.from_settings(n_landmarks, settings)
+    batch, mapped = slam.batch, n_landmarks - 2
     for name in batch.state_names:
-        target = getattr(batch, name)
-        values = np.array(data[name])
+        target = getattr(batch, name)[:1]  # the map's row, as an array even when 1-D
+        values = np.asarray(data[name])
         if name in LANDMARK_AXES:  # one env's arrays have no map axis
-            values = np.take(values, np.arange(mapped), axis=LANDMARK_AXES[name] - 1)
-        if target.dtype.kind == "c":  # (x, y) pairs back to complex
-            points = np.asarray(values[..., 0], dtype=np.complex128)
-            points.imag = values[..., 1]
-            values = points
+            values = values[(slice(None),) * (LANDMARK_AXES[name] - 1) + (slice(mapped),)]
+        if target.dtype.kind == "c":  # (x, y) pairs into the complex numbers' memory
+            target.view(np.float64).reshape(*target.shape, 2)[...] = values
+        else:
+            target[...] = values
         if name in UNKNOWN_AS_INF:
-            unknown = complex(np.nan, np.nan) if values.dtype.kind == "c" else np.nan
-            values[np.isinf(values)] = unknown  # back to the map's "unknown"
-        target[0] = values
+            target[np.isinf(target)] = (
+                complex(np.nan, np.nan) if target.dtype.kind == "c" else np.nan
+            )
     return slam

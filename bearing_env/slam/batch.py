@@ -347,8 +347,8 @@ class BatchedPolygonSLAM(HasMapSettings):
     def fill_from(self, source: BatchedPolygonSLAM, map_index: int) -> None:
         """Make every map of this batch a copy of ``source``'s map ``map_index`` (same
         settings), in place: a planner's scratch batch, refilled for each decision."""
-        for name in STATE_ARRAYS:
-            getattr(self, name)[:] = getattr(source, name)[map_index]
+        rows = np.full(self.num_maps, int(map_index), dtype=np.int64)
+        kernels.copy_maps(source._kernel_state(), rows, self._kernel_state())
 
     def take(self, maps: ArrayLike, into: BatchedPolygonSLAM | None = None) -> BatchedPolygonSLAM:
         """A batch whose map ``i`` is a copy of map ``maps[i]`` (indices may repeat): for
@@ -363,8 +363,7 @@ class BatchedPolygonSLAM(HasMapSettings):
             copies = into
         else:
             copies = self.empty_like(rows.size)
-        for name in STATE_ARRAYS:
-            np.take(getattr(self, name), rows, axis=0, out=getattr(copies, name))
+        kernels.copy_maps(self._kernel_state(), rows, copies._kernel_state())
         return copies
 
     @property

@@ -297,6 +297,30 @@ void update_maps_binding(nb::handle bearings_start, nb::handle bearings_end, nb:
     slam::update_maps(start, end, rows_view, params, state.views, outputs, threads);
 }
 
+void copy_maps_binding(const PyMapState& from, nb::handle rows, const PyMapState& to) {
+    require(from.views.vertices.data != to.views.vertices.data,
+            "copy_maps needs two different states (from_state and to_state)");
+    require(from.mapped == to.mapped && from.window == to.window && from.levels == to.levels &&
+                from.history == to.history &&
+                from.views.base_vertices.shape[2] == to.views.base_vertices.shape[2] &&
+                from.views.probe_vertices.shape[2] == to.views.probe_vertices.shape[2],
+            "copy_maps needs states of the same landmarks and fusion arrays: from has " +
+                std::to_string(from.mapped) + " mapped landmarks, to " +
+                std::to_string(to.mapped));
+    auto rows_view = view_of<const int64_t, 1>(rows, "rows");
+    require(rows_view.shape[0] <= to.maps, "rows has " + std::to_string(rows_view.shape[0]) +
+                                               " entries, more than to's " +
+                                               std::to_string(to.maps) + " maps");
+    for (int64_t i = 0; i < rows_view.shape[0]; ++i) {
+        if (rows_view(i) < 0 || rows_view(i) >= from.maps) {
+            value_error("rows must be map indices in [0, " + std::to_string(from.maps) +
+                        "), got " + std::to_string(rows_view(i)) + " at position " +
+                        std::to_string(i));
+        }
+    }
+    slam::copy_maps(from.views, rows_view, to.views);
+}
+
 int64_t check_indices_binding(nb::handle indices, int64_t size, bool distinct) {
     auto view = view_of<const int64_t, 1>(indices, "indices");
     if (distinct && size < 0) value_error("size must not be negative, got " + std::to_string(size));
@@ -444,6 +468,9 @@ void bind_slam_update(nb::module_& m) {
           "params"_a, "state"_a, "out"_a, "threads"_a = 1,
           "Fuse one movement into each map rows[i] (bearings row i), in place, reporting to "
           "out (an Outputs tuple); threads > 1 splits the rows into that many blocks.");
+    m.def("copy_maps", &copy_maps_binding, "from_state"_a, "rows"_a, "to_state"_a,
+          "Map i of to_state becomes a copy of map rows[i] of from_state (rows may repeat; "
+          "same landmarks and fusion arrays).");
     m.def("check_indices", &check_indices_binding, "indices"_a, "size"_a, "distinct"_a,
           "INDEX_OK, INDEX_OUT_OF_RANGE or INDEX_REPEATED for int64 indices into [0, size).");
     m.def("none_infinite", &none_infinite_binding, "values"_a,

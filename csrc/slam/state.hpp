@@ -105,4 +105,9 @@ struct Outputs {
     View1<int64_t> n_bad;           // (rows,)
 };
 
+// Map i of `to` becomes a copy of map rows[i] of `from` (rows may repeat), array by array:
+// planners' copies of a map (state.cpp). The caller checks that the two states have the
+// same shapes past the map axis and that rows fit both.
+void copy_maps(const MapState& from, View1<const int64_t> rows, const MapState& to);
+
 }  // namespace bearing::slam

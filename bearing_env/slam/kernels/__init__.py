@@ -118,6 +118,7 @@ from bearing_env.slam.kernels.update import (
     INDEX_REPEATED,
     check_indices,
     contains_points,
+    copy_maps,
     none_infinite,
     update_maps,
 )
@@ -185,6 +186,7 @@ __all__ = [
     "cone_region",
     "contains_point",
     "contains_points",
+    "copy_maps",
     "convex_hull",
     "cross",
     "dot",

@@ -9,6 +9,9 @@ is False), its counters and the relaxed and robust fusions' arrays. Each map is 
 on its own, so its result never depends on the other maps of the batch; with
 ``threads > 1`` the rows are split into that many contiguous blocks, one per thread, and
 the results are the same bit for bit. What each movement did goes to ``out``.
+
+:func:`copy_maps` makes map ``i`` of one state a copy of map ``rows[i]`` of another, every
+array in one native call (planners' copies of a map).
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from bearing_env._core import (
     INDEX_REPEATED,
     check_indices,
     contains_points,
+    copy_maps,
     none_infinite,
     update_maps,
 )
@@ -29,6 +33,7 @@ __all__ = [
     "INDEX_REPEATED",
     "check_indices",
     "contains_points",
+    "copy_maps",
     "none_infinite",
     "update_maps",
 ]
