@@ -205,7 +205,7 @@ def test_the_compiled_encoding_is_the_numpy_one_and_decodes_to_the_map(
         venv.step(rng.uniform(-1, 1, (12, 2)).astype(np.float32))
     state, config = venv._state, venv.get_attr("config")[0]
     slots = config.observations.max_landmarks - 2
-    checked = 0
+    checked, reused = 0, None
     for group_config, rows in venv._groups(np.arange(12)):
         group = venv._maps.group(state, rows, group_config)
         for some in (group.rows, group.rows[::-2]):  # every row, and some out of order
@@ -218,6 +218,12 @@ def test_the_compiled_encoding_is_the_numpy_one_and_decodes_to_the_map(
             for i, row in enumerate(some.tolist()):
                 data = {name: values[i] for name, values in compiled.items()}
                 back = robot_map.decode(data, group.n, config.map_settings).batch
+                # Into the map of the last row: the same state as a new map.
+                again = robot_map.decode(data, group.n, config.map_settings, into=reused)
+                assert (again is reused) == (reused is not None and reused.n_landmarks == group.n)
+                for name in group.batch.state_names:
+                    np.testing.assert_array_equal(getattr(again.batch, name), getattr(back, name))
+                reused = again
                 for name in group.batch.state_names:
                     mine = getattr(group.batch, name)[row]
                     theirs = getattr(back, name)[0]

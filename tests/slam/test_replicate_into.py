@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
+from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM, kernels
 from bearing_env.slam.batch import STATE_ARRAYS
 
 
@@ -71,3 +71,22 @@ def _bearings_for(batch: BatchedPolygonSLAM, seed: int) -> tuple[np.ndarray, np.
     b1 = np.angle(landmarks[None, :] - start[:, None]) - heading
     b2 = np.angle(landmarks[None, :] - (start + step)[:, None]) - heading
     return b1, b2
+
+
+def test_copy_maps_refuses_mismatched_states_and_rows() -> None:
+    four, five = (
+        BatchedPolygonSLAM(2, 4, np.deg2rad(2.0)),
+        BatchedPolygonSLAM(2, 5, np.deg2rad(2.0)),
+    )
+    rows = np.zeros(2, dtype=np.int64)
+    with pytest.raises(ValueError, match="same landmarks"):
+        kernels.copy_maps(four._kernel_state(), rows, five._kernel_state())
+    with pytest.raises(ValueError, match="two different states"):
+        kernels.copy_maps(four._kernel_state(), rows, four._kernel_state())
+    other = four.empty_like(2)
+    with pytest.raises(ValueError, match="rows must be map indices"):
+        kernels.copy_maps(four._kernel_state(), np.array([0, 2]), other._kernel_state())
+    with pytest.raises(ValueError, match="more than to's 2 maps"):
+        kernels.copy_maps(four._kernel_state(), np.zeros(3, dtype=np.int64), other._kernel_state())
+    with pytest.raises(TypeError, match="rows"):
+        kernels.copy_maps(four._kernel_state(), np.zeros(2), other._kernel_state())
