@@ -114,6 +114,22 @@ def test_the_command_prints_the_table_and_draws_the_arenas(
     assert len(wide["updates"]) == 2  # L3 and L4
     assert wide["frame_changes"] > narrow["frame_changes"]
     assert wide["starts_mapping_any"] > 0.5
+    measured = written["measured"]
+    assert measured["command"].startswith("bearing-env observability --env BearingSLAM-Khepera-v0")
+    assert {"commit", "date", "machine"} <= measured.keys()
+    # The environment page's table reads the file as it is written.
+    table = observability.markdown_observability({"observability_khepera": written})
+    assert "| `BearingSLAM-Khepera-v0` (" in table and "| 360° |" in table and "| 90° |" in table
+    assert f"Measured by `{measured['command']}`" in table
+
+
+def test_the_page_table_rounds_shares_and_areas_as_the_page_shows_them() -> None:
+    assert [observability._percent(s) for s in (1.0, 0.46947, 0.005878, 0.000494, 0.0)] == [
+        "100%", "46.9%", "0.59%", "0.05%", "0%",
+    ]  # fmt: skip
+    assert [observability._area(a) for a in (6.247, 102.74, 1992.5, 22122.5, math.inf)] == [
+        "6.25", "103", "1,990", "22,100", "-",
+    ]  # fmt: skip
 
 
 def test_a_bad_field_of_view_is_named(capsys: pytest.CaptureFixture[str]) -> None:

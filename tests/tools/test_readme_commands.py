@@ -16,8 +16,8 @@ How each kind is checked, cheaply:
   not run (these are the long runs: 200-episode comparisons, 600k-step training);
 - ``run``: the command runs for real, with the extra arguments given (a smaller budget);
 - ``make``: ``make -n TARGET`` (a dry run) knows the target;
-- ``help``: the program's ``--help`` (with its subcommand) runs: Ray's own CLI, and the
-  long benchmark;
+- ``help``: the program's ``--help`` (with its subcommand) runs and names every option the
+  command gives: Ray's own CLI, and the long benchmarks;
 - ``copy``: a ``cp`` of a comparison plot, whose destination folder is in the repository
   and whose source is written by a documented ``compare`` command;
 - ``zoo``: an rl-zoo3 command, which ``tests/tools/test_zoo_commands.py`` runs (briefly)
@@ -161,9 +161,14 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env observability --env BearingSLAM-Khepera-v0 --fov 360 180 90 "
     "--oracle-episodes 20": ("parse", ()),
     "bearing-env observability --env BearingSLAM-Khepera-v0 --fov 360 180 90 --plot "
-    "docs/figures/observability_khepera.png": ("parse", ()),
+    "docs/figures/observability_khepera.png --json docs/figures/observability_khepera.json": (
+        "parse",
+        (),
+    ),
     "bearing-env observability --env BearingSLAM-FurnishedRoom-v0 --fov 360 180 90 --plot "
-    "docs/figures/observability_furnished_room.png": ("parse", ()),
+    "docs/figures/observability_furnished_room.png --json "
+    "docs/figures/observability_furnished_room.json": ("parse", ()),
+    "bearing-env robust-eval --episodes 200 --json docs/figures/robust_eval.json": ("parse", ()),
     "bearing-env compare --episodes 200 --executor ray": ("parse", ()),
     "bearing-env compare --episodes 2000 --executor ray --ray-address auto "
     "--out outputs/compare_2000": ("parse", ()),
@@ -178,6 +183,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env sweep --grid lr=0.0001,0.0003 --env-grid scenario=khepera,random "
     "--num-env-runners 0 --iterations 20 --out runs/sweep": ("parse", ()),
     "python -m bearing_env.benchmarks.bench_compare": ("help", ()),
+    "python -m bearing_env.benchmarks.bench_compare --repeats 3": ("help", ()),
     "ray start --head --port=6379": ("help", ()),
     "ray start --address=A_IP:6379": ("help", ()),
     "ray status": ("help", ()),
@@ -337,6 +343,11 @@ def _parse(argv: list[str]) -> None:
         pytest.fail(f"no parser check for bearing-env {command}")
 
 
+def documented_options(argv: list[str]) -> set[str]:
+    """The options a command gives (``--port=6379`` gives ``--port``)."""
+    return {arg.split("=", 1)[0] for arg in argv if arg.startswith("--")}
+
+
 def command_extra(command: str) -> str | None:
     """The extra a README command needs to run or parse: training (and rl-zoo3's trainer)
     needs ``train``, Ray's own command line ``ray``."""
@@ -396,6 +407,7 @@ def test_readme_command_runs_or_parses(command: str, tmp_path: Path) -> None:
             [*program, "--help"], capture_output=True, text=True, timeout=120
         )
         assert result.returncode == 0, result.stderr[-3000:]
+        assert documented_options(argv) <= set(re.findall(r"--[\w-]+", result.stdout))
     else:
         assert kind == "run"
         program = [str(BIN / "bearing-env")] if argv[0] == "bearing-env" else [sys.executable]

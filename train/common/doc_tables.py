@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from bearing_env.train.common.cli_parser import command_parser
+from bearing_env.train.common.provenance import measured_sentence
 
 #: The files whose blocks are generated (relative to the repository's root).
 PAGES: tuple[str, ...] = ("README.md", "docs/*.md", "docs/tasks/index.md")
@@ -194,9 +195,74 @@ def compare_outcomes(summary: Mapping[str, Any]) -> str:
     )
 
 
+#: How the scaling page names the runs of ``benchmarks/bench_compare.py``.
+RAY_RUN_LABELS: dict[str, str] = {
+    "local, 1 process": "`--workers 1` (this process, env and policies built)",
+    "local, 2 processes": "`--workers 2` (new worker processes)",
+    "ray, new instance": "`--executor ray`, as run on one machine (starts and stops a local "
+    "instance)",
+    "ray start-up (ray.init)": "of which `ray.init` alone",
+    "ray, running instance": "`--executor ray` on a running 2-CPU instance (new workers)",
+    "ray, warm workers": "the same, second run (warm workers)",
+    "ray, 1 CPU": "`--executor ray` on a running 1-CPU instance, new workers",
+    "ray, 1 CPU, warm": "`--executor ray` on a running 1-CPU instance, warm",
+}
+
+
+def _range(values: Sequence[float] | None, digits: int, unit: str = "") -> str:
+    """``low–high`` with ``digits`` decimals and the unit; "1" for the baseline itself;
+    empty where the results file has no figure."""
+    if values is None:
+        return ""
+    low, high = values
+    if low == high == 1:
+        return "1"
+    return f"{low:.{digits}f}\u2013{high:.{digits}f}{unit}"
+
+
+def compare_on_ray(results: Mapping[str, Any]) -> str:
+    """The scaling page's table (``benchmarks/results/bench_compare.json``): each way of
+    running one comparison, its wall time and its speed-ups over ``--workers 1`` and
+    ``--workers 2`` (min–max over the repeats, a speed-up taken within a repeat), then
+    Ray's overhead per episode and where the figures were measured."""
+    episodes = results["episodes"]
+    labels = [label.replace("_", " ") for label in results["policies"]]
+    policies = ", ".join(labels[:-1]) + f" and {labels[-1]}" if len(labels) > 1 else labels[0]
+    rows = []
+    for run in results["runs"]:
+        seconds = _range(run["seconds"], 1, " s")
+        if run["run"] == "local, 1 process":
+            low, high = (1000 * value / episodes for value in run["seconds"])
+            seconds += f" ({low:.0f}\u2013{high:.0f} ms an episode)"
+        rows.append(
+            (
+                RAY_RUN_LABELS.get(run["run"], run["run"]),
+                seconds,
+                _range(run["over_workers_1"], 2, "\u00d7"),
+                _range(run["over_workers_2"], 2, "\u00d7"),
+            )
+        )
+    header = ("run", "wall time", "over `--workers 1`", "over `--workers 2`")
+    overhead = results["ray_overhead_ms_per_episode"]
+    base = next(run["seconds"] for run in results["runs"] if run["run"] == "local, 1 process")
+    episode_ms = [1000 * value / episodes for value in base]
+    share = (100 * overhead[0] / episode_ms[1], 100 * overhead[1] / episode_ms[0])
+    return (
+        f"{episodes} episodes ({episodes // len(labels)} each of {policies}, Khepera, 20 "
+        f"moves), {results['repeats']} repeats: every figure is a range over the repeats, and "
+        "a speed-up is taken within a repeat. "
+        + measured_sentence(results["measured"], "benchmarks/results/bench_compare.json")
+        + "\n\n"
+        + markdown_table(header, rows)
+        + "\n\nRay's overhead per episode (as many empty tasks as episodes, each sending an "
+        "episode's task and returning a real record, on one CPU) was "
+        f"{_range(overhead, 2, ' ms')}, {share[0]:.0f}\u2013{share[1]:.0f}% of an episode here."
+    )
+
+
 def _blocks() -> dict[str, Block]:
     from bearing_env.train.compare import task_cards
-    from bearing_env.train.studies import figures
+    from bearing_env.train.studies import figures, observability, robust_eval
 
     bench = "benchmarks/results/bench_env.json"
     report = "bearing_env.benchmarks.bench_report"
@@ -214,6 +280,11 @@ def _blocks() -> dict[str, Block]:
         "khepera-25cm": Block("docs/compare/results/khepera_25cm.json", compare_medians),
         "other-settings": Block("docs/compare/results/settings_*.json", compare_settings),
         "lookahead": Block("docs/compare/results/lookahead.json", compare_outcomes),
+        "observability": Block(
+            observability.RESULTS_FILES, observability.markdown_observability
+        ),
+        "robust-eval": Block(robust_eval.RESULTS_FILE, robust_eval.markdown_robust_eval),
+        "compare-on-ray": Block("benchmarks/results/bench_compare.json", compare_on_ray),
     }
 
 

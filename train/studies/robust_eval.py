@@ -15,20 +15,29 @@ time excluded).
 
     bearing-env robust-eval --episodes 200             # the full table
     bearing-env robust-eval --episodes 10 --no-progress
+
+``--json`` writes every row (with its area over the strict fusion's on clean data), the
+step ratio and the command, commit, date and machine that measured them; the results
+page's table is written from ``docs/figures/robust_eval.json`` by ``bearing-env
+docs-tables`` (:func:`markdown_robust_eval`).
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
-from bearing_env.train.common.cli_parser import add_no_progress, command_parser
+from bearing_env.train.common.cli_parser import add_json_output, add_no_progress, command_parser
 from bearing_env.train.common.cli_values import COUNT
+from bearing_env.train.common.doc_tables import markdown_table
+from bearing_env.train.common.files import write_json_atomically
 from bearing_env.train.common.progress import progress_bar
+from bearing_env.train.common.provenance import measured_here, measured_sentence
 from bearing_env.train.common.seeds import EVAL_SEED_START
 
 #: The layouts: label -> env kwargs.
@@ -51,6 +60,13 @@ FUSIONS: dict[str, dict[str, Any]] = {
     "robust, nominal bound": {"fusion": "robust", "noise_bound": "nominal"},
 }
 MOVES = 20
+#: The containment the robust fusion is held to, by bearing error (the results page
+#: shows a case that reaches it in bold).
+CONTAINMENT_TARGETS: dict[str, float] = {"outliers 5%": 0.98, "bound 3 deg": 0.95}
+#: The most a robust env step may cost, in strict steps.
+STEP_RATIO_TARGET = 3.0
+#: The results file of the results page's table (``--json``).
+RESULTS_FILE = "docs/figures/robust_eval.json"
 #: Target area no region reaches: episodes never end early.
 NEVER_SUCCEEDS = 1e-12
 
@@ -149,13 +165,26 @@ def evaluate(
     return rows
 
 
-def table(rows: list[dict[str, Any]]) -> str:
-    """The rows as a text table, areas over the strict fusion's on clean data."""
+def with_area_ratios(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """The rows, each with its median area over the strict fusion's on clean data for
+    the same layout and policy (``area_over_clean_strict``)."""
     clean_strict = {
         (r["layout"], r["policy"]): r["median_area"]
         for r in rows
         if r["noise"] == "clean" and r["fusion"] == "strict"
     }
+    return [
+        {
+            **row,
+            "area_over_clean_strict": row["median_area"]
+            / clean_strict[(row["layout"], row["policy"])],
+        }
+        for row in rows
+    ]
+
+
+def table(rows: list[dict[str, Any]]) -> str:
+    """The rows as a text table, areas over the strict fusion's on clean data."""
     step_strict = {
         (r["layout"], r["policy"], r["noise"]): r["step_seconds"]
         for r in rows
@@ -165,14 +194,74 @@ def table(rows: list[dict[str, Any]]) -> str:
         f"{'layout':9} {'policy':7} {'noise':12} {'fusion':21} {'contained':>9} "
         f"{'area/clean strict':>17} {'step/strict':>11}"
     ]
-    for r in rows:
-        ratio = r["median_area"] / clean_strict[(r["layout"], r["policy"])]
+    for r in with_area_ratios(rows):
         step = r["step_seconds"] / step_strict[(r["layout"], r["policy"], r["noise"])]
         lines.append(
             f"{r['layout']:9} {r['policy']:7} {r['noise']:12} {r['fusion']:21} "
-            f"{100 * r['containment']:8.1f}% {ratio:17.2f} {step:11.2f}"
+            f"{100 * r['containment']:8.1f}% {r['area_over_clean_strict']:17.2f} {step:11.2f}"
         )
     return "\n".join(lines)
+
+
+#: The results page's columns: (bearing error, fusion, heading).
+PAGE_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("clean", "robust", "clean: robust"),
+    ("outliers 5%", "strict", "5% outliers: strict"),
+    ("outliers 5%", "relaxed", "relaxed"),
+    ("outliers 5%", "robust", "robust"),
+    ("outliers 5%", "robust, nominal bound", "robust, nominal bound"),
+    ("bound 3 deg", "strict", "3°: strict"),
+    ("bound 3 deg", "relaxed", "relaxed"),
+    ("bound 3 deg", "robust", "robust"),
+    ("bound 3 deg", "robust, nominal bound", "robust, nominal bound"),
+)
+#: The pages' multiplication sign (ruff would take a literal one for a mistyped x).
+TIMES = "\u00d7"
+#: How the page names the layouts and the policies.
+LAYOUT_NAMES = {"khepera": "Khepera", "random-8": "random 8"}
+POLICY_NAMES = {"random": "RandomPolygonal", "greedy": "GreedyOneStep"}
+
+
+def _cell(row: Mapping[str, Any]) -> str:
+    """Containment (in bold where the robust fusion meets its target) and the area over
+    the strict fusion's on clean data, when the results file has it."""
+    containment = row["containment"]
+    shown = "100%" if containment == 1.0 else f"{100 * containment:.1f}%"
+    target = CONTAINMENT_TARGETS.get(row["noise"])
+    if row["fusion"] == "robust" and target is not None and containment >= target:
+        shown = f"**{shown}**"
+    ratio = row.get("area_over_clean_strict")
+    return shown if ratio is None else f"{shown} ({ratio:.2f}{TIMES})"
+
+
+def markdown_robust_eval(results: Mapping[str, Any]) -> str:
+    """The results page's table from the ``--json`` file: per layout and policy, the
+    containment and relative area of each bearing error and fusion; then the command,
+    commit and machine, and the step ratio."""
+    rows = {(r["layout"], r["policy"], r["noise"], r["fusion"]): r for r in results["rows"]}
+    cases = list(dict.fromkeys((r["layout"], r["policy"]) for r in results["rows"]))
+    body = [
+        [
+            LAYOUT_NAMES.get(layout, layout),
+            POLICY_NAMES.get(policy, policy),
+            *(
+                _cell(rows[(layout, policy, noise, fusion)])
+                if (layout, policy, noise, fusion) in rows
+                else "-"
+                for noise, fusion, _ in PAGE_COLUMNS
+            ),
+        ]
+        for layout, policy in cases
+    ]
+    header = ["layout", "policy", *(heading for _, _, heading in PAGE_COLUMNS)]
+    step = results["robust_step_over_strict"]
+    return (
+        markdown_table(header, body)
+        + "\n\n"
+        + measured_sentence(results["measured"], RESULTS_FILE)
+        + f" A robust env step costs {step:.2f}{TIMES} a strict one (Khepera, 5% outliers, random "
+        f"actions, the two timed in turns in one process; target ≤ {STEP_RATIO_TARGET:g}{TIMES})."
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -191,15 +280,27 @@ def build_parser() -> argparse.ArgumentParser:
         default=list(POLICIES),
         help="policies to run (default: random greedy)",
     )
+    add_json_output(parser, f"the rows and the step ratio (the results page's: {RESULTS_FILE})")
     add_no_progress(parser)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> None:
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    arguments = list(sys.argv[1:] if argv is None else argv)
+    args = parser.parse_args(arguments)
     rows = evaluate(args.episodes, args.policies, progress=not args.no_progress)
     print(table(rows))
+    ratio = step_ratio()
     print(
-        f"robust step / strict step (Khepera, 5% outliers, random actions, in turns): "
-        f"{step_ratio():.2f}"
+        f"robust step / strict step (Khepera, 5% outliers, random actions, in turns): {ratio:.2f}"
     )
+    if args.json is not None:
+        results = {
+            "measured": measured_here(parser.prog, arguments),
+            "episodes": args.episodes,
+            "rows": with_area_ratios(rows),
+            "robust_step_over_strict": ratio,
+        }
+        write_json_atomically(args.json, results)
+        print(f"wrote {args.json}")
