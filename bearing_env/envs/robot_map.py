@@ -19,6 +19,7 @@ what the robot knows, never ground truth.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Mapping
 from typing import Any, NamedTuple
 
@@ -129,27 +130,59 @@ def decode(
     copy), or ``into``, overwritten in place, when it has those landmarks and settings (a
     policy's map from its last decision: no new arrays for every info)."""
     n_landmarks = int(n_landmarks)
-    if (
+    fits = (
         into is not None
         and into.batch.num_maps == 1
         and into.n_landmarks == n_landmarks
         and into.settings == settings
-    ):
-        slam = into
-    else:
-        slam = PolygonSLAM.from_settings(n_landmarks, settings)
-    batch, mapped = slam.batch, n_landmarks - 2
-    for name in batch.state_names:
-        target = getattr(batch, name)[:1]  # the map's row, as an array even when 1-D
-        values = np.asarray(data[name])
-        if name in LANDMARK_AXES:  # one env's arrays have no map axis
-            values = values[(slice(None),) * (LANDMARK_AXES[name] - 1) + (slice(mapped),)]
-        if target.dtype.kind == "c":  # (x, y) pairs into the complex numbers' memory
-            target.view(np.float64).reshape(*target.shape, 2)[...] = values
-        else:
-            target[...] = values
-        if name in UNKNOWN_AS_INF:
-            target[np.isinf(target)] = (
-                complex(np.nan, np.nan) if target.dtype.kind == "c" else np.nan
-            )
+    )
+    slam = into if fits and into is not None else PolygonSLAM.from_settings(n_landmarks, settings)
+    for step in _decoding_plan(slam):
+        step.target[...] = np.asarray(data[step.name])[step.used_slots]
+        if step.unknown is not None:  # inf in an info, the map's "unknown" (NaN) again
+            step.row[np.isinf(step.row)] = step.unknown
     return slam
+
+
+class DecodingStep(NamedTuple):
+    """How :func:`decode` writes one state array of a map."""
+
+    #: The array's name in the info.
+    name: str
+    #: The map's row (an array even for a 1-D state array).
+    row: NDArray[Any]
+    #: ``row`` as the info's arrays come: complex numbers as (x, y) pairs over its memory.
+    target: NDArray[Any]
+    #: The info's landmark slots the map uses (one env's arrays have no map axis).
+    used_slots: tuple[slice, ...]
+    #: The map's "unknown" for the info's inf, or None (no unknown values).
+    unknown: float | complex | None
+
+
+def _decoding_plan(slam: PolygonSLAM) -> list[DecodingStep]:
+    """The map's decoding steps, made on its first decode and kept while its batch lives (a
+    policy decodes into the same map at every decision)."""
+    batch = slam.batch
+    plan = _DECODING_PLANS.get(batch)
+    if plan is not None:
+        return plan
+    plan, mapped = [], batch.n_landmarks - 2
+    for name in batch.state_names:
+        row = getattr(batch, name)[:1]
+        complex_row = row.dtype.kind == "c"
+        target = row.view(np.float64).reshape(*row.shape, 2) if complex_row else row
+        axis = LANDMARK_AXES.get(name)
+        used = () if axis is None else (slice(None),) * (axis - 1) + (slice(mapped),)
+        unknown: float | complex | None = None
+        if name in UNKNOWN_AS_INF:
+            unknown = complex(np.nan, np.nan) if complex_row else np.nan
+        plan.append(DecodingStep(name, row, target, used, unknown))
+    _DECODING_PLANS[batch] = plan
+    return plan
+
+
+#: Each batch's decoding steps (views of its arrays: kept out of the batch, so that
+#: pickling a batch never copies them apart from the arrays they view).
+_DECODING_PLANS: weakref.WeakKeyDictionary[BatchedPolygonSLAM, list[DecodingStep]] = (
+    weakref.WeakKeyDictionary()
+)
