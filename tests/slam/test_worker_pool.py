@@ -7,6 +7,7 @@ import multiprocessing
 import threading
 
 import numpy as np
+import pytest
 from numpy.typing import NDArray
 
 from bearing_env.slam import BatchedPolygonSLAM, kernels
@@ -94,3 +95,16 @@ def test_two_python_threads_updating_at_once_get_the_serial_maps() -> None:
     assert not errors and all(not thread.is_alive() for thread in threads)
     for seed in (2, 3):
         assert_same_maps(results[seed], serial[seed])
+
+
+def test_the_thread_count_comes_from_the_variable_or_the_cpus(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.delenv(kernels.THREADS_VARIABLE, raising=False)
+    assert kernels.threads() >= 1
+    monkeypatch.setenv(kernels.THREADS_VARIABLE, "3")
+    assert kernels.threads() == 3
+    for bad in ("0", "two", "-1"):
+        monkeypatch.setenv(kernels.THREADS_VARIABLE, bad)
+        with pytest.raises(ValueError, match=f"{kernels.THREADS_VARIABLE}.*{bad!r}"):
+            kernels.threads()

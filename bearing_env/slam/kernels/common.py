@@ -9,6 +9,7 @@ the native core, so the Python side and the kernels share one definition.
 
 from __future__ import annotations
 
+import functools
 import os
 
 from bearing_env._core import (
@@ -56,10 +57,7 @@ def threads() -> int:
     computed by the same code, whichever thread runs it)."""
     setting = os.environ.get(THREADS_VARIABLE)
     if setting is None:
-        try:
-            return max(1, len(os.sched_getaffinity(0)))
-        except AttributeError:  # why: no sched_getaffinity outside Linux
-            return max(1, os.cpu_count() or 1)
+        return _available_cpus()
     try:
         count = int(setting)
     except ValueError:
@@ -67,6 +65,15 @@ def threads() -> int:
     if count < 1:
         raise ValueError(f"{THREADS_VARIABLE} must be a positive integer, got {setting!r}")
     return count
+
+
+@functools.cache
+def _available_cpus() -> int:
+    """The CPUs this process may run on, read once (every batched step asks)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # why: no sched_getaffinity outside Linux
+        return max(1, os.cpu_count() or 1)
 
 
 __all__ = [
