@@ -492,7 +492,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         if self.render_mode == "human":
             self.render()
         info = core.single_info(report, robot_map_info, core.sensor_info(self._state, group))
-        return self._observation(report.observations[0]), info
+        return self._observation(report.observations[0].copy()), info  # a step reuses it
 
     def step(
         self, action: NDArray[np.float32] | ArrayLike

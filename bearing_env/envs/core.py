@@ -490,18 +490,12 @@ def _owned(values: NDArray[Any], dtype: type = np.float64) -> NDArray[Any]:
 
 def report(state: BatchState, group: Group) -> tuple[kernels.Report, dict[str, Any] | None]:
     """The group's observations and infos as they stand (after a reset: nothing moved,
-    nothing earned), with the ``robot_map`` info (None with ``robot_map_info`` off)."""
-    slots = group.config.observations.max_landmarks - 2
-    arrays, encoded = _core.report_rows(_owned(group.rows, np.int64), group.inputs, slots)
-    return kernels.Report._make(arrays), _robot_map(group, encoded)
-
-
-def _robot_map(group: Group, encoded: tuple[Any, ...] | None) -> dict[str, Any] | None:
-    """The ``robot_map`` info from :func:`robot_map.encode_map`'s new arrays (after a
-    reset); None when the setting is off."""
-    if encoded is None or not group.config.observations.robot_map_info:
-        return None
-    return _with_fusion_arrays(group, robot_map.as_info(robot_map.MAP_ARRAYS, encoded))
+    nothing earned), with the ``robot_map`` info (None with ``robot_map_info`` off), in
+    the arrays a step reuses (:func:`_outputs`): whoever keeps them copies them."""
+    rows = _owned(group.rows, np.int64)
+    report, encoded, outputs = _outputs(group, rows.size)
+    _core.report_rows_into(rows, group.inputs, outputs, encoded is not None)
+    return report, _robot_map_of(group, encoded)
 
 
 def _robot_map_of(group: Group, encoded: robot_map.Buffers | None) -> dict[str, Any] | None:

@@ -453,6 +453,31 @@ void bind_env(nb::module_& m) {
         "rows"_a, "inputs"_a, "map_slots"_a,
         "(report's 16 arrays, encode_map's 12 arrays) of rows as they stand.");
     m.def(
+        "report_rows_into",
+        [](nb::handle rows, EnvInputs& inputs, StepOutputs& outputs, bool with_map) {
+            if (outputs.inputs != &inputs) {
+                value_error("outputs were made for other inputs (StepOutputs(inputs, ...))");
+            }
+            if (with_map && !outputs.with_map) {
+                value_error("with_map needs outputs made with the encoded arrays");
+            }
+            InUse in_use(outputs.busy);
+            auto r = rows_of(rows, inputs.num_rows, &outputs.seen);
+            const int64_t size = r.shape[0];
+            if (size > outputs.capacity) {
+                value_error("rows has " + std::to_string(size) + " rows, outputs hold " +
+                            std::to_string(outputs.capacity));
+            }
+            nb::gil_scoped_release release;
+            const env::Report views = outputs.report.first(size);
+            env::clear_report(views);
+            env::observe(r, inputs.inputs, views);
+            if (with_map) env::encode_map_into(inputs.inputs.maps, r, outputs.encoded.first(size));
+        },
+        "rows"_a, "inputs"_a, "outputs"_a, "with_map"_a,
+        "report_rows into outputs' first len(rows) rows (a step's reused arrays, as step_rows "
+        "writes them): the rows' observations and infos as they stand.");
+    m.def(
         "potentials",
         [](nb::handle rows, const EnvInputs& inputs, nb::handle out) {
             auto r = rows_of(rows, inputs.num_rows, nullptr);

@@ -27,28 +27,31 @@ SETTINGS: dict[str, dict[str, Any]] = {
 
 @pytest.mark.parametrize("name", sorted(SETTINGS))
 def test_a_single_env_step_is_not_changed_by_the_next_steps(name: str) -> None:
-    env = gym.make("BearingSLAM-v0", **SETTINGS[name])
-    env.reset(seed=3)
+    env = gym.make("BearingSLAM-v0", **SETTINGS[name], max_moves=5)
+    first = env.reset(seed=3)
     env.action_space.seed(3)
-    kept: list[tuple[Any, Any]] = []
+    kept: list[tuple[Any, Any]] = [(first, copy.deepcopy(first))]  # resets reuse them too
     for _ in range(12):
         step = env.step(env.action_space.sample())
         kept.append((step, copy.deepcopy(step)))
         if step[2] or step[3]:
-            env.reset()
+            again = env.reset()
+            kept.append((again, copy.deepcopy(again)))
     changed = 0
     for step, snapshot in kept:
         assert_same(step, snapshot)
         changed += not np.array_equal(_flat(step[0]), _flat(kept[-1][0][0]))
     assert changed > 0  # the steps differ: had they shared arrays, the asserts would fail
+    assert len(kept) > 14  # and resets were kept among them
 
 
 @pytest.mark.parametrize("name", sorted(SETTINGS))
 def test_a_batched_step_is_not_changed_by_the_next_steps(name: str) -> None:
-    envs = gym.make_vec("BearingSLAM-v0", num_envs=3, **SETTINGS[name])
-    envs.reset(seed=5)
+    # Episodes of 5 moves: autoresets write their first observations among the steps'.
+    envs = gym.make_vec("BearingSLAM-v0", num_envs=3, **SETTINGS[name], max_moves=5)
+    first = envs.reset(seed=5)
     envs.action_space.seed(5)
-    kept: list[tuple[Any, Any]] = []
+    kept: list[tuple[Any, Any]] = [(first, copy.deepcopy(first))]
     for _ in range(12):
         step = envs.step(envs.action_space.sample())
         kept.append((step, copy.deepcopy(step)))
