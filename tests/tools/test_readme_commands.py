@@ -111,7 +111,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--out outputs/compare_khepera_discrete": ("parse", ()),
     "bearing-env compare --episodes 100 --workers 2 --env-kwargs scenario=random "
     "n_landmarks=6 --out outputs/compare_random6": ("parse", ()),
-    "bearing-env train --algo ppo --env BearingSLAM-v0 --seed 0 --eval-freq 250000 "
+    "bearing-env train --algo ppo --env BearingSLAM-Khepera-v0 --seed 0 --eval-freq 250000 "
     "--output runs/ppo_khepera": ("parse", ()),
     "bearing-env train --algo ppo --output runs/ppo_khepera --export "
     "agents/pretrained/ppo_khepera --export-only": ("parse", ()),
@@ -122,15 +122,10 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "agents/pretrained/ppo_random --export-only": ("parse", ()),
     "python -m bearing_env.train.studies.generalisation --model ppo_random --counts 3 4 6 8 10 "
     "--episodes 50": ("parse", ()),
-    "python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 "
-    '--conf-file "$(bearing-env hyperparams ppo)" --eval-env-kwargs "scenario:\'khepera\'"': (
-        "zoo",
-        (),
-    ),
-    "python -m rl_zoo3.enjoy --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 -f logs": (
-        "zoo",
-        (),
-    ),
+    "python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-Khepera-v0 "
+    '--conf-file "$(bearing-env hyperparams ppo)"': ("zoo", ()),
+    "python -m rl_zoo3.enjoy --gym-packages bearing_env --algo ppo --env BearingSLAM-Khepera-v0 "
+    "-f logs": ("zoo", ()),
     'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_entities)" '
     "--seed 0 --eval-freq 100000 --output runs/ppo_generalist": ("parse", ()),
     'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_attention)" '
@@ -144,7 +139,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env figures --only robust --out docs/figures": ("parse", ()),
     "bearing-env robust-eval": ("parse", ()),
     "bearing-env robust-eval --episodes 200": ("parse", ()),
-    "bearing-env train --algo ppo --env BearingSLAM-v0 --env-kwargs scenario=khepera "
+    "bearing-env train --algo ppo --env BearingSLAM-Khepera-v0 "
     "--init-from pretrained:ppo_khepera --timesteps 2000000 "
     "--output runs/ppo_khepera_finetune": ("parse", ()),
     "bearing-env observability": ("parse", ()),

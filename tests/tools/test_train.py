@@ -146,7 +146,9 @@ def test_tiny_run_writes_a_complete_run_folder(
     record = json.loads((run / "run.json").read_text())
     assert record["status"] == "finished"
     assert record["num_timesteps"] == TINY_TIMESTEPS
-    assert record["env_kwargs"] == {"scenario": "khepera"}  # from the shipped YAML
+    # The shipped YAML's entry is keyed by the Khepera task id, whose kwargs hold the scenario.
+    assert record["env_id"].rpartition(":")[2] == DEFAULT_ENV_IDS[algo]
+    assert record["env_kwargs"] == {}
     assert record["seeds"]["validation"] == [VALIDATION_SEED_START, VALIDATION_SEED_START + 2]
     for name in ("model.zip", "vecnormalize.pkl", "best/best_model.zip", "best/vecnormalize.pkl"):
         assert (run / name).is_file(), name
@@ -491,8 +493,8 @@ def test_export_writes_the_pretrained_layout(
     assert exported.source == "best"
     assert (folder / "ppo_tiny.zip").read_bytes() == (run / "best" / BEST_MODEL_NAME).read_bytes()
     metadata = json.loads((folder / "ppo_tiny.json").read_text())
-    assert metadata["algo"] == "ppo" and metadata["env_id"] == "BearingSLAM-v0"
-    assert metadata["env_kwargs"] == {"scenario": "khepera"}
+    assert metadata["algo"] == "ppo" and metadata["env_id"] == "BearingSLAM-Khepera-v0"
+    assert metadata["env_kwargs"] == {}
     assert metadata["files"] == {
         "model": "ppo_tiny.zip",
         "vecnormalize": "ppo_tiny_vecnormalize.pkl",
@@ -536,7 +538,9 @@ def test_exported_models_load_by_name_and_join_the_comparison(
         SB3Policy.pretrained("ppo_nope", env)
     env.close()
 
-    # Compared by default only where it was trained: same id and env kwargs.
+    # Compared by default only where it was trained: the same action kind and settings,
+    # by the task id or by the base id with the task's kwargs.
+    assert matching_pretrained("BearingSLAM-Khepera-v0", {}) == ["pretrained:ppo_tiny"]
     assert matching_pretrained("bearing_env:BearingSLAM-v0", {"scenario": "khepera"}) == [
         "pretrained:ppo_tiny"
     ]
@@ -547,44 +551,20 @@ def test_exported_models_load_by_name_and_join_the_comparison(
     # Records are JSON: a tuple-valued kwarg must still match its JSON list.
     record = folder / "ppo_tiny.json"
     metadata = json.loads(record.read_text())
-    metadata["env_kwargs"]["n_landmarks"] = [4, 8]
+    metadata["env_id"] = "BearingSLAM-v0"
+    metadata["env_kwargs"] = {"scenario": "random", "n_landmarks": [4, 8], "max_landmarks": 10}
     record.write_text(json.dumps(metadata))
     assert matching_pretrained(
-        "BearingSLAM-v0", {"scenario": "khepera", "n_landmarks": (4, 8)}
+        "BearingSLAM-v0", {"scenario": "random", "n_landmarks": (4, 8), "max_landmarks": 10}
     ) == ["pretrained:ppo_tiny"]
+    # Settings that do not resolve match no model (the comparison reports them).
+    assert matching_pretrained("BearingSLAM-v0", {"scenario": "khepera", "n_landmarks": 6}) == []
     assert matching_pretrained("BearingSLAMDiscrete-v0", {"scenario": "khepera"}) == []
 
 
 # --------------------------------------------------------------------------------------
 # Hyperparameter files, seeds, rl-zoo3
 # --------------------------------------------------------------------------------------
-
-
-@pytest.mark.parametrize(
-    ("algo", "env_id"),
-    [("ppo", "BearingSLAM-v0"), ("ppo", "BearingSLAMDiscrete-v0"), ("sac", "BearingSLAM-v0"),
-     ("dqn", "BearingSLAMDiscrete-v0")],
-)  # fmt: skip
-def test_shipped_hyperparameters_parse(algo: str, env_id: str) -> None:
-    raw = read_hyperparameters(algo, env_id)
-    parsed = parse_hyperparameters(raw, algo)
-    assert parsed.n_envs >= 1 and parsed.n_timesteps >= 1
-    assert parsed.env_kwargs == {"scenario": "khepera"}
-    assert parsed.normalize is not None and parsed.normalize["gamma"] == raw["gamma"]
-    assert isinstance(parsed.algorithm_kwargs["policy_kwargs"], dict)
-    gym.make(env_id, **parsed.env_kwargs).close()
-    constructor_kwargs = {k: v for k, v in parsed.algorithm_kwargs.items() if k != "policy"}
-    if algo != "ppo":
-        constructor_kwargs["buffer_size"] = 10  # the model builds, without a big buffer
-    else:  # every update's rollout splits into whole mini-batches
-        rollout = parsed.algorithm_kwargs["n_steps"] * parsed.n_envs
-        assert rollout % parsed.algorithm_kwargs["batch_size"] == 0
-    from stable_baselines3.common.env_util import make_vec_env
-
-    venv = make_vec_env(env_id, n_envs=parsed.n_envs, env_kwargs=parsed.env_kwargs)
-    algorithm_class = algorithm_class_for(algo)
-    algorithm_class(parsed.algorithm_kwargs["policy"], venv, device="cpu", **constructor_kwargs)
-    venv.close()
 
 
 def test_hyperparameters_are_preprocessed_by_rl_zoo3() -> None:

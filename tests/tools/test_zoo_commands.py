@@ -11,13 +11,15 @@ few dozen timesteps, an evaluation every 16 steps of one episode, tiny buffers.
 What is checked, through :mod:`tests.tools.zoo_probe`, which records the settings of every
 env rl-zoo3 builds: the training envs are the YAML entry's ``env_kwargs``, and the
 evaluation env (and ``enjoy``'s env) has exactly the training envs' settings. rl-zoo3
-gives a YAML's ``env_kwargs`` to its training envs only, so a command without
-``--eval-env-kwargs`` evaluates on the defaults (``scenario="random"``) and fails here,
-as the ``ppo_entities`` command did (``norm_obs_keys`` on a Box observation). A file
-keyed by a task id (``ppo_entities.yml``: ``BearingSLAM-Random3to16-Entities-v0``) needs
-no such flag: rl-zoo3 makes the evaluation env from the id, whose kwargs carry the
-settings; :func:`test_the_plain_command_trains_and_evaluates_each_task_keyed_file` runs
-that plain form for every such shipped file, whatever the docs show.
+gives a YAML's ``env_kwargs`` to its training envs only, so an entry with settings of its
+own evaluated on the id's defaults without ``--eval-env-kwargs`` and failed here, as the
+``ppo_entities`` command did (``norm_obs_keys`` on a Box observation). Every shipped
+entry is keyed by a registered id whose kwargs carry its settings (``ppo.yml``:
+``BearingSLAM-Khepera-v0``; ``ppo_entities.yml``: ``BearingSLAM-Random3to16-Entities-v0``),
+so no command needs that flag: rl-zoo3 makes the evaluation env from the id;
+:func:`test_the_plain_command_trains_and_evaluates_each_task_keyed_file` runs that plain
+form for every single-entry file, whatever the docs show, and
+``tests/tools/test_hyperparams_files.py`` runs every entry of every file in process.
 
 The ``ppo`` and ``ppo_entities`` runs and ``enjoy`` are in the default run; the other
 algorithms' commands are ``slow``.
@@ -183,9 +185,8 @@ COMMANDS = documented_commands()
 
 def test_the_docs_show_the_zoo_commands_this_test_must_run() -> None:
     labels = {command.label for command in COMMANDS}
-    assert {"train-ppo-ppo", "train-ppo-ppo_entities", "enjoy-ppo-BearingSLAM-v0"} <= labels
-    entities = [c for c in COMMANDS if c.label == "train-ppo-ppo_entities"]
-    assert entities and all("--eval-env-kwargs" not in c.argv for c in entities)
+    assert {"train-ppo-ppo", "train-ppo-ppo_entities", "enjoy-ppo-BearingSLAM-Khepera-v0"} <= labels
+    assert all("--eval-env-kwargs" not in c.argv for c in COMMANDS)
     text = (
         "Train:\n\n```bash\npython -m rl_zoo3.train --algo ppo \\\n    --env E  # why\n```\n"
         "or `python -m rl_zoo3.enjoy --algo ppo --env E`.\n"

@@ -93,7 +93,6 @@ from bearing_env.train.compare.config import (
     DEFAULT_ENV_KWARGS,
     DEFAULT_EPISODES,
     CompareConfig,
-    json_normalised,
     policies_from_specs,
 )
 from bearing_env.train.compare.log import LOG_NAME, CorruptLogError
@@ -243,22 +242,33 @@ def _add_statistics_options(group: argparse._ArgumentGroup) -> None:
 
 
 def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
-    """Specs of the shipped models trained on this env id and these env kwargs.
+    """Specs of the shipped models trained on this env's task: the same action kind and the
+    same resolved settings (the id's registered kwargs, then the env kwargs), so a model
+    trained on ``BearingSLAM-Khepera-v0`` matches ``BearingSLAM-v0`` with
+    ``scenario="khepera"``.
 
     ``max_moves`` is ignored: it only sets how long an episode runs.
     """
+    import gymnasium as gym
+
     from bearing_env.agents import pretrained_names, pretrained_record
 
-    def plain(kwargs: dict[str, Any]) -> dict[str, Any]:
-        # Through JSON, as the record was written: tuples and lists compare equal.
-        return dict(json_normalised({k: v for k, v in kwargs.items() if k != "max_moves"}))
+    def task_of(env_id: str, kwargs: dict[str, Any]) -> tuple[bool, object] | None:
+        settings = {key: value for key, value in kwargs.items() if key != "max_moves"}
+        task = ModelTask(env_id.rpartition(":")[2], settings)
+        try:
+            return task.discrete, task.config
+        except (ValueError, TypeError, gym.error.Error):
+            return None  # the comparison says what is wrong when it makes the env
 
-    wanted = env_id.split(":")[-1]
+    wanted = task_of(env_id, env_kwargs)
+    if wanted is None:
+        return []
     specs = []
     for name in pretrained_names():
         record = pretrained_record(name)
-        trained_on = str(record.get("env_id", "")).split(":")[-1]
-        if trained_on == wanted and plain(dict(record.get("env_kwargs", {}))) == plain(env_kwargs):
+        trained_on = task_of(str(record.get("env_id", "")), dict(record.get("env_kwargs", {})))
+        if trained_on == wanted:
             specs.append(f"pretrained:{name}")
     return specs
 

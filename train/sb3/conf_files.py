@@ -4,11 +4,13 @@ The files are package data of ``bearing_env.train.sb3`` (``hyperparams/<algo>.ym
 through :mod:`bearing_env.shipped`), so they exist in site-packages as well as in a
 checkout. ``bearing-env hyperparams ppo`` prints the path of ``ppo.yml``, for rl-zoo3::
 
-    python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-v0 \\
-        --conf-file "$(bearing-env hyperparams ppo)" --eval-env-kwargs "scenario:'khepera'"
+    python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-Khepera-v0 \\
+        --conf-file "$(bearing-env hyperparams ppo)"
 
-(rl-zoo3 gives a file's ``env_kwargs`` to its training envs only: the evaluation env
-needs the same settings as ``--eval-env-kwargs``; each file's header shows its command.)
+(rl-zoo3 gives an entry's ``env_kwargs`` to its training envs only and makes its
+evaluation env from the id alone, so every entry is keyed by the id it trains on and
+holds no ``env_kwargs``: the id's registered kwargs carry the settings. Each file's
+header shows its command.)
 
 ``bearing-env hyperparams`` without an algorithm lists the shipped files. Nothing here
 needs an optional extra.

@@ -38,11 +38,12 @@ from bearing_env.train.sb3.conf_files import default_conf_file
 from bearing_env.validation import int_at_least, is_integer
 
 #: The algorithms ``bearing-env train`` ships hyperparameters for, and the env id each
-#: trains on by default.
+#: trains on by default: the Khepera task ids, whose registered kwargs carry the scenario
+#: (the shipped files are keyed by them, as rl-zoo3 needs).
 DEFAULT_ENV_IDS: dict[str, str] = {
-    "ppo": "BearingSLAM-v0",
-    "sac": "BearingSLAM-v0",
-    "dqn": "BearingSLAMDiscrete-v0",
+    "ppo": "BearingSLAM-Khepera-v0",
+    "sac": "BearingSLAM-Khepera-v0",
+    "dqn": "BearingSLAMDiscrete-Khepera-v0",
 }
 
 #: rl-zoo3 keys that this trainer does not implement (rl-zoo3 itself does).
