@@ -99,16 +99,45 @@ def count(driver: str, entry: str, arguments: Sequence[str], top: int = 12) -> d
             text=True,
             check=True,
         ).stdout
+    return {"instructions": int(totals[1]), "functions": functions_of(annotate, top)}
+
+
+def functions_of(annotate: str, top: int) -> list[dict[str, Any]]:
+    """The ``top`` functions of ``callgrind_annotate --inclusive=yes`` output, largest
+    first: short name, inclusive instructions and share of the total."""
     functions: list[dict[str, Any]] = []
     for line in annotate.splitlines():
-        match = re.match(r"\s*([\d,]+)\s+\(\s*([\d.]+)%\)\s+\S*:(.+?)(?: \[.*\])?$", line)
-        if match and len(functions) < top:
+        # "count (share%) file:function [object]"; the file part has no colon.
+        match = re.match(r"\s*([\d,]+)\s+\(\s*([\d.]+)%\)\s+[^\s:]+:(.+?)(?: \[(.*)\])?$", line)
+        # The core's own functions and the maths library's: not the interpreter's frames
+        # above the entry point nor nanobind's call wrappers, which hold every
+        # instruction and say nothing.
+        if match and _counted_object(match[4]) and not match[3].startswith(NANOBIND_WRAPPERS):
+            if len(functions) == top:
+                break
             instructions = int(match[1].replace(",", ""))
             functions.append(
-                {"function": match[3].strip(), "instructions": instructions,
+                {"function": _short_name(match[3]), "instructions": instructions,
                  "share": float(match[2]) / 100}
             )  # fmt: skip
-    return {"instructions": int(totals[1]), "functions": functions}
+    return functions
+
+
+#: nanobind's frames between the interpreter and a bound function.
+NANOBIND_WRAPPERS = ("nanobind::", "nb_func_", "func_create<")
+
+
+def _short_name(signature: str) -> str:
+    """A function's qualified name without its parameter list or clone suffixes."""
+    name = signature.strip().replace("(anonymous namespace)", "{anonymous}")
+    return name.split("(", 1)[0]
+
+
+def _counted_object(path: str | None) -> bool:
+    """Whether a function of the shared object at ``path`` is listed: the native core's
+    or the maths library's (``hypot``, ``atan2``)."""
+    name = Path(path or "").name
+    return name.startswith(("_core.", "libm.", "libm-"))
 
 
 def main(argv: Sequence[str] | None = None) -> None:
