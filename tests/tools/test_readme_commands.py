@@ -15,7 +15,7 @@ How each kind is checked, cheaply:
   which reject unknown options, bad values and bad env kwargs; the command then does
   not run (these are the long runs: 200-episode comparisons, 600k-step training);
 - ``run``: the command runs for real, with the extra arguments given (a smaller budget);
-- ``make``: ``make -n TARGET`` (a dry run) knows the target;
+- ``make``: the Makefile defines the target, and ``make -n TARGET`` (a dry run) knows it;
 - ``help``: the program's ``--help`` (with its subcommand) runs and names every option the
   command gives: Ray's own CLI, and the long benchmarks;
 - ``copy``: a ``cp`` of a comparison plot, whose destination folder is in the repository
@@ -59,6 +59,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "make bench": ("make", ()),
     "make bench-slam": ("make", ()),
     "make lint": ("make", ()),
+    "make native": ("make", ()),
     "bearing-env train": ("parse", ("--algo", "ppo")),
     "bearing-env figures": ("parse", ()),
     "bearing-env demo": ("run", ("--episodes", "1", "--moves", "3")),
@@ -184,6 +185,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "ray status": ("help", ()),
     "ray stop": ("help", ()),
     'bearing-env bench --help': ('help', ()),
+    "bearing-env bench-callgrind --json benchmarks/results/bench_callgrind.json": ("help", ()),
     'bearing-env bench --json benchmarks/results/bench_env.json': ('parse', ()),
     'bearing-env bench --sections single,vector': ('parse', ()),
     'bearing-env compare --policies greedy oracle lookahead lookahead_oracle': ('parse', ()),
@@ -365,6 +367,8 @@ def test_readme_command_runs_or_parses(command: str, tmp_path: Path) -> None:
     kind, extra = CHECKS[command]
     argv = shlex.split(command)
     if kind == "make":
+        makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
+        assert re.search(rf"^{re.escape(argv[1])}:", makefile, re.MULTILINE), argv[1]
         result = subprocess.run(
             ["make", "-n", *argv[1:]], cwd=ROOT, capture_output=True, text=True, timeout=60
         )
