@@ -1,5 +1,5 @@
 """The timing of ``bearing-env bench``: every measured figure of BearingSLAM-v0 (single
-env, batched vector env, world model, compiled start-up, planning, PPO training) and the
+env, batched vector env, world model, a fresh process's start-up, planning, PPO training) and the
 CartPole-v1 reference each figure is divided by. What each section measures is in
 :mod:`bearing_env.benchmarks.bench_env`'s docstring.
 """
@@ -48,8 +48,15 @@ DEFAULT_PPO_ROUNDS = 3
 QUICK_PPO_OVERRIDES: dict[str, Any] = {"n_steps": 8, "n_epochs": 1}
 #: Episodes of the planning section (Khepera, 20 moves each; --quick: 2).
 PLANNING_EPISODES = 20
-#: Fresh processes timed with a warm cache (the median counts).
-STARTUP_WARM_RUNS = 3
+#: Timed pairs of fresh processes (bearing_env, CartPole-v1) of the startup section; the
+#: medians count.
+STARTUP_RUNS = 5
+#: The same with --quick.
+QUICK_STARTUP_RUNS = 1
+#: The env the startup section's fresh processes make and step.
+STARTUP_ENV_ID = "BearingSLAM-Khepera-v0"
+
+
 def log(message: str) -> None:
     """Progress lines go to stderr, so stdout holds only the table."""
     print(message, file=sys.stderr, flush=True)
@@ -232,7 +239,7 @@ def _step_cost_ratios(rows: list[dict[str, Any]]) -> None:
 
 
 # --------------------------------------------------------------------------------------
-# The world model alone, and the compiled core's start-up
+# The world model alone, and a fresh process's start-up
 # --------------------------------------------------------------------------------------
 
 
@@ -252,44 +259,101 @@ def bench_slam_updates(bench: Bench) -> list[dict[str, Any]]:
     return rows
 
 
-#: Run in a fresh interpreter: seconds from its start to the end of the first env step.
-FIRST_STEP_SCRIPT = """
-import time
-start = time.perf_counter()
-import gymnasium as gym
-import bearing_env  # noqa: F401
-env = gym.make("BearingSLAM-v0", scenario="khepera")
-env.reset(seed=0)
-env.step(env.action_space.sample())
-print(time.perf_counter() - start)
-"""
+#: The start-up section's scripts, each run whole in a fresh interpreter: imports, an env
+#: made, reset and stepped once; each prints whether numba was imported (the core is
+#: compiled at build time: nothing compiles, or loads a JIT compiler, at run time).
+STARTUP_SCRIPTS: dict[str, str] = {
+    "bearing_env": (
+        "import gymnasium as gym\n"
+        "import bearing_env\n"
+        f'env = gym.make("{STARTUP_ENV_ID}")\n'
+        "env.reset(seed=0)\n"
+        "env.step(env.action_space.sample())\n"
+        "import sys\n"
+        'print("numba" in sys.modules)\n'
+    ),
+    "cartpole": (
+        "import gymnasium as gym\n"
+        'env = gym.make("CartPole-v1")\n'
+        "env.reset(seed=0)\n"
+        "env.step(env.action_space.sample())\n"
+        "import sys\n"
+        'print("numba" in sys.modules)\n'
+    ),
+}
 
 
-def first_step_seconds(cache_dir: str) -> float:
-    environment = dict(os.environ, XDG_CACHE_HOME=cache_dir)
+def startup_environment(home: str, cache: str) -> dict[str, str]:
+    """The children's environment: ``home`` and ``cache`` as HOME and XDG_CACHE_HOME, and
+    no PYTHONDONTWRITEBYTECODE (a sandbox's setting no user has: with it every process
+    compiles the project's sources again)."""
+    environment = dict(os.environ, HOME=home, XDG_CACHE_HOME=cache)
+    environment.pop("PYTHONDONTWRITEBYTECODE", None)
+    return environment
+
+
+def process_seconds(script: str, environment: dict[str, str]) -> tuple[float, bool]:
+    """Run ``script`` in a fresh interpreter: (wall seconds from before its start to its
+    exit, whether it imported numba)."""
+    start = time.perf_counter()
     done = subprocess.run(
-        [sys.executable, "-c", FIRST_STEP_SCRIPT],
+        [sys.executable, "-c", script],
         capture_output=True,
         text=True,
         env=environment,
-        check=True,
+        cwd=environment["HOME"],  # not the checkout, whose bearing_env/ would come first
         timeout=900,
     )
-    return float(done.stdout.strip().splitlines()[-1])
+    elapsed = time.perf_counter() - start
+    lines = done.stdout.strip().splitlines()
+    if done.returncode != 0 or not lines or lines[-1] not in ("True", "False"):
+        raise RuntimeError(
+            f"the start-up script exited with status {done.returncode}: "
+            f"{(done.stderr or done.stdout).strip()[-2000:]}"
+        )
+    return elapsed, lines[-1] == "True"
 
 
-def bench_startup() -> dict[str, Any]:
-    """Time the first step of fresh processes: once with empty cache folders, then again
-    (the native core is compiled at build time: the two should be alike)."""
-    with tempfile.TemporaryDirectory(prefix="bearing-env-cache-") as cache_dir:
-        log("  first step in a fresh process, empty cache folders ...")
-        cold = first_step_seconds(cache_dir)
-        warm = [first_step_seconds(cache_dir) for _ in range(STARTUP_WARM_RUNS)]
-    log(f"  first step: {cold:.2f} s with empty caches, {np.median(warm):.2f} s after")
+def bench_startup(runs: int = STARTUP_RUNS) -> dict[str, Any]:
+    """Time whole fresh processes (start to exit) that make and step BearingSLAM-Khepera-v0,
+    and the same script on CartPole-v1 without bearing_env, alternately, ``runs`` pairs
+    after one untimed pair (which writes the bytecode caches; its bearing_env run, from
+    empty HOME and XDG_CACHE_HOME folders, is kept as the cold figure)."""
+    if runs < 1:
+        raise ValueError(f"runs must be >= 1, not {runs}")
+    bearing: list[float] = []
+    cartpole: list[float] = []
+    with tempfile.TemporaryDirectory(prefix="bearing-env-startup-") as folder:
+        home, cache = os.path.join(folder, "home"), os.path.join(folder, "cache")
+        os.mkdir(home)
+        os.mkdir(cache)
+        environment = startup_environment(home, cache)
+        log(f"  fresh processes: 1 untimed pair, then {runs} pairs, alternately ...")
+        cold, numba = process_seconds(STARTUP_SCRIPTS["bearing_env"], environment)
+        process_seconds(STARTUP_SCRIPTS["cartpole"], environment)
+        for _ in range(runs):
+            seconds, imported = process_seconds(STARTUP_SCRIPTS["bearing_env"], environment)
+            bearing.append(seconds)
+            numba = numba or imported
+            seconds, _ = process_seconds(STARTUP_SCRIPTS["cartpole"], environment)
+            cartpole.append(seconds)
+    bearing_median, cartpole_median = float(np.median(bearing)), float(np.median(cartpole))
+    ratio = bearing_median / cartpole_median
+    log(
+        f"  fresh process: {STARTUP_ENV_ID} {bearing_median:.3f} s, CartPole-v1 "
+        f"{cartpole_median:.3f} s (medians): {ratio:.2f}x; first run {cold:.3f} s; "
+        f"numba imported: {numba}"
+    )
     return {
-        "cold_first_step_s": cold,
-        "warm_first_step_s": float(np.median(warm)),
-        "warm_runs_s": warm,
+        "env_id": STARTUP_ENV_ID,
+        "runs": runs,
+        "bearing_env_runs_s": bearing,
+        "cartpole_runs_s": cartpole,
+        "bearing_env_median_s": bearing_median,
+        "cartpole_median_s": cartpole_median,
+        "ratio_to_cartpole": ratio,
+        "cold_bearing_env_s": cold,
+        "numba_imported": numba,
     }
 
 
