@@ -26,12 +26,14 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from shapely.geometry import Polygon
 
 from bearing_env.validation import int_at_least, is_integer
+
+if TYPE_CHECKING:  # shapely is imported where it is used: an env without obstacles never needs it
+    from shapely.geometry import Polygon
 
 #: An obstacle as the settings hold it: its vertices (x, y) in metres.
 Obstacle = tuple[tuple[float, float], ...]
@@ -81,6 +83,10 @@ def _polygon(item: Any, index: int) -> Obstacle:
 def check_obstacles(polygons: Sequence[Obstacle], width: float, height: float) -> None:
     """ValueError unless every polygon is simple, inside the arena and apart from the
     others (touching is overlapping: the robot could not pass between them anyway)."""
+    if not polygons:
+        return
+    from shapely.geometry import Polygon
+
     shapes: list[Polygon] = []
     for index, polygon in enumerate(polygons):
         shape = Polygon(polygon)
@@ -160,6 +166,8 @@ def random_obstacles(
     ``rng``: each a tenth to a fifth of the shorter side across, kept a robot-sized gap
     (6% of the shorter side) apart and from the walls, so the free space stays connected
     in practice. Fewer boxes when no more fit (rejection sampling, deterministic)."""
+    from shapely.geometry import Polygon
+
     short = min(width, height)
     gap = 0.06 * short
     boxes: list[Obstacle] = []

@@ -1,18 +1,23 @@
 """One-movement functions returning shapely geometry: for inspection, plots and tests.
 
 The map (:class:`~bearing_env.slam.PolygonSLAM`) calls the compiled kernels directly;
-these wrappers give the exact polygons of a single movement.
+these wrappers give the exact polygons of a single movement. shapely is imported when
+one of them is first called: making and stepping an env never needs it.
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import shapely
 from numpy.typing import ArrayLike
 
 from bearing_env.slam.geometry import FR_BOUNDED, cone_region
 from bearing_env.slam.transfer import transfer_vertices
 from bearing_env.validation import epsilon_radians
+
+if TYPE_CHECKING:
+    import shapely
 
 
 def fr_region(bearing_start: float, bearing_end: float, epsilon: float) -> shapely.Polygon | None:
@@ -59,6 +64,8 @@ def transfer_point(
 
 
 def _vertices(region: shapely.Polygon | ArrayLike) -> np.ndarray:
+    import shapely
+
     if isinstance(region, shapely.Polygon):
         xy = np.asarray(region.exterior.coords)[:-1]
         if shapely.is_ccw(region.exterior) is False:
@@ -70,6 +77,8 @@ def _vertices(region: shapely.Polygon | ArrayLike) -> np.ndarray:
 
 def _polygon(verts: np.ndarray) -> shapely.Geometry:
     """The polygon of CCW vertices; a point or a segment when it has no area."""
+    import shapely
+
     xy = np.stack([verts.real, verts.imag], -1)
     if verts.size >= 3:
         return shapely.Polygon(xy)

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from bearing_env.slam import kernels
@@ -27,6 +26,9 @@ from bearing_env.slam.settings import (
     MapSettings,
 )
 from bearing_env.validation import int_at_least
+
+if TYPE_CHECKING:  # imported where used: making and stepping an env never needs it
+    import shapely
 
 (
     FRAME_OK,
@@ -377,6 +379,8 @@ class PolygonSLAM(HasMapSettings):
     @property
     def regions(self) -> list[shapely.Polygon | None]:
         """Regions of landmarks 3..n as shapely Polygons in FL (None if not initialised)."""
+        import shapely
+
         return [None if p is None else shapely.Polygon(p) for p in self.polygons]
 
     @property
@@ -389,6 +393,8 @@ class PolygonSLAM(HasMapSettings):
     @property
     def robot_region(self) -> shapely.Polygon | None:
         poly = self.robot_polygon
+        import shapely
+
         return None if poly is None else shapely.Polygon(poly)
 
     @property
