@@ -24,6 +24,14 @@ inline int64_t fptosi(double x) {
     return static_cast<int64_t>(x);
 }
 
+// n * per_edge, saturated at INT64_MAX: a huge per_edge must fail the capacity check, not
+// wrap to a small or negative count that passes it (and overruns the sample buffers).
+inline int64_t samples_of(int64_t n, int64_t per_edge) {
+    int64_t samples;
+    if (__builtin_mul_overflow(n, per_edge, &samples)) return std::numeric_limits<int64_t>::max();
+    return samples;
+}
+
 }  // namespace
 
 // --------------------------------------------------------------------------------------
@@ -119,8 +127,8 @@ int64_t sample_hypotheses(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2
     cplx* s2 = s2_buffer.data;
     cplx* column = column_buffer.data;
     if (per_edge > 0) {
-        check_capacity("sample_hypotheses samples of a1", n1 * per_edge, MAX_SAMPLES);
-        check_capacity("sample_hypotheses samples of a2", n2 * per_edge, MAX_SAMPLES);
+        check_capacity("sample_hypotheses samples of a1", samples_of(n1, per_edge), MAX_SAMPLES);
+        check_capacity("sample_hypotheses samples of a2", samples_of(n2, per_edge), MAX_SAMPLES);
     }
     const int64_t m1 = boundary_samples(a1, n1, per_edge, s1);
     const int64_t m2 = boundary_samples(a2, n2, per_edge, s2);
