@@ -5,6 +5,7 @@
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/string.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -324,12 +325,34 @@ void copy_maps_binding(const PyMapState& from, nb::handle rows, const PyMapState
 int64_t check_indices_binding(nb::handle indices, int64_t size, bool distinct) {
     auto view = view_of<const int64_t, 1>(indices, "indices");
     if (distinct && size < 0) value_error("size must not be negative, got " + std::to_string(size));
-    std::unique_ptr<bool[]> seen(distinct ? new bool[static_cast<size_t>(size)] : nullptr);
-    return slam::check_indices(view.data, view.shape[0], size, distinct, seen.get());
+    const int64_t n = view.shape[0];
+    if (!distinct) return slam::check_indices(view.data, n, size, false, nullptr);
+    // The kernel's table of seen indices needs a slot per index in range only up to the
+    // largest one given, not `size` slots (a huge size would allocate and clear that
+    // much): with `limit` for `size`, an index is in range exactly when it was before.
+    int64_t limit = 0;
+    for (int64_t k = 0; k < n; ++k) {
+        if (view(k) >= 0 && view(k) < size) limit = std::max(limit, view(k) + 1);
+    }
+    constexpr int64_t MAX_TABLE = int64_t{1} << 20;
+    if (limit <= MAX_TABLE) {
+        std::unique_ptr<bool[]> seen(new bool[static_cast<size_t>(limit)]);
+        return slam::check_indices(view.data, n, limit, true, seen.get());
+    }
+    // Sparse large indices: the kernel's answer (the first problem in order) from a sorted
+    // copy of the indices before the first one out of range.
+    int64_t stop = 0;
+    while (stop < n && view(stop) >= 0 && view(stop) < size) ++stop;
+    std::vector<int64_t> sorted(view.data, view.data + stop);
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+        return slam::INDEX_REPEATED;
+    }
+    return stop < n ? slam::INDEX_OUT_OF_RANGE : slam::INDEX_OK;
 }
 
 bool none_infinite_binding(nb::handle values) {
-    nb::ndarray<nb::numpy> array;
+    nb::ndarray<nb::numpy, nb::ro> array;  // read-only arrays too: it only reads them
     if (!nb::try_cast(values, array, false)) {
         bearing::bindings::type_error(std::string("values must be a numpy array, not ") +
                                       nb::type_name(values.type()).c_str());
