@@ -409,6 +409,15 @@ void contains_points_binding(nb::handle vertices, nb::handle counts, nb::handle 
     slam::contains_points(v, c, r, p, relative, o);
 }
 
+// A vertex count the kernels read a region of the state with (from an array a user can
+// write, as the update's own check of a map does): within the region's `slots`.
+void check_region_count(int64_t n, int64_t slots, const char* name) {
+    if (n < 0 || n > slots) {
+        value_error(std::string("state.") + name + " holds " + std::to_string(n) +
+                    ", outside [0, " + std::to_string(slots) + "]: a corrupt state");
+    }
+}
+
 // The relaxed fusion's region of landmark j of map `row` over the window slots `slots`
 // (int64, k of them), with the bases if use_base: (n, q), the region in out[:n]
 // (bearing_env.slam.geometry.relaxed_intersection's kernel; not the per-step path).
@@ -427,6 +436,14 @@ nb::tuple relaxed_region_binding(const PyMapState& s, int64_t row, int64_t j, nb
     }
     require(0 <= max_outliers && max_outliers < slam::MAX_WINDOW, "max_outliers out of range");
     require(o.shape[0] >= slam::SCRATCH, "out must hold SCRATCH points");
+    for (int64_t i = 0; i < k_slots.shape[0]; ++i) {
+        check_region_count(s.views.window_counts(row, k_slots(i), j),
+                           s.views.window_vertices.shape[3], "window_counts");
+    }
+    if (use_base) {
+        check_region_count(s.views.base_counts(row, j), s.views.base_vertices.shape[2],
+                           "base_counts");
+    }
     auto scratch = std::make_unique<slam::Scratch>();
     for (int64_t i = 0; i < k_slots.shape[0]; ++i) scratch->slots[i] = k_slots(i);
     auto [n, q] = slam::relaxed_region(s.views, row, j, k_slots.shape[0], use_base, max_outliers,
@@ -446,6 +463,11 @@ void update_levels_binding(const PyMapState& s, int64_t row, int64_t j, nb::hand
     require(s.levels > 0, "the state has no robust levels (fusion must be 'robust')");
     require(3 <= f.shape[0] && f.shape[0] <= slam::CAPACITY,
             "fresh must have 3.." + std::to_string(slam::CAPACITY) + " vertices");
+    require(s.views.n_regions(row, j) >= 0, "state.n_regions is negative: a corrupt state");
+    for (int64_t k = 0; k < s.levels; ++k) {
+        check_region_count(s.views.level_counts(row, j, k), s.views.level_vertices.shape[3],
+                           "level_counts");
+    }
     auto scratch = std::make_unique<slam::Scratch>();
     for (int64_t v = 0; v < f.shape[0]; ++v) scratch->fresh[v] = f(v);
     slam::update_levels(s.views, row, j, f.shape[0], *scratch);
