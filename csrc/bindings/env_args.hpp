@@ -78,6 +78,13 @@ inline env::Settings settings_of(nb::handle obj, Kept& kept) {
         value_error("settings.n_slots (" + std::to_string(s.n_slots) +
                     ") must be at least settings.n (" + std::to_string(s.n) + ")");
     }
+    // Far above any env's slots (max_landmarks is at most 1024), and low enough that the
+    // observation's size (about 8 floats a slot) is computed without overflow.
+    constexpr int64_t MAX_SLOTS = int64_t{1} << 20;
+    if (s.n_slots > MAX_SLOTS) {
+        value_error("settings.n_slots (" + std::to_string(s.n_slots) + ") must be at most " +
+                    std::to_string(MAX_SLOTS));
+    }
     return s;
 }
 
