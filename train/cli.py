@@ -73,6 +73,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "bearing_env.benchmarks.region_search",
         "a seeded search for world-model regions that are not simple, convex or conservative",
     ),
+    "transfer-tightness": (
+        "bearing_env.benchmarks.transfer_tightness",
+        "single-movement regions against the exact transferred sets they bound (area, containment)",
+    ),
     "soak": (
         "bearing_env.benchmarks.soak",
         "a soak of the envs over random configurations, checking containment every step",
