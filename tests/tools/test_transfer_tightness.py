@@ -1,0 +1,195 @@
+"""``bearing-env transfer-tightness``: the exact transferred set's membership test against
+brute force and shapely, today's regions against the exact set, and the command end to
+end."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+from bearing_env.benchmarks import transfer_tightness as tightness
+
+ComplexArray = tightness.ComplexArray
+
+#: Angles (radians) of a polygon's vertices on its circle: 3 to 5, at least 0.3 apart so
+#: that no edge is too short to matter.
+ANGLES = st.lists(st.floats(0.0, 2.0 * math.pi), min_size=3, max_size=5).filter(
+    lambda angles: np.diff(sorted([*angles, min(angles) + 2.0 * math.pi])).min() > 0.3
+)
+UNIT = st.floats(0.05, 1.0)
+
+
+def on_circle(angles: list[float], centre: complex, radius: float) -> ComplexArray:
+    """A convex CCW polygon with its vertices on a circle."""
+    return np.ascontiguousarray(centre + radius * np.exp(1j * np.sort(np.array(angles))))
+
+
+def shapely_polygon(vertices: ComplexArray) -> shapely.Polygon:
+    return shapely.Polygon(np.stack([vertices.real, vertices.imag], axis=-1))
+
+
+@st.composite
+def regions(draw: st.DrawFn) -> tuple[ComplexArray, ComplexArray, ComplexArray]:
+    """A target region A and disjoint regions of L1 and L2 (radius < 1, centres 3 apart
+    at a random angle), as a movement's FR regions are."""
+    target = on_circle(draw(ANGLES), complex(draw(UNIT), draw(UNIT)) * 2.0, draw(UNIT))
+    turn = np.exp(1j * draw(st.floats(-math.pi, math.pi)))
+    a1 = on_circle(draw(ANGLES), -1.5 * turn, 0.9 * draw(UNIT))
+    a2 = on_circle(draw(ANGLES), 1.5 * turn, 0.9 * draw(UNIT))
+    return target, a1, a2
+
+
+def inside_point(polygon: ComplexArray, weights: list[float]) -> complex:
+    """A convex combination of the polygon's vertices (weights cycled to its size)."""
+    w = np.resize(np.array(weights), polygon.size)
+    return complex((w * polygon).sum() / w.sum())
+
+
+WEIGHTS = st.lists(st.floats(0.01, 1.0), min_size=5, max_size=5)
+
+
+@settings(max_examples=60, deadline=None)
+@given(regions(), WEIGHTS, WEIGHTS, WEIGHTS)
+def test_every_image_of_a_hypothesis_pair_is_a_member(
+    polygons: tuple[ComplexArray, ComplexArray, ComplexArray],
+    p_weights: list[float],
+    h1_weights: list[float],
+    h2_weights: list[float],
+) -> None:
+    target, a1, a2 = polygons
+    p, h1, h2 = (
+        inside_point(target, p_weights),
+        inside_point(a1, h1_weights),
+        inside_point(a2, h2_weights),
+    )
+    assert tightness.exact_member(np.array([(p - h1) / (h2 - h1)]), target, a1, a2)[0]
+
+
+@settings(max_examples=60, deadline=None)
+@given(regions(), st.floats(-3.0, 3.0), st.floats(-3.0, 3.0))
+def test_the_axis_test_agrees_with_shapely_on_the_minkowski_sum(
+    polygons: tuple[ComplexArray, ComplexArray, ComplexArray], x: float, y: float
+) -> None:
+    target, a1, a2 = polygons
+    w = complex(x, y)
+    summed = shapely_polygon(tightness.minkowski_sum((1.0 - w) * a1, w * a2))
+    gap = shapely.distance(shapely_polygon(target), summed)
+    overlap = shapely.intersection(shapely_polygon(target), summed).area
+    assume(gap > 1e-9 or overlap > 1e-9)  # touching is a measure-zero tie
+    assert bool(tightness.exact_member(np.array([w]), target, a1, a2)[0]) == (gap == 0.0)
+
+
+@settings(max_examples=25, deadline=None)
+@given(regions(), st.floats(-3.0, 3.0), st.floats(-3.0, 3.0))
+def test_no_image_comes_nearer_a_non_member_than_its_gap_allows(
+    polygons: tuple[ComplexArray, ComplexArray, ComplexArray], x: float, y: float
+) -> None:
+    # (p - h1)/(h2 - h1) - w = (p - (1 - w) h1 - w h2)/(h2 - h1), so every image lies at
+    # least gap / max|h2 - h1| from w, gap the distance from A to (1 - w) A_L1 + w A_L2.
+    target, a1, a2 = polygons
+    w = complex(x, y)
+    assume(not tightness.exact_member(np.array([w]), target, a1, a2)[0])
+    summed = shapely_polygon(tightness.minkowski_sum((1.0 - w) * a1, w * a2))
+    gap = shapely.distance(shapely_polygon(target), summed)
+    rng = np.random.default_rng(0)
+
+    def samples(polygon: ComplexArray, count: int) -> ComplexArray:
+        weights = rng.exponential(size=(count, polygon.size))
+        inner = (weights @ polygon) / weights.sum(axis=1)
+        return np.concatenate([inner, tightness.boundary_points(polygon, 10)])
+
+    p, h1, h2 = samples(target, 40), samples(a1, 40), samples(a2, 40)
+    spans = h2[None, :] - h1[:, None]
+    images = (p[:, None, None] - h1[None, :, None]) / spans[None]
+    assert np.abs(images - w).min() >= gap / np.abs(spans).max() * (1.0 - 1e-9)
+
+
+def test_with_exact_l1_and_l2_the_exact_set_is_the_region_itself() -> None:
+    # L1 = 0 and L2 = 1 exactly make T the identity, so E = A: the grid's area must be
+    # A's within its error bound, and A must hold itself.
+    target = on_circle([0.1, 1.7, 3.0, 4.6], 0.4 + 0.8j, 0.3)
+    movement = tightness.Movement(
+        layout="test", epsilon=0.01, landmark=2, target_fr=target,
+        l1_fr=np.array([0j]), l2_fr=np.array([1 + 0j]), truth_fl=complex(target.mean()),
+        region=target,
+    )  # fmt: skip
+    reference = tightness.reference_hull(target, movement.l1_fr, movement.l2_fr)
+    found = tightness.measure(movement, reference, 200)
+    area = shapely_polygon(target).area
+    assert found.reference_area == pytest.approx(area, rel=1e-12)
+    assert abs(found.exact_area / area - 1.0) <= found.grid_error_bound
+    assert abs(found.exact_area / area - 1.0) < 0.01
+    assert found.contained and found.truth_in_e and found.box_growths == 0
+
+
+def draw_movements(count: int, seed: int) -> list[tightness.Movement]:
+    rng = np.random.default_rng(seed)
+    drawn: list[tightness.Movement] = []
+    while len(drawn) < count:
+        movement = tightness.draw_movement(rng)
+        if not isinstance(movement, str):
+            drawn.append(movement)
+    return drawn
+
+
+def test_todays_regions_hold_the_exact_set_and_are_no_smaller() -> None:
+    movements = draw_movements(20, seed=11)
+    assert {m.layout for m in movements} == set(tightness.LAYOUTS)
+    for movement in movements:
+        # A coarser reference and grid than the command's keep the test quick.
+        reference = tightness.reference_hull(
+            movement.target_fr, movement.l1_fr, movement.l2_fr, per_edge=30
+        )
+        found = tightness.measure(movement, reference, 80)
+        assert found.holds_grid and found.holds_reference, found
+        assert found.truth_in_e, found
+        assert found.region_area >= found.reference_area
+        assert found.ratio >= 1.0 - found.grid_error_bound, found
+
+
+def test_the_command_runs_end_to_end_and_writes_the_json(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "results" / "tightness.json"
+    argv = ["--movements", "8", "--resolution", "60", "--json", str(path), "--no-progress"]
+    tightness.main(argv)
+    out = capsys.readouterr().out
+    assert "region area / exact area: median" in out and f"wrote {path}" in out
+    written = json.loads(path.read_text())
+    measured = written["measured"]
+    assert measured["command"] == "bearing-env transfer-tightness " + " ".join(argv)
+    assert {"commit", "date", "machine"} <= set(measured)
+    figures = written["summary"]
+    assert figures["regions"] == len(written["regions"]) == 8
+    assert figures["contains_grid"] == figures["contains_reference"] == 1.0
+    assert figures["truth_in_exact_set"] == 1.0
+    assert figures["ratio_median"] >= 1.0 and figures["ratio_to_reference_median"] >= 1.0
+    assert len(written["resolution_checks"]) == 8
+
+
+def test_a_region_that_misses_the_exact_set_is_reported_and_exits_1(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    draw = tightness.draw_movement
+
+    def shrunk(rng: np.random.Generator) -> tightness.Movement | str:
+        movement = draw(rng)
+        if isinstance(movement, str):
+            return movement
+        centre = movement.region.mean()
+        return replace(movement, region=centre + 0.5 * (movement.region - centre))
+
+    monkeypatch.setattr(tightness, "draw_movement", shrunk)
+    with pytest.raises(SystemExit) as stopped:
+        tightness.main(["--movements", "2", "--resolution", "40", "--no-progress"])
+    assert stopped.value.code == 1
+    out = capsys.readouterr().out
+    assert "every grid point of E: 0.0%" in out and "not contained:" in out
