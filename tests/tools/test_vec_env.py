@@ -405,7 +405,8 @@ def test_auto_is_batched_only_with_a_vector_entry_point(
 def run_cli(output: Path, timesteps: int, *extra: str) -> dict[str, Any]:
     train_cli.main(
         [
-            "--algo", "ppo", "--output", str(output), "--n-envs", "2", "--seed", "4",
+            "--algo", "ppo", "--env", "BearingSLAM-v0", "--output", str(output),
+            "--n-envs", "2", "--seed", "4",
             "--timesteps", str(timesteps), "--hyperparams", *TINY_PPO,
             "--eval-freq", "32", "--eval-episodes", "1", "--checkpoint-freq", "32",
             "--no-progress", "--no-tensorboard", *extra,
