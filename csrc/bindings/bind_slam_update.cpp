@@ -542,6 +542,7 @@ void bind_slam_update(nb::module_& m) {
     m.attr("MAX_FR_EXTENT") = slam::MAX_FR_EXTENT;
     m.attr("RELATIVE_TOLERANCE") = slam::RELATIVE_TOLERANCE;
     m.attr("MAX_WINDOW") = slam::MAX_WINDOW;
+    m.attr("PARALLEL_MIN_MAPS") = slam::PARALLEL_MIN_MAPS;
     m.attr("MAX_LANDMARKS") = slam::MAX_LANDMARKS;
     m.attr("ROBUST_LEVELS") = slam::ROBUST_LEVELS;
     m.attr("HISTORY") = slam::HISTORY;

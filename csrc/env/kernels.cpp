@@ -82,7 +82,7 @@ void update_moving_maps(View2<double> start, View2<double> end, View1<const int6
                            {size, buffers.out.landmark_status.shape[1]}};
     out.n_bad = {buffers.out.n_bad.data, {size}};
     const int64_t blocks =
-        threads > 1 && size >= PARALLEL_MIN_MAPS ? std::min(size, threads) : int64_t{1};
+        threads > 1 && size >= slam::PARALLEL_MIN_MAPS ? std::min(size, threads) : int64_t{1};
     slam::update_maps(moving_start, moving_end, moving_rows, inputs.params, inputs.maps, out,
                       blocks);
     for (int64_t k = 0; k < size; ++k) {

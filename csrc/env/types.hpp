@@ -22,9 +22,6 @@ inline constexpr int64_t BEARING_FEATURES = 3;
 inline constexpr int64_t SHAPE_FEATURES = 3;
 inline constexpr double ELONGATION_LIMIT = 10.0;
 
-// Maps from which the step updates its maps on `threads` threads (bearing_env/slam/batch.py).
-inline constexpr int64_t PARALLEL_MIN_MAPS = 32;
-
 // Outcomes of step_rows (kernels.STEP_*).
 enum StepStatus : int64_t { STEP_DONE = 0, STEP_NEEDS_NOISE = 1, STEP_NEEDS_TRAJECTORY = 2 };
 // Outcomes of decode_continuous (kernels.ACTIONS_*).
