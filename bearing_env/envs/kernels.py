@@ -2,12 +2,12 @@
 rewards, terminations, observations and infos in one call of the C++ core
 (``csrc/env/``, bound in :mod:`bearing_env._core`).
 
-:func:`~bearing_env._core.step_rows` is the whole step; ``report_rows`` the observations
-and infos alone (after a reset). :mod:`bearing_env.envs.core` calls them for the single
-env (a group of one row) and the vector env alike, so both compute every number with the
-same code. The noise of the readings is drawn ahead, in blocks, by each row's own
-generator (``core.fill_noise``) into the rows' noise buffers, which the step reads by
-index.
+:func:`~bearing_env._core.step_rows` is the whole step; ``report_rows_into`` the
+observations and infos alone (after a reset), into the same reused arrays.
+:mod:`bearing_env.envs.core` calls them for the single env (a group of one row) and the
+vector env alike, so both compute every number with the same code. The noise of the
+readings is drawn ahead, in blocks, by each row's own generator (``core.fill_noise``)
+into the rows' noise buffers, which the step reads by index.
 
 A group's long-lived inputs (its :class:`Settings`, its maps' update settings, its map
 batch's state and the envs' ``BatchState``) are checked once into a native

@@ -434,25 +434,6 @@ void bind_env(nb::module_& m) {
         "size"_a, "inputs"_a,
         "A report's 16 arrays (kernels.Report's order) of size rows for the group of inputs.");
     m.def(
-        "report_rows",
-        [](nb::handle rows, const EnvInputs& inputs, int64_t map_slots) {
-            auto r = rows_of(rows, inputs.num_rows, nullptr);
-            const env::Settings& settings = inputs.inputs.settings;
-            nb::tuple report = new_report_arrays(r.shape[0], settings.n - 2,
-                                                 env::observation_size(settings));
-            Kept kept;
-            const env::Report views = report_of(report, inputs.inputs, r.shape[0], kept);
-            {
-                nb::gil_scoped_release release;
-                env::observe(r, inputs.inputs, views);
-            }
-            nb::tuple encoded =
-                encode_map_new(inputs.inputs.maps, r, std::max(map_slots, settings.n - 2));
-            return std::make_pair(report, encoded);
-        },
-        "rows"_a, "inputs"_a, "map_slots"_a,
-        "(report's 16 arrays, encode_map's 12 arrays) of rows as they stand.");
-    m.def(
         "report_rows_into",
         [](nb::handle rows, EnvInputs& inputs, StepOutputs& outputs, bool with_map) {
             if (outputs.inputs != &inputs) {

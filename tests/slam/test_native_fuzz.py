@@ -95,7 +95,7 @@ FUZZED: frozenset[str] = frozenset(
         "free_length", "_cross", "segments_cross", "_on_segment", "line_of_sight",
         "visible", "inside_polygon", "_segment_distance", "clearance", "visible_rows",
         # bind_env.cpp
-        "EnvInputs", "StepOutputs", "step_rows", "new_report", "report_rows",
+        "EnvInputs", "StepOutputs", "step_rows", "new_report",
         "report_rows_into", "potentials", "move_and_read", "append_positions", "capped",
         "potential_of", "_write_shape", "decode_continuous", "_known", "encode_map",
         "encode_map_into", "encode_window", "encode_levels", "_potentials_of_rows",
@@ -1270,15 +1270,6 @@ def test_reports_and_potentials_of_any_state(name: str, data: st.DataObject) -> 
     report = result(_core.new_report, size, inputs)
     if report is not None:
         check_report(report, size, inputs)
-    map_slots = data.draw(st.integers(-2, 8))
-    both = result(_core.report_rows, rows, inputs, map_slots)
-    if both is not None:
-        observed, encoded = both
-        check_report(observed, rows.size, inputs)
-        slots = max(map_slots, inputs.n - 2)
-        assert encoded[0].shape == (rows.size, slots, kernels.CAPACITY)
-        if clean:
-            assert finite(observed[0])
     out = np.zeros(out_length(data.draw, rows.size))
     if completes(_core.potentials, rows, inputs, out) and clean:
         assert not np.any(np.isnan(out))
