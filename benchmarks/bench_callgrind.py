@@ -34,8 +34,10 @@ from typing import Any
 
 from bearing_env.train.common.cli_parser import add_json_output, command_parser, doc_summary
 from bearing_env.train.common.cli_values import at_least
+from bearing_env.train.common.doc_tables import markdown_table
 from bearing_env.train.common.errors import exit_on_output_errors
 from bearing_env.train.common.files import atomic_write_text
+from bearing_env.train.common.provenance import measured_here, measured_sentence
 
 #: The native entry point each measurement collects inside.
 ENTRY_POINTS = {"update": "bearing::slam::update_maps*", "step": "bearing::env::step_rows*"}
@@ -147,7 +149,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--steps", type=at_least(1), default=400,
                         help="env steps counted (default %(default)s)")  # fmt: skip
     add_json_output(parser, "the counts")
-    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    arguments = sys.argv[1:] if argv is None else list(argv)
+    args = parser.parse_args(arguments)
     results: dict[str, Any] = {}
     for transfer in ("conservative", "paper"):
         counted = count(UPDATE_DRIVER, ENTRY_POINTS["update"], [str(args.movements), transfer])
@@ -160,8 +163,33 @@ def main(argv: Sequence[str] | None = None) -> None:
     results["step_khepera"] = {**counted, "count": args.steps, "per_call": per}
     print(f"BearingSLAM-Khepera-v0 env step (native part):   {per:12,.0f} instructions per step")
     if args.json is not None:
+        record = {"measured": measured_here("bearing-env bench-callgrind", arguments),
+                  "counts": results}  # fmt: skip
         with exit_on_output_errors(parser, args.json, "--json", refusals=()):
-            atomic_write_text(args.json, json.dumps(results, indent=2))
+            atomic_write_text(args.json, json.dumps(record, indent=2))
+
+
+#: The functions of a Khepera env step the performance page lists (the core's main parts).
+PAGE_FUNCTIONS = 6
+
+
+def markdown_callgrind(record: dict[str, Any]) -> str:
+    """The performance page's instruction counts (``bearing-env docs-tables``), from
+    :func:`main`'s ``--json`` file: per movement and per step, then where a Khepera env
+    step's instructions go."""
+    counts = record["counts"]
+    step = counts["step_khepera"]
+    sentence = (
+        f"{measured_sentence(record['measured'], 'benchmarks/results/bench_callgrind.json')} "
+        f"Instructions per 4-landmark movement: {counts['update_conservative_4']['per_call']:,.0f}"
+        f" conservative, {counts['update_paper_4']['per_call']:,.0f} paper; per Khepera env "
+        f"step (native part, {step['count']} steps): {step['per_call']:,.0f}, of which:"
+    )
+    names = [(entry["function"].rpartition("::")[2], entry) for entry in step["functions"][1:]]
+    # The update's per-row loop (update_rows, update_row) holds what update_maps holds.
+    parts = [(name, entry) for name, entry in names if not name.startswith("update_row")]
+    rows = [(f"`{name}`", f"{entry['share']:.0%}") for name, entry in parts[:PAGE_FUNCTIONS]]
+    return sentence + "\n\n" + markdown_table(("function (inclusive)", "share of a step"), rows)
 
 
 if __name__ == "__main__":

@@ -45,7 +45,11 @@ def test_the_listed_functions_are_the_cores_and_libms_by_short_name() -> None:
 def test_the_command_counts_the_update_and_the_step(tmp_path: Path) -> None:
     out = tmp_path / "callgrind.json"
     bench_callgrind.main(["--movements", "20", "--steps", "20", "--json", str(out)])
-    results = json.loads(out.read_text())
+    record = json.loads(out.read_text())
+    assert record["measured"]["command"] == (
+        "bearing-env bench-callgrind --movements 20 --steps 20 --json " + str(out)
+    )
+    results = record["counts"]
     assert set(results) == {"update_conservative_4", "update_paper_4", "step_khepera"}
     for counted in results.values():
         assert counted["per_call"] == counted["instructions"] / counted["count"] > 1000
@@ -54,3 +58,24 @@ def test_the_command_counts_the_update_and_the_step(tmp_path: Path) -> None:
     # The conservative transfer costs more than the paper's, per movement.
     assert results["update_conservative_4"]["per_call"] > results["update_paper_4"]["per_call"]
     assert results["step_khepera"]["functions"][0]["function"] == "bearing::env::step_rows"
+
+
+def test_the_page_table_lists_the_steps_functions_below_the_step_itself() -> None:
+    step = {"count": 400, "per_call": 140_335.0, "functions": [
+        {"function": "bearing::env::step_rows", "share": 1.0},
+        {"function": "bearing::slam::{anonymous}::update_rows", "share": 0.95},
+        *({"function": f"bearing::slam::part{k}", "share": 0.9 - 0.1 * k} for k in range(8)),
+    ]}  # fmt: skip
+    record = {
+        "measured": {"command": "bearing-env bench-callgrind", "commit": "abc1234def",
+                     "date": "2026-12-03", "machine": "2-core x86_64 machine"},
+        "counts": {"update_conservative_4": {"per_call": 61_168.3},
+                   "update_paper_4": {"per_call": 26_694.4}, "step_khepera": step},
+    }  # fmt: skip
+    text = bench_callgrind.markdown_callgrind(record)
+    assert (
+        "61,168 conservative, 26,694 paper" in text and "(native part, 400 steps): 140,335" in text
+    )
+    rows = [line for line in text.splitlines() if line.startswith("| `")]
+    assert rows[0] == "| `part0` | 90% |" and len(rows) == bench_callgrind.PAGE_FUNCTIONS
+    assert "step_rows" not in "".join(rows) and "update_rows" not in "".join(rows)

@@ -187,7 +187,6 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     'bearing-env bench --help': ('help', ()),
     "bearing-env bench-callgrind --json benchmarks/results/bench_callgrind.json": ("help", ()),
     'bearing-env bench --json benchmarks/results/bench_env.json': ('parse', ()),
-    'bearing-env bench --sections single,vector': ('parse', ()),
     'bearing-env compare --policies greedy oracle lookahead lookahead_oracle': ('parse', ()),
     'bearing-env docs-tables': ('parse', ()),
     'bearing-env generalisation': ('help', ()),

@@ -273,6 +273,10 @@ def _blocks() -> dict[str, Block]:
         "bench-env": Block(bench, f"{report}:markdown_env_table"),
         "bench-startup": Block(bench, f"{report}:markdown_startup"),
         "bench-throughput": Block(bench, f"{report}:markdown_throughput"),
+        "bench-callgrind": Block(
+            "benchmarks/results/bench_callgrind.json",
+            "bearing_env.benchmarks.bench_callgrind:markdown_callgrind",
+        ),
         "khepera-medians": Block(khepera, task_cards.markdown_medians),
         "fig11-fits": Block("docs/figures/figures.json", figures.markdown_fig11),
         "robust-figure": Block("docs/figures/figures.json", figures.markdown_robust),
