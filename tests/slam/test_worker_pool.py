@@ -108,3 +108,18 @@ def test_the_thread_count_comes_from_the_variable_or_the_cpus(
         monkeypatch.setenv(kernels.THREADS_VARIABLE, bad)
         with pytest.raises(ValueError, match=f"{kernels.THREADS_VARIABLE}.*{bad!r}"):
             kernels.threads()
+
+
+def test_an_error_in_a_workers_block_reaches_the_caller_and_the_workers_go_on() -> None:
+    batch = BatchedPolygonSLAM(MAPS, LANDMARKS, EPS)
+    batch.counts[MAPS - 1, 0] = 10**6  # a corrupt map in the last block, a worker's
+    b1, b2 = readings(4)[0]
+    out = kernels.Outputs(
+        np.empty(MAPS, dtype=np.int8),
+        np.empty((MAPS, LANDMARKS - 2), dtype=np.int8),
+        np.empty(MAPS, dtype=np.int64),
+    )
+    arguments = (b1, b2, np.arange(MAPS), batch._kernel_params(True), batch._kernel_state(), out)
+    with pytest.raises(ValueError, match=f"map {MAPS - 1} has a corrupt state"):
+        kernels.update_maps(*arguments, 2)
+    assert_same_maps(run(5, threads=2), run(5, threads=1))  # the workers still answer
