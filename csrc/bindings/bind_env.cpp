@@ -281,6 +281,25 @@ struct InUse {
     InUse& operator=(const InUse&) = delete;
 };
 
+// The rows of a call that writes into outputs (step_rows, report_rows_into), checked:
+// outputs made for these inputs, with the encoded arrays when with_map, and room for the
+// rows. The caller holds the outputs (InUse) first: the rows' check uses their buffer.
+View1<const int64_t> rows_for_outputs(nb::handle rows, const EnvInputs& inputs,
+                                      StepOutputs& outputs, bool with_map) {
+    if (outputs.inputs != &inputs) {
+        value_error("outputs were made for other inputs (StepOutputs(inputs, ...))");
+    }
+    if (with_map && !outputs.with_map) {
+        value_error("with_map needs outputs made with the encoded arrays");
+    }
+    auto r = rows_of(rows, inputs.num_rows, &outputs.seen);
+    if (r.shape[0] > outputs.capacity) {
+        value_error("rows has " + std::to_string(r.shape[0]) + " rows, outputs hold " +
+                    std::to_string(outputs.capacity));
+    }
+    return r;
+}
+
 // ---------------------------------------------------------------------------------------
 // New arrays (the calls that hand out new arrays, as the numba kernels did)
 // ---------------------------------------------------------------------------------------
@@ -386,19 +405,9 @@ void bind_env(nb::module_& m) {
         "step_rows",
         [](nb::handle rows, nb::handle turns, nb::handle lengths, EnvInputs& inputs,
            nb::handle trajectory, int64_t threads, StepOutputs& outputs, bool with_map) {
-            if (outputs.inputs != &inputs) {
-                value_error("outputs were made for other inputs (StepOutputs(inputs, ...))");
-            }
-            if (with_map && !outputs.with_map) {
-                value_error("with_map needs outputs made with the encoded arrays");
-            }
             InUse in_use(outputs.busy);
-            auto r = rows_of(rows, inputs.num_rows, &outputs.seen);
+            auto r = rows_for_outputs(rows, inputs, outputs, with_map);
             const int64_t size = r.shape[0];
-            if (size > outputs.capacity) {
-                value_error("rows has " + std::to_string(size) + " rows, outputs hold " +
-                            std::to_string(outputs.capacity));
-            }
             auto t = view_of<const double, 1>(turns, "turns", {size});
             auto l = view_of<const double, 1>(lengths, "lengths", {size});
             if (t.shape[0] != size || l.shape[0] != size) {
@@ -436,19 +445,9 @@ void bind_env(nb::module_& m) {
     m.def(
         "report_rows_into",
         [](nb::handle rows, EnvInputs& inputs, StepOutputs& outputs, bool with_map) {
-            if (outputs.inputs != &inputs) {
-                value_error("outputs were made for other inputs (StepOutputs(inputs, ...))");
-            }
-            if (with_map && !outputs.with_map) {
-                value_error("with_map needs outputs made with the encoded arrays");
-            }
             InUse in_use(outputs.busy);
-            auto r = rows_of(rows, inputs.num_rows, &outputs.seen);
+            auto r = rows_for_outputs(rows, inputs, outputs, with_map);
             const int64_t size = r.shape[0];
-            if (size > outputs.capacity) {
-                value_error("rows has " + std::to_string(size) + " rows, outputs hold " +
-                            std::to_string(outputs.capacity));
-            }
             nb::gil_scoped_release release;
             const env::Report views = outputs.report.first(size);
             env::clear_report(views);
