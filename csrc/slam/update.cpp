@@ -1,15 +1,13 @@
 // bearing_env/slam/kernels/update.py in C++: one movement per map for a batch of maps,
-// serial or on kept worker threads over contiguous blocks of rows (same branches, same order of
-// operations as the numba kernels, so the same bits).
+// serial or on kept worker threads over contiguous blocks of rows (same branches, same
+// order of operations as the numba kernels, so the same bits).
 #include "slam/update.hpp"
 
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 #include "core/errors.hpp"
 #include "core/pymath.hpp"
