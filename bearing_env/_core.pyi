@@ -42,6 +42,7 @@ LANDMARK_SKIPPED: int
 LANDMARK_MISSING: int
 TRANSFER_CONSERVATIVE: int
 TRANSFER_PAPER: int
+TRANSFER_CONSERVATIVE_GLOBAL: int
 INCONSISTENCY_RESTART: int
 INCONSISTENCY_KEEP: int
 FUSION_INTERSECT: int
@@ -217,6 +218,21 @@ def transfer_region(
     hull: NDArray[np.complex128],
     out: NDArray[np.complex128],
 ) -> int: ...
+def transfer_polygon(
+    target: NDArray[np.complex128],
+    a1: NDArray[np.complex128],
+    a2: NDArray[np.complex128],
+    transfer: int,
+    edge_samples: int,
+    out: NDArray[np.complex128],
+) -> tuple[int, int]: ...
+def sub_square_growths(
+    target: NDArray[np.complex128],
+    a1: NDArray[np.complex128],
+    a2: NDArray[np.complex128],
+    per_edge: int,
+    out: NDArray[np.float64],
+) -> tuple[int, int]: ...
 
 # ---- The simulator (csrc/bindings/bind_sim.cpp; keep in step with it) ----
 # Same signatures and return conventions as the numba kernels of bearing_env.world and

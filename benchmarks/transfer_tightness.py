@@ -42,6 +42,7 @@ from numpy.typing import NDArray
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.audit import SearchSettings, contains
 from bearing_env.slam.batch import CONTAINMENT_TOLERANCE
+from bearing_env.slam.transfer import TRANSFERS
 from bearing_env.slam.geometry import FR_BOUNDED, cone_region
 from bearing_env.train.common.cli_parser import (
     add_json_output,
@@ -180,7 +181,15 @@ class Movement:
     region: ComplexArray
 
 
-def draw_movement(rng: np.random.Generator) -> Movement | str:
+@dataclass(frozen=True)
+class Mapping:
+    """How the measured map transfers its regions (:class:`PolygonSLAM`'s arguments)."""
+
+    transfer: str = "conservative"
+    edge_samples: int = 3
+
+
+def draw_movement(rng: np.random.Generator, mapping: Mapping | None = None) -> Movement | str:
     """A fresh map's first movement, drawn from ``rng`` with the world's own generators;
     one of the landmarks it updated, drawn uniformly. When it gives no region, why not:
     ``"no_move"`` (the robot faced a wall), the map's frame status (``"l1_l2_too_close"``,
@@ -201,7 +210,10 @@ def draw_movement(rng: np.random.Generator) -> Movement | str:
     if moved.travelled < arena.min_baseline:
         return "no_move"
     bearings_end = world.read_bearings(rng)
-    slam = PolygonSLAM(len(landmarks), epsilon)
+    mapping = mapping or Mapping()
+    slam = PolygonSLAM(
+        len(landmarks), epsilon, transfer=mapping.transfer, edge_samples=mapping.edge_samples
+    )
     result = slam.update(bearings_start, bearings_end)
     updated = np.flatnonzero(result.landmark_status == "updated")
     if not result.frame_changed:
@@ -371,8 +383,15 @@ class TightnessRun:
     seconds: float
 
 
-def run(movements: int, seed: int, resolution: int, progress: bool = False) -> TightnessRun:
-    """Measure ``movements`` single-movement regions drawn from ``seed``."""
+def run(
+    movements: int,
+    seed: int,
+    resolution: int,
+    progress: bool = False,
+    mapping: Mapping | None = None,
+) -> TightnessRun:
+    """Measure ``movements`` single-movement regions drawn from ``seed``, transferred
+    with ``mapping`` (the map's defaults if None)."""
     rng = np.random.default_rng(seed)
     measurements: list[Measurement] = []
     checks: list[float] = []
@@ -382,7 +401,7 @@ def run(movements: int, seed: int, resolution: int, progress: bool = False) -> T
     with progress_bar(movements, desc="regions", unit="region", enabled=progress) as bar:
         while len(measurements) < movements:
             drawn += 1
-            movement = draw_movement(rng)
+            movement = draw_movement(rng, mapping)
             if isinstance(movement, str):
                 no_region[movement] = no_region.get(movement, 0) + 1
                 continue
@@ -455,6 +474,14 @@ def make_parser() -> argparse.ArgumentParser:
         help="grid points per side of E's box (default %(default)s)",
     )
     parser.add_argument("--seed", type=SEED, default=0, help="movement seed (default %(default)s)")
+    parser.add_argument(
+        "--transfer", choices=TRANSFERS, default="conservative",
+        help="the map's transfer (default %(default)s)",
+    )
+    parser.add_argument(
+        "--edge-samples", type=at_least(1), default=3,
+        help="the map's samples per edge (default %(default)s)",
+    )
     add_json_output(parser, "the figures and every region's measurement")
     add_no_progress(parser)
     return parser
@@ -467,7 +494,10 @@ def main(argv: Sequence[str] | None = None) -> None:
     if args.json:  # an unwritable --json fails before the measurement, in one line
         with exit_on_output_errors(parser, Path(args.json), "--json", refusals=()):
             Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-    result = run(args.movements, args.seed, args.resolution, progress=not args.no_progress)
+    mapping = Mapping(args.transfer, args.edge_samples)
+    result = run(
+        args.movements, args.seed, args.resolution, progress=not args.no_progress, mapping=mapping
+    )
     figures = summary(result)
     print("\n".join(format_summary(figures, args.resolution)))
     misses = [asdict(m) for m in result.measurements if not m.contained]
@@ -480,6 +510,8 @@ def main(argv: Sequence[str] | None = None) -> None:
                 "movements": args.movements,
                 "seed": args.seed,
                 "resolution": args.resolution,
+                "transfer": mapping.transfer,
+                "edge_samples": mapping.edge_samples,
                 "reference_samples_per_edge": REFERENCE_SAMPLES,
                 "containment_tolerance": CONTAINMENT_TOLERANCE,
                 "layouts": list(LAYOUTS),

@@ -5,14 +5,16 @@ This corpus keeps that reference after the numba kernels are gone: each case run
 of maps through seeded movement sequences with :class:`BatchedPolygonSLAM` (the public
 API) and hashes every state array and every update result, as float64 bits (NaN
 canonicalised: its payload carries no information), after every movement.
-``tests/golden/slam_updates.json`` holds the hashes the numba kernels gave;
-``tests/slam/test_golden_slam.py`` compares.
+``tests/golden/slam_updates.json`` holds the hashes the numba kernels gave for the
+``"paper"`` and ``"conservative_global"`` transfers (the latter recorded as
+``"conservative"``, its name then), and the hashes of the local-bound ``"conservative"``
+transfer from its first version; ``tests/slam/test_golden_slam.py`` compares.
 
     python -m tests.golden_slam              # print the hashes, and any changes
     python -m tests.golden_slam --update     # record them (only for a deliberate change)
     python -m tests.golden_slam --large      # the large corpus (slow test), same options
 
-The cases cover both transfers (several edge samples), the three fusions (the robust one
+The cases cover the three transfers (several edge samples), the three fusions (the robust one
 with and without the bound estimate, guaranteed and likely sets), both inconsistency
 policies, 3 to 30 landmarks, epsilon from 0.5 to 10 degrees, noise beyond epsilon,
 outlying and missed readings, and moves that barely change frames.
@@ -71,7 +73,13 @@ class Case:
 
 def _cases(large: bool) -> list[Case]:
     cases: list[Case] = []
-    transfers = (("conservative", 3), ("conservative", 2), ("paper", 3))
+    transfers = (
+        ("conservative_global", 3),
+        ("conservative_global", 2),
+        ("paper", 3),
+        ("conservative", 3),
+        ("conservative", 2),
+    )
     fusions = (
         ("intersect", {}),
         ("relaxed", {}),

@@ -37,6 +37,7 @@ NOISE_BOUNDS = ("estimate", "nominal")
 if (
     TRANSFERS.index("conservative") != kernels.TRANSFER_CONSERVATIVE
     or TRANSFERS.index("paper") != kernels.TRANSFER_PAPER
+    or TRANSFERS.index("conservative_global") != kernels.TRANSFER_CONSERVATIVE_GLOBAL
     or INCONSISTENCY_POLICIES.index("restart") != kernels.INCONSISTENCY_RESTART
     or INCONSISTENCY_POLICIES.index("keep") != kernels.INCONSISTENCY_KEEP
     or FUSIONS.index("intersect") != kernels.FUSION_INTERSECT

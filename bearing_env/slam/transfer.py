@@ -4,7 +4,7 @@ For hypotheses ``h1`` in ``A_L1`` and ``h2`` in ``A_L2`` (regions in FR), the si
 ``T(h1, h2)(z) = (z - h1) / (h2 - h1)`` maps FR to FL. A point or region ``A`` of FR
 becomes the union of ``T(h1, h2)(A)`` over all hypotheses.
 
-Two transfers are offered:
+Three transfers are offered:
 
 ``"paper"``
     The paper's approximation: the convex hull of the images of the vertices of ``A``
@@ -12,7 +12,7 @@ Two transfers are offered:
     on random layouts), because the image of an edge of ``A_L1`` or ``A_L2`` is a circular
     arc that bulges beyond the vertex images.
 
-``"conservative"``
+``"conservative"`` (the default)
     Provably contains the union. Three facts make it exact up to a bound:
 
     1. ``T`` is affine in ``z`` for fixed hypotheses, so the vertices of ``A`` suffice.
@@ -20,22 +20,32 @@ Two transfers are offered:
        its pole outside ``A_L1``, hence harmonic: its maximum over ``A_L1`` lies on the
        boundary. The same holds in ``h2``. So the hull of the union is the hull of the
        images of ``boundary(A_L1) x boundary(A_L2)``.
-    3. Each boundary edge is cut into pieces of length ``delta``. Moving one hypothesis
-       along a piece traces a circular arc (a Moebius image of a segment) whose distance
-       to its chord is its sagitta ``(c / 2) tan(alpha / 2)``, with chord
-       ``c <= V delta / D**2`` and ``tan(alpha / 2) <= delta / (2 D)``, where ``D`` is the
-       distance between ``A_L1`` and ``A_L2`` and ``V`` the largest distance from ``z`` to
-       the other region. Applying this once per hypothesis, every image lies within
-       ``r = (V2 delta1**2 + V1 delta2**2) / (4 D**3)`` of the hull of the sampled images.
+    3. Each boundary is cut into pieces between samples (``edge_samples`` per edge). For
+       one piece of each boundary (a sub-square), every image lies within a local bound
+       ``sigma`` of the hull of the four corner images. ``sigma`` is a sagitta argument
+       applied twice: moving one hypothesis along its piece traces a circular arc, whose
+       distance to its chord is computed exactly at the sample points, then the other
+       hypothesis moves, bounded with the piece-to-piece distances; the better of the two
+       orders is kept. The proof, its conditions and its floating-point margin are in
+       ``docs/world_model.md`` ("The local bound").
 
-    The sagitta bound needs ``delta <= 2 D`` (arcs under a half circle). Edges are cut
-    finely enough for that, up to :data:`MAX_EDGE_SAMPLES` pieces; a movement whose L1
-    and L2 regions are closer still, relative to their size, is refused
-    (``"l1_l2_too_close"``): its frame change is too uncertain to be useful. The region
-    is the sampled hull grown by ``r``, which shrinks with the square of the number of
-    samples per edge. The growth is a true outward offset: every edge of the hull moves
-    out by ``r`` (:func:`~bearing_env.slam.kernels.offset_outward`), so the region
-    contains every point within ``r`` of the hull.
+    The region is the sampled hull grown by the largest ``sigma`` over the sub-squares
+    and the vertices of ``A`` (never more than the global radius below). The growth is a
+    true outward offset: every edge of the hull moves out by it
+    (:func:`~bearing_env.slam.kernels.offset_outward`).
+
+``"conservative_global"``
+    The same hull grown by one global radius per movement,
+    ``r = (V2 delta1**2 + V1 delta2**2) / (4 D**3)``, with ``D`` the distance between
+    ``A_L1`` and ``A_L2`` and ``V`` the largest distance from ``A`` to the other region:
+    the bound of bearing_env 0.1, which the ``-v0`` task ids keep so that their published
+    figures reproduce. It is larger than the local bound wherever the L1 and L2 regions
+    come close somewhere, as ``D`` is their smallest distance.
+
+Both conservative bounds need pieces under a half circle (``delta <= 2 D``). Edges are cut
+finely enough for that, up to :data:`MAX_EDGE_SAMPLES` pieces; a movement whose L1 and L2
+regions are closer still, relative to their size, is refused (``"l1_l2_too_close"``): its
+frame change is too uncertain to be useful.
 
 The kernels are in :mod:`bearing_env.slam.kernels`; :func:`transfer_vertices` runs one
 movement's transfer for inspection and tests.
@@ -49,7 +59,8 @@ from numpy.typing import ArrayLike, NDArray
 from bearing_env.slam import kernels
 from bearing_env.slam.kernels import MAX_EDGE_SAMPLES
 
-TRANSFERS = ("conservative", "paper")
+#: The transfers, in the order of the kernels' codes (``TRANSFER_CONSERVATIVE`` = 0, ...).
+TRANSFERS = ("conservative", "paper", "conservative_global")
 
 __all__ = ["MAX_EDGE_SAMPLES", "TRANSFERS", "transfer_vertices"]
 
@@ -66,7 +77,7 @@ def transfer_vertices(
     Args:
         target_fr: complex vertices of a convex FR region (CCW), or a single point.
         a1, a2: complex vertices (CCW) of the FR regions of L1 and L2 (1 to 4 each).
-        transfer: ``"paper"`` or ``"conservative"``.
+        transfer: ``"conservative"``, ``"conservative_global"`` or ``"paper"``.
         edge_samples: samples per edge for the conservative transfer (1..8).
 
     Returns:
@@ -77,37 +88,20 @@ def transfer_vertices(
         raise ValueError(f"transfer must be one of {TRANSFERS}, got {transfer!r}")
     if not 1 <= edge_samples <= MAX_EDGE_SAMPLES:
         raise ValueError(f"edge_samples must be in 1..{MAX_EDGE_SAMPLES}, got {edge_samples!r}")
-    target = np.atleast_1d(np.asarray(target_fr, dtype=np.complex128))
-    p1 = _small_polygon(a1, "a1")
-    p2 = _small_polygon(a2, "a2")
-    conservative = transfer == "conservative"
-    status, per_edge, distance, delta1, delta2 = kernels.frame_plan(
-        p1, p1.size, p2, p2.size, conservative, int(edge_samples)
+    target = np.ascontiguousarray(np.atleast_1d(np.asarray(target_fr, dtype=np.complex128)))
+    out = np.empty(kernels.SCRATCH, dtype=np.complex128)
+    status, n = kernels.transfer_polygon(
+        target.ravel(),
+        _small_polygon(a1, "a1"),
+        _small_polygon(a2, "a2"),
+        TRANSFERS.index(transfer),
+        int(edge_samples),
+        out,
     )
     if status == kernels.FRAME_L1_L2_OVERLAP:
         return "l1_l2_overlap"
     if status == kernels.FRAME_L1_L2_TOO_CLOSE:
         return "l1_l2_too_close"
-    h1 = np.empty(kernels.MAX_PAIRS, dtype=np.complex128)
-    inv_d = np.empty(kernels.MAX_PAIRS, dtype=np.complex128)
-    n_pairs = kernels.sample_hypotheses(p1, p1.size, p2, p2.size, per_edge, h1, inv_d)
-    cloud = np.empty(target.size * n_pairs, dtype=np.complex128)
-    hull = np.empty(cloud.size + 1, dtype=np.complex128)
-    out = np.empty(max(cloud.size + 1, kernels.SCRATCH), dtype=np.complex128)
-    frame = kernels.FrameChange(
-        p1,
-        int(p1.size),
-        p2,
-        int(p2.size),
-        h1,
-        inv_d,
-        int(n_pairs),
-        conservative,
-        float(distance),
-        float(delta1),
-        float(delta2),
-    )
-    n = kernels.transfer_region(target, target.size, frame, cloud, hull, out)
     return out[:n].copy()
 
 

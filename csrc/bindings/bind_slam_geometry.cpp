@@ -11,12 +11,15 @@
 #include <nanobind/nanobind.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "bindings/arrays.hpp"
 #include "slam/common.hpp"
 #include "slam/frames.hpp"
+#include "slam/local_bound.hpp"
 #include "slam/polygons.hpp"
+#include "slam/scratch.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -288,6 +291,99 @@ int64_t transfer_region(nb::handle target_obj, int64_t n_target, nb::handle fram
                                           out.data);
 }
 
+// The FR regions of L1 and L2 for transfer_polygon and sub_square_growths: 1 to
+// FR_VERTICES vertices each.
+In small_region(nb::handle obj, const char* name) {
+    const In region = input(obj, name);
+    if (region.shape[0] < 1 || region.shape[0] > bearing::slam::FR_VERTICES) {
+        value_error(std::string(name) + " must have 1 to " +
+                    std::to_string(bearing::slam::FR_VERTICES) + " vertices, it has " +
+                    std::to_string(region.shape[0]));
+    }
+    return region;
+}
+
+void check_edge_samples(int64_t edge_samples, const char* name) {
+    if (edge_samples < 1 || edge_samples > bearing::slam::MAX_EDGE_SAMPLES) {
+        value_error(std::string(name) + " must be in [1, " +
+                    std::to_string(bearing::slam::MAX_EDGE_SAMPLES) + "], got " +
+                    std::to_string(edge_samples));
+    }
+}
+
+// One FR region's whole change of frames for one movement, as the update runs it:
+// frame_plan, the hypotheses, the sub-squares (TRANSFER_CONSERVATIVE) and transfer_region.
+nb::tuple transfer_polygon(nb::handle target_obj, nb::handle a1_obj, nb::handle a2_obj,
+                           int64_t transfer, int64_t edge_samples, nb::handle out_obj) {
+    namespace slam = bearing::slam;
+    const In target = input(target_obj, "target");
+    const In a1 = small_region(a1_obj, "a1");
+    const In a2 = small_region(a2_obj, "a2");
+    const Out out = output(out_obj, "out");
+    if (target.shape[0] < 1) value_error("target must hold at least one point");
+    if (!slam::valid_transfer(transfer)) {
+        value_error("transfer must be TRANSFER_CONSERVATIVE (0), TRANSFER_PAPER (1) or "
+                    "TRANSFER_CONSERVATIVE_GLOBAL (2), got " + std::to_string(transfer));
+    }
+    check_edge_samples(edge_samples, "edge_samples");
+    check_room(slam::SCRATCH, out.shape[0], "out");
+    const int64_t n1 = a1.shape[0], n2 = a2.shape[0];
+    const bool conservative = transfer != slam::TRANSFER_PAPER;
+    const slam::FramePlan plan =
+        slam::frame_plan(a1.data, n1, a2.data, n2, conservative, edge_samples);
+    if (plan.status != slam::FRAME_OK) return nb::make_tuple(plan.status, 0);
+    // Allocated without zero-filling (every slot used is written first).
+    const std::unique_ptr<slam::Buffers> buf(new slam::Buffers);
+    slam::FrameChange frame;
+    frame.a1 = a1.data;
+    frame.n1 = n1;
+    frame.a2 = a2.data;
+    frame.n2 = n2;
+    frame.n_pairs = slam::sample_hypotheses(a1.data, n1, a2.data, n2, plan.per_edge, buf->h1,
+                                            buf->inv_d);
+    frame.h1 = buf->h1;
+    frame.inv_d = buf->inv_d;
+    frame.conservative = conservative;
+    if (transfer == slam::TRANSFER_CONSERVATIVE) {
+        slam::plan_sub_squares(a1.data, n1, a2.data, n2, plan.per_edge, buf->sub);
+        frame.local = &buf->sub;
+    }
+    frame.distance = plan.distance;
+    frame.delta1 = plan.delta1;
+    frame.delta2 = plan.delta2;
+    slam::Scratch& scratch = buf->scratch;
+    const int64_t n = slam::transfer_region(target.data, target.shape[0], frame, scratch.cloud,
+                                            scratch.hull, scratch.fresh);
+    check_room(n, out.shape[0], "out");
+    for (int64_t v = 0; v < n; ++v) out.data[v] = scratch.fresh[v];
+    return nb::make_tuple(plan.status, n);
+}
+
+// sigma(z) of every target point and sub-square into out (n_target * m1 * m2, as
+// [point][piece of L1][piece of L2]); returns (m1, m2).
+nb::tuple sub_square_growths(nb::handle target_obj, nb::handle a1_obj, nb::handle a2_obj,
+                             int64_t per_edge, nb::handle out_obj) {
+    namespace slam = bearing::slam;
+    const In target = input(target_obj, "target");
+    const In a1 = small_region(a1_obj, "a1");
+    const In a2 = small_region(a2_obj, "a2");
+    const View1<double> out = view_of<double, 1>(out_obj, "out");
+    check_edge_samples(per_edge, "per_edge");
+    const std::unique_ptr<slam::SubSquares> sub(new slam::SubSquares);
+    slam::plan_sub_squares(a1.data, a1.shape[0], a2.data, a2.shape[0], per_edge, *sub);
+    const int64_t squares = sub->m1 * sub->m2;
+    check_room(product(target.shape[0], squares), out.shape[0], "out");
+    for (int64_t v = 0; v < target.shape[0]; ++v) {
+        for (int64_t i = 0; i < sub->m1; ++i) {
+            for (int64_t j = 0; j < sub->m2; ++j) {
+                out.data[v * squares + i * sub->m2 + j] =
+                    slam::sub_square_growth(target.data[v], *sub, i, j);
+            }
+        }
+    }
+    return nb::make_tuple(sub->m1, sub->m2);
+}
+
 }  // namespace
 
 void bind_slam_geometry(nb::module_& m) {
@@ -340,4 +436,12 @@ void bind_slam_geometry(nb::module_& m) {
     m.def("transfer_region", &transfer_region, "target"_a, "n_target"_a, "frame"_a, "cloud"_a,
           "hull"_a, "out"_a,
           "The FL region of an FR region into out (SCRATCH); returns its vertex count.");
+    m.def("transfer_polygon", &transfer_polygon, "target"_a, "a1"_a, "a2"_a, "transfer"_a,
+          "edge_samples"_a, "out"_a,
+          "(status, n): one FR region's change of frames as the update runs it, into out "
+          "(SCRATCH).");
+    m.def("sub_square_growths", &sub_square_growths, "target"_a, "a1"_a, "a2"_a, "per_edge"_a,
+          "out"_a,
+          "(m1, m2): the local bound of every target point and sub-square into out "
+          "(float64, n_target * m1 * m2).");
 }

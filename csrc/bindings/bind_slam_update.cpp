@@ -195,8 +195,9 @@ slam::Params make_params(double epsilon, int64_t transfer, int64_t edge_samples,
                          bool with_robot, double risk, bool likely, bool estimate_bound) {
     require(std::isfinite(epsilon) && epsilon > 0.0,
             "epsilon must be a positive finite number of radians, not " + std::to_string(epsilon));
-    require(transfer == slam::TRANSFER_CONSERVATIVE || transfer == slam::TRANSFER_PAPER,
-            "transfer must be TRANSFER_CONSERVATIVE (0) or TRANSFER_PAPER (1), not " +
+    require(slam::valid_transfer(transfer),
+            "transfer must be TRANSFER_CONSERVATIVE (0), TRANSFER_PAPER (1) or "
+            "TRANSFER_CONSERVATIVE_GLOBAL (2), not " +
                 std::to_string(transfer));
     require(edge_samples >= 1 && edge_samples <= slam::MAX_EDGE_SAMPLES,
             "edge_samples must be in [1, " + std::to_string(slam::MAX_EDGE_SAMPLES) + "], not " +
@@ -572,6 +573,8 @@ void bind_slam_update(nb::module_& m) {
     m.attr("LANDMARK_MISSING") = static_cast<int64_t>(slam::LANDMARK_MISSING);
     m.attr("TRANSFER_CONSERVATIVE") = static_cast<int64_t>(slam::TRANSFER_CONSERVATIVE);
     m.attr("TRANSFER_PAPER") = static_cast<int64_t>(slam::TRANSFER_PAPER);
+    m.attr("TRANSFER_CONSERVATIVE_GLOBAL") =
+        static_cast<int64_t>(slam::TRANSFER_CONSERVATIVE_GLOBAL);
     m.attr("INCONSISTENCY_RESTART") = static_cast<int64_t>(slam::INCONSISTENCY_RESTART);
     m.attr("INCONSISTENCY_KEEP") = static_cast<int64_t>(slam::INCONSISTENCY_KEEP);
     m.attr("FUSION_INTERSECT") = static_cast<int64_t>(slam::FUSION_INTERSECT);

@@ -107,7 +107,7 @@ inline slam::Params params_of(nb::handle obj) {
     // The ranges the native Params checks (the update's buffers are sized by them).
     const bool valid =
         std::isfinite(p.epsilon) && p.epsilon > 0.0 &&
-        (p.transfer == slam::TRANSFER_CONSERVATIVE || p.transfer == slam::TRANSFER_PAPER) &&
+        slam::valid_transfer(p.transfer) &&
         p.edge_samples >= 1 && p.edge_samples <= slam::MAX_EDGE_SAMPLES &&
         (p.on_inconsistency == slam::INCONSISTENCY_RESTART ||
          p.on_inconsistency == slam::INCONSISTENCY_KEEP) &&

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/errors.hpp"
+#include "slam/local_bound.hpp"
 #include "slam/polygons.hpp"
 
 namespace bearing::slam {
@@ -206,6 +207,11 @@ int64_t transfer_region(const cplx* target, int64_t n_target, const FrameChange&
         // distance**3 as numba unrolls it: (1.0 * d) * (d * d).
         const double cube = (1.0 * distance) * (distance * distance);
         double radius = (v2 * delta1 * delta1 + v1 * delta2 * delta2) / (4.0 * cube);
+        // Both bounds are valid; the local one is tighter wherever it is finite.
+        if (frame.local != nullptr) {
+            const double local = local_growth(target, n_target, *frame.local);
+            if (local < radius) radius = local;
+        }
         // A relative margin far above rounding error keeps the bound a bound in floats.
         radius += 1e-9 * (1.0 + v1 / distance);
         n = drop_edges_outward(hull, n, SCRATCH - 8);

@@ -9,6 +9,8 @@
 
 namespace bearing::slam {
 
+struct SubSquares;  // slam/local_bound.hpp
+
 // One movement's change of frames, as transfer_region applies it (frames.py FrameChange).
 struct FrameChange {
     const cplx* a1 = nullptr;  // the FR region of L1 (a1[:n1])
@@ -19,6 +21,9 @@ struct FrameChange {
     const cplx* inv_d = nullptr;  // their 1 / (h2 - h1)
     int64_t n_pairs = 0;
     bool conservative = false;  // grow the hull by the bound (else the paper's hull)
+    // With conservative: the movement's sub-squares, for the local bound (the growth is
+    // the smaller of it and the global one); nullptr grows by the global bound alone.
+    const SubSquares* local = nullptr;
     double distance = 0.0;      // distance between the regions of L1 and L2
     double delta1 = 0.0;        // sample spacing on L1's edges
     double delta2 = 0.0;

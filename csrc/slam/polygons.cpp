@@ -47,14 +47,6 @@ inline bool within_chord(cplx a, cplx b, cplx c, double tol) {
     return turn <= tol * abs(c - a);
 }
 
-inline double point_segment_distance(cplx z, cplx a, cplx b) {
-    const cplx d = b - a;
-    const double len2 = dot(d, d);
-    if (len2 == 0.0) return abs(z - a);
-    const double t = std::min(std::max(dot(z - a, d) / len2, 0.0), 1.0);
-    return abs(z - (a + t * d));
-}
-
 inline bool separated(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q, cplx axis) {
     double lo_p = dot(axis, p[0]), hi_p = lo_p;
     for (int64_t i = 1; i < n_p; ++i) {

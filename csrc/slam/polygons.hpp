@@ -4,6 +4,7 @@
 // A polygon is a vertex array in counter-clockwise order plus its count n.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <utility>
 
@@ -33,5 +34,14 @@ int64_t drop_edges_outward(cplx* poly, int64_t n, int64_t capacity);
 int64_t clip_convex(const cplx* subject, int64_t n_subject, const cplx* clipper,
                     int64_t n_clipper, cplx* out, cplx* work);
 int64_t offset_outward(const cplx* poly, int64_t n, double radius, cplx* out);
+
+// Distance from z to the segment [a, b].
+inline double point_segment_distance(cplx z, cplx a, cplx b) {
+    const cplx d = b - a;
+    const double len2 = dot(d, d);
+    if (len2 == 0.0) return abs(z - a);
+    const double t = std::min(std::max(dot(z - a, d) / len2, 0.0), 1.0);
+    return abs(z - (a + t * d));
+}
 
 }  // namespace bearing::slam

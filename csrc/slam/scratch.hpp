@@ -11,6 +11,7 @@
 
 #include "core/complex.hpp"
 #include "core/errors.hpp"
+#include "slam/local_bound.hpp"
 #include "slam/state.hpp"
 
 namespace bearing::slam {
@@ -41,7 +42,7 @@ struct Scratch {
 // What one thread of the update works in for one movement (update.py Buffers): the FR
 // regions (fr, fr_count, fr_status), the sampled hypotheses (h1, inv_d), the relaxed
 // fusion's new-region counts, the FR robot point, a movement's bearings read back from
-// a map's history (start, end) and the polygon scratch.
+// a map's history (start, end), the local bound's sub-squares and the polygon scratch.
 struct Buffers {
     cplx fr[MAX_LANDMARKS][FR_VERTICES];
     int64_t fr_count[MAX_LANDMARKS];
@@ -52,6 +53,7 @@ struct Buffers {
     cplx robot_point[1];
     double start[MAX_LANDMARKS];
     double end[MAX_LANDMARKS];
+    SubSquares sub;  // the movement's sub-squares (TRANSFER_CONSERVATIVE only)
     Scratch scratch;
 };
 

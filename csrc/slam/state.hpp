@@ -45,7 +45,20 @@ enum LandmarkStatus : int8_t {
     LANDMARK_SKIPPED = 3,
     LANDMARK_MISSING = 4,
 };
-enum Transfer : int64_t { TRANSFER_CONSERVATIVE = 0, TRANSFER_PAPER = 1 };
+// TRANSFER_CONSERVATIVE grows the sampled hull by the local bound (local_bound.hpp),
+// TRANSFER_CONSERVATIVE_GLOBAL by the movement's one global radius (the bound of
+// bearing_env 0.1, kept to reproduce its figures), TRANSFER_PAPER not at all.
+enum Transfer : int64_t {
+    TRANSFER_CONSERVATIVE = 0,
+    TRANSFER_PAPER = 1,
+    TRANSFER_CONSERVATIVE_GLOBAL = 2,
+};
+
+// Whether a transfer code is one of the above.
+inline bool valid_transfer(int64_t transfer) {
+    return transfer == TRANSFER_CONSERVATIVE || transfer == TRANSFER_PAPER ||
+           transfer == TRANSFER_CONSERVATIVE_GLOBAL;
+}
 enum Inconsistency : int64_t { INCONSISTENCY_RESTART = 0, INCONSISTENCY_KEEP = 1 };
 enum Fusion : int64_t { FUSION_INTERSECT = 0, FUSION_RELAXED = 1, FUSION_ROBUST = 2 };
 

@@ -27,16 +27,18 @@ constexpr double NaN = std::numeric_limits<double>::quiet_NaN();
 
 // One movement's frame code and, when it is FRAME_OK, its change of frames (hypotheses
 // sampled into h1 and inv_d) from the FR regions of L1 and L2.
-int64_t frame_of(const Buffers& buf, const Params& params, cplx* h1, cplx* inv_d,
+int64_t frame_of(Buffers& buf, const Params& params, cplx* h1, cplx* inv_d,
                  FrameChange& frame) {
     const cplx* a1 = buf.fr[0];
     const cplx* a2 = buf.fr[1];
     const int64_t n1 = buf.fr_count[0], n2 = buf.fr_count[1];
-    const bool conservative = params.transfer == TRANSFER_CONSERVATIVE;
+    const bool conservative = params.transfer != TRANSFER_PAPER;
+    const bool local = params.transfer == TRANSFER_CONSERVATIVE;
     const FramePlan plan = frame_plan(a1, n1, a2, n2, conservative, params.edge_samples);
     int64_t n_pairs = 0;
     if (plan.status == FRAME_OK) {
         n_pairs = sample_hypotheses(a1, n1, a2, n2, plan.per_edge, h1, inv_d);
+        if (local) plan_sub_squares(a1, n1, a2, n2, plan.per_edge, buf.sub);
     }
     frame.a1 = a1;
     frame.n1 = n1;
@@ -46,6 +48,7 @@ int64_t frame_of(const Buffers& buf, const Params& params, cplx* h1, cplx* inv_d
     frame.inv_d = inv_d;
     frame.n_pairs = n_pairs;
     frame.conservative = conservative;
+    frame.local = local && plan.status == FRAME_OK ? &buf.sub : nullptr;
     frame.distance = plan.distance;
     frame.delta1 = plan.delta1;
     frame.delta2 = plan.delta2;

@@ -85,7 +85,7 @@ FUZZED: frozenset[str] = frozenset(
         "small_convex_hull", "small_hull_indices", "area_centroid", "contains_point",
         "polygon_distance", "longest_edge", "simplify", "drop_edges_outward", "clip_convex",
         "offset_outward", "cone_region", "boundary_samples", "frame_plan",
-        "sample_hypotheses", "transfer_region",
+        "sample_hypotheses", "transfer_region", "transfer_polygon", "sub_square_growths",
         # bind_slam_update.cpp
         "MapState", "Params", "update_maps", "copy_maps", "check_indices", "none_infinite",
         "contains_points", "binomial_q", "relaxed_region", "update_levels",
@@ -550,6 +550,43 @@ def test_transfer_region_of_any_target_and_frame(
     k = result(_core.transfer_region, target, n_target, frame, cloud, hull, out)
     if k is not None:
         assert isinstance(k, int) and 0 <= k <= kernels.CAPACITY
+
+
+TRANSFER_CODES = (
+    kernels.TRANSFER_CONSERVATIVE, kernels.TRANSFER_PAPER, kernels.TRANSFER_CONSERVATIVE_GLOBAL
+)  # fmt: skip
+
+
+@fuzz(target=polygons(max_size=6), data=st.data())
+def test_transfer_polygon_of_any_target_and_regions(
+    target: ComplexArray, data: st.DataObject
+) -> None:
+    a1, a2 = fr_region(data.draw), fr_region(data.draw)
+    transfer = data.draw(st.one_of(st.sampled_from(TRANSFER_CODES), st.integers(-2, 5)))
+    edge_samples = data.draw(st.one_of(st.integers(-1, 9), st.sampled_from(SPECIAL_INTS)))
+    out = np.zeros(out_length(data.draw, kernels.SCRATCH), dtype=np.complex128)
+    returned = result(_core.transfer_polygon, target, a1, a2, transfer, edge_samples, out)
+    if returned is not None:
+        status, k = returned
+        assert status in (kernels.FRAME_OK, kernels.FRAME_L1_L2_OVERLAP,
+                          kernels.FRAME_L1_L2_TOO_CLOSE)  # fmt: skip
+        assert isinstance(k, int) and 0 <= k <= kernels.CAPACITY
+        assert status == kernels.FRAME_OK or k == 0
+
+
+@fuzz(target=polygons(max_size=6), data=st.data())
+def test_sub_square_growths_of_any_target_and_regions(
+    target: ComplexArray, data: st.DataObject
+) -> None:
+    a1, a2 = fr_region(data.draw), fr_region(data.draw)
+    per_edge = data.draw(st.one_of(st.integers(-1, 9), st.sampled_from(SPECIAL_INTS)))
+    needed = target.size * kernels.MAX_SAMPLES * kernels.MAX_SAMPLES
+    out = np.zeros(out_length(data.draw, needed), dtype=np.float64)
+    returned = result(_core.sub_square_growths, target, a1, a2, per_edge, out)
+    if returned is not None:
+        m1, m2 = returned
+        assert 0 <= m1 <= kernels.MAX_SAMPLES and 0 <= m2 <= kernels.MAX_SAMPLES
+        assert target.size * m1 * m2 <= out.size
 
 
 # ----------------------------------------------------------------------------------------

@@ -17,6 +17,8 @@ from bearing_env._core import (
     cone_region,
     frame_plan,
     sample_hypotheses,
+    sub_square_growths,
+    transfer_polygon,
     transfer_region,
 )
 
@@ -35,7 +37,9 @@ class FrameChange(NamedTuple):
     h1: ComplexArray  #: hypotheses ``h1`` (``h1[:n_pairs]``)
     inv_d: ComplexArray  #: their ``1 / (h2 - h1)``
     n_pairs: int
-    conservative: bool  #: grow the hull by the bound (else the paper's hull)
+    #: grow the hull by the global bound (else the paper's hull); the local bound needs
+    #: the movement's sub-squares, which :func:`transfer_polygon` plans
+    conservative: bool
     distance: float  #: distance between the regions of L1 and L2
     delta1: float  #: sample spacing on L1's edges
     delta2: float
@@ -47,5 +51,7 @@ __all__ = [
     "cone_region",
     "frame_plan",
     "sample_hypotheses",
+    "sub_square_growths",
+    "transfer_polygon",
     "transfer_region",
 ]
