@@ -42,8 +42,8 @@ from numpy.typing import NDArray
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.audit import SearchSettings, contains
 from bearing_env.slam.batch import CONTAINMENT_TOLERANCE
-from bearing_env.slam.transfer import TRANSFERS
 from bearing_env.slam.geometry import FR_BOUNDED, cone_region
+from bearing_env.slam.transfer import TRANSFERS
 from bearing_env.train.common.cli_parser import (
     add_json_output,
     add_no_progress,
