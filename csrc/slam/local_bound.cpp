@@ -91,6 +91,7 @@ void plan_sub_squares(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2, in
     }
     for (int64_t i = 0; i < m1; ++i) {
         const int64_t i_next = next_index(i, m1);
+        double row_exact1 = 0.0, row_moving2 = 0.0;
         for (int64_t j = 0; j < m2; ++j) {
             const int64_t j_next = next_index(j, m2);
             // The distance between two disjoint segments is attained at an end of one.
@@ -100,7 +101,11 @@ void plan_sub_squares(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2, in
                 moving_factor(piece1[i], to_piece2[i][j], to_piece2[i_next][j], gap);
             out.moving2[i][j] =
                 moving_factor(piece2[j], to_piece1[i][j], to_piece1[i][j_next], gap);
+            row_exact1 = std::max(row_exact1, out.exact1[i][j]);
+            row_moving2 = std::max(row_moving2, out.moving2[i][j]);
         }
+        out.row_exact1[i] = row_exact1;
+        out.row_moving2[i] = row_moving2;
     }
 }
 
@@ -122,30 +127,51 @@ double local_growth(const cplx* target, int64_t n_target, const SubSquares& sub)
     for (int64_t v = 0; v < n_target; ++v) {
         const cplx z = target[v];
         for (int64_t i = 0; i < m1; ++i) r1[i] = length(z - sub.s1[i]);
-        for (int64_t j = 0; j < m2; ++j) r2[j] = length(z - sub.s2[j]);
+        double r2_max = 0.0;
+        for (int64_t j = 0; j < m2; ++j) {
+            r2[j] = length(z - sub.s2[j]);
+            r2_max = std::max(r2_max, r2[j]);
+        }
+        // Rows in two passes: first the one whose bound is largest, so that its sigma
+        // lets the bound skip most other rows (only the maximum is needed).
+        int64_t first = 0;
+        double first_bound = -1.0;
         for (int64_t i = 0; i < m1; ++i) {
-            const int64_t i_next = next_index(i, m1);
-            const double ra = r1[i], rb = r1[i_next];
-            const double far1 = std::max(ra, rb);
-            const double* exact1 = sub.exact1[i];
-            const double* moving1 = sub.moving1[i];
-            const double* moving2 = sub.moving2[i];
-            const double* exact2_a = sub.exact2[i];
-            const double* exact2_b = sub.exact2[i_next];
-            for (int64_t j = 0; j < m2; ++j) {
-                const int64_t j_next = next_index(j, m2);
-                const double rc = r2[j], rd = r2[j_next];
-                const double order_a = std::max(rc * exact1[j], rd * exact1[j_next]) +
-                                       far1 * moving2[j];
-                // sigma = min(order_a, order_b) can raise the growth only if both do.
-                if (order_a <= growth) continue;
-                const double order_b = std::max(ra * exact2_a[j], rb * exact2_b[j]) +
-                                       std::max(rc, rd) * moving1[j];
-                const double sigma = std::min(order_a, order_b);
-                // NaN (from NaN inputs) is returned as it is: the caller then keeps the
-                // global bound, which a max would silently have replaced.
-                if (std::isnan(sigma)) return sigma;
-                growth = std::max(growth, sigma);
+            const double bound = r2_max * sub.row_exact1[i] +
+                                 std::max(r1[i], r1[next_index(i, m1)]) * sub.row_moving2[i];
+            if (bound > first_bound) {
+                first_bound = bound;
+                first = i;
+            }
+        }
+        for (int64_t pass = 0; pass < 2; ++pass) {
+            for (int64_t i = pass == 0 ? first : 0; i < (pass == 0 ? first + 1 : m1); ++i) {
+                if (pass == 1 && i == first) continue;
+                const int64_t i_next = next_index(i, m1);
+                const double ra = r1[i], rb = r1[i_next];
+                const double far1 = std::max(ra, rb);
+                // Order A over the row is at most this; sigma is at most order A.
+                if (r2_max * sub.row_exact1[i] + far1 * sub.row_moving2[i] <= growth) continue;
+                const double* exact1 = sub.exact1[i];
+                const double* moving1 = sub.moving1[i];
+                const double* moving2 = sub.moving2[i];
+                const double* exact2_a = sub.exact2[i];
+                const double* exact2_b = sub.exact2[i_next];
+                for (int64_t j = 0; j < m2; ++j) {
+                    const int64_t j_next = next_index(j, m2);
+                    const double rc = r2[j], rd = r2[j_next];
+                    const double order_a = std::max(rc * exact1[j], rd * exact1[j_next]) +
+                                           far1 * moving2[j];
+                    // sigma = min(order_a, order_b) can raise the growth only if both do.
+                    if (order_a <= growth) continue;
+                    const double order_b = std::max(ra * exact2_a[j], rb * exact2_b[j]) +
+                                           std::max(rc, rd) * moving1[j];
+                    const double sigma = std::min(order_a, order_b);
+                    // NaN (from NaN inputs) is returned as it is: the caller then keeps
+                    // the global bound, which a max would silently have replaced.
+                    if (std::isnan(sigma)) return sigma;
+                    growth = std::max(growth, sigma);
+                }
             }
         }
     }

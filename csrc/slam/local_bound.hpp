@@ -41,6 +41,10 @@ struct SubSquares {
     double exact2[MAX_SAMPLES][MAX_SAMPLES];   // [sample i of L1][piece j of L2]
     double moving1[MAX_SAMPLES][MAX_SAMPLES];  // [piece i][piece j]: h1 along piece i
     double moving2[MAX_SAMPLES][MAX_SAMPLES];  // [piece i][piece j]: h2 along piece j
+    // Per piece i of L1, the largest exact1[i][:] and moving2[i][:]: with a target point's
+    // distances they bound order A, hence sigma, over the whole row of sub-squares.
+    double row_exact1[MAX_SAMPLES];
+    double row_moving2[MAX_SAMPLES];
     SubSquares() {}  // NOLINT: deliberately uninitialised (33 KB); plan_sub_squares fills it
 };
 
