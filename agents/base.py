@@ -8,7 +8,7 @@ which robot policies never read.
 
 Policies choose a *movement* as a turn (radians, counter-clockwise, relative to the
 current heading) and a length (metres); :class:`ActionCodec` turns that into the env's
-action, continuous (``BearingSLAM-v0``) or discrete (``BearingSLAMDiscrete-v0``, the
+action, continuous (``BearingSLAM-v1``) or discrete (``BearingSLAMDiscrete-v1``, the
 nearest entry of the env's turn and length tables).
 """
 

@@ -33,7 +33,7 @@ def bearing_env_of(env: gym.Env) -> BearingSLAMEnv:
     base = getattr(env, "unwrapped", env)
     if not isinstance(base, BearingSLAMEnv):
         raise TypeError(
-            f"expected a BearingSLAM-v0 / BearingSLAMDiscrete-v0 env (possibly wrapped), "
+            f"expected a BearingSLAM-v1 / BearingSLAMDiscrete-v1 env (possibly wrapped), "
             f"got {type(base).__name__}"
         )
     return base

@@ -1,10 +1,14 @@
 """The named, versioned tasks: settings people compare on, each registered as its own id.
 
-This table is the one home of the tasks: :mod:`bearing_env.registration` registers them,
-``bearing-env suite`` (:mod:`bearing_env.train.compare.suite`) runs the baselines on them
-and writes their cards in ``docs/tasks/``.
+This table is the one home of the tasks and of their versions: :mod:`bearing_env.registration`
+registers them, ``bearing-env suite`` (:mod:`bearing_env.train.compare.suite`) runs the
+baselines on the current ones and writes their cards in ``docs/tasks/``.
 
-The ids follow :data:`NAMING_RULE`.
+The ids follow :data:`NAMING_RULE`. Every id exists in every version of :data:`VERSIONS`
+(``BearingSLAM-Khepera-v0``, ``BearingSLAM-Khepera-v1``, and the base ids
+``BearingSLAM-v0``, ``BearingSLAM-v1``, ...): the current version is on the env's defaults,
+an older one registers the defaults it was measured with on top, so that its published
+figures still reproduce bit for bit.
 
 A task's settings are ``gym.make`` keyword arguments on top of the env's defaults;
 ``gym.make(task_id, **more)`` overrides them as for any id. Importing this module is
@@ -42,13 +46,55 @@ NAMING_RULE = """\
   so that its training and evaluation envs have the same observation space;
 - `version` starts at 0 and goes up whenever a change alters what an agent faces (the
   task's settings, an env default it relies on, the dynamics or the reward), so scores
-  reported under one id stay comparable.
+  reported under one id stay comparable; every id stays registered in every version, an
+  older one with the env defaults it was measured with (each card's version history says
+  what changed).
 """
 
-#: The base ids a task builds on, by action kind.
-BASE_IDS: dict[str, str] = {
-    "continuous": "BearingSLAM-v0",
-    "discrete": "BearingSLAMDiscrete-v0",
+#: Every version of the ids, oldest first, and the settings it registers on top of its
+#: ids' own: an older version keeps the env defaults that changed after it (the last, the
+#: current version, adds nothing). A new version adds its entry here (and the settings
+#: that change to every older entry) and its line to :data:`HISTORY`.
+VERSIONS: dict[int, Mapping[str, Any]] = {
+    0: MappingProxyType({"transfer": "conservative_global"}),
+    1: MappingProxyType({}),
+}
+#: The current version: the tasks, the cards and the shipped hyperparameters use it.
+VERSION: int = max(VERSIONS)
+#: What each version changed, one line each, oldest first (the cards' "Version history").
+HISTORY: tuple[str, ...] = (
+    "v0: the first version (bearing_env 0.1.0).",
+    "v1: the conservative transfer grows regions by a local bound instead of one global "
+    "radius per movement (bearing_env 0.2.0): every transferred region is smaller or "
+    "equal, so areas and rewards change; `-v0` keeps the old bound "
+    '(`transfer="conservative_global"`).',
+)
+
+#: The base ids' names, by action kind (the id adds ``-v<version>``).
+BASE_NAMES: dict[str, str] = {"continuous": "BearingSLAM", "discrete": "BearingSLAMDiscrete"}
+
+
+def versioned_id(name: str, version: int = VERSION) -> str:
+    """``<name>-v<version>``, by default the current version's id."""
+    return f"{name}-v{version}"
+
+
+def split_id(task_id: str) -> tuple[str, int]:
+    """An id's name and version: ``"BearingSLAM-Khepera-v1"`` -> ``("BearingSLAM-Khepera",
+    1)`` (a ``module:`` prefix is dropped); ValueError without a ``-v<N>`` suffix."""
+    name, _, version = task_id.rpartition(":")[2].rpartition("-v")
+    if not name or not version.isdigit():
+        raise ValueError(f"{task_id!r} is not a versioned id (NAME-vN)")
+    return name, int(version)
+
+
+#: The current base ids a task builds on, by action kind.
+BASE_IDS: dict[str, str] = {kind: versioned_id(name) for kind, name in BASE_NAMES.items()}
+#: Every registered base id, all versions, and its action kind.
+BASE_ID_KINDS: dict[str, str] = {
+    versioned_id(name, version): kind
+    for version in VERSIONS
+    for kind, name in BASE_NAMES.items()
 }
 
 #: The sensor of the ``Outliers`` tasks: 5% of bearings replaced by a random angle (the
@@ -64,9 +110,10 @@ class Task:
 
     Attributes:
         id: the registered id (see the module doc for the naming rule).
-        base_id: the base id whose env (and vector env) it makes: ``BearingSLAM-v0`` or
-            ``BearingSLAMDiscrete-v0``.
-        settings: the ``gym.make`` keyword arguments that define it (read-only).
+        base_id: the base id of the same version whose env (and vector env) it makes:
+            ``BearingSLAM-v1`` or ``BearingSLAMDiscrete-v1`` (``-v0`` for a ``-v0`` task).
+        settings: the ``gym.make`` keyword arguments that define it (read-only), those of
+            its version (:data:`VERSIONS`) included.
         description: one line for tables.
     """
 
@@ -77,13 +124,13 @@ class Task:
     description: str = ""
     #: What each version changed, one line each, oldest first (the cards' "Version
     #: history").
-    history: tuple[str, ...] = ("v0: the first version (bearing_env 0.1.0).",)
+    history: tuple[str, ...] = HISTORY
 
     def __post_init__(self) -> None:
-        if self.base_id not in BASE_IDS.values():
+        bases = [base for base in BASE_ID_KINDS if split_id(base)[1] == split_id(self.id)[1]]
+        if self.base_id not in bases:
             raise ValueError(
-                f"task {self.id!r}: base_id must be one of {sorted(BASE_IDS.values())}, "
-                f"got {self.base_id!r}"
+                f"task {self.id!r}: base_id must be one of {bases}, got {self.base_id!r}"
             )
         # Held read-only, so the table cannot be changed through a task.
         object.__setattr__(self, "settings", MappingProxyType(copy.deepcopy(dict(self.settings))))
@@ -91,7 +138,31 @@ class Task:
     @property
     def action_kind(self) -> str:
         """``"continuous"`` or ``"discrete"``."""
-        return next(kind for kind, base in BASE_IDS.items() if base == self.base_id)
+        return BASE_ID_KINDS[self.base_id]
+
+    @property
+    def name(self) -> str:
+        """The id without its version: ``BearingSLAM-Khepera``."""
+        return split_id(self.id)[0]
+
+    @property
+    def version(self) -> int:
+        """The id's version."""
+        return split_id(self.id)[1]
+
+    def at_version(self, version: int) -> Task:
+        """This task as ``version`` registers it: the same name with that version, on
+        that version's base id, the version's settings (:data:`VERSIONS`) under the
+        task's own, and the history up to it."""
+        if version == self.version:
+            return self
+        return Task(
+            id=versioned_id(self.name, version),
+            base_id=versioned_id(BASE_NAMES[self.action_kind], version),
+            settings={**self.settings, **_missing(VERSIONS[version], self.settings)},
+            description=self.description,
+            history=tuple(line for line in self.history if _line_version(line) <= version),
+        )
 
     def kwargs(self) -> dict[str, Any]:
         """The settings as a new ``dict`` (nested values copied), for ``gym.make``."""
@@ -102,11 +173,20 @@ class Task:
         return ", ".join(f"{key}={json.dumps(value)}" for key, value in self.settings.items())
 
 
+def _missing(added: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
+    """The settings of ``added`` that ``settings`` does not set itself."""
+    return {key: value for key, value in added.items() if key not in settings}
+
+
+def _line_version(line: str) -> int:
+    """The version a history line is about: ``"v1: ..."`` -> 1."""
+    return int(line.partition(":")[0].removeprefix("v"))
+
+
 def _khepera(kind: str) -> Task:
-    name = "BearingSLAM" if kind == "continuous" else "BearingSLAMDiscrete"
     actions = "continuous turn and move length" if kind == "continuous" else "a grid of moves"
     return Task(
-        id=f"{name}-Khepera-v0",
+        id=versioned_id(f"{BASE_NAMES[kind]}-Khepera"),
         base_id=BASE_IDS[kind],
         settings={"scenario": "khepera"},
         description=f"the paper's Khepera arena (4 fixed landmarks), {actions}",
@@ -115,7 +195,7 @@ def _khepera(kind: str) -> Task:
 
 def _random(n_landmarks: int) -> Task:
     return Task(
-        id=f"BearingSLAM-Random{n_landmarks}-v0",
+        id=versioned_id(f"BearingSLAM-Random{n_landmarks}"),
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "random", "n_landmarks": n_landmarks},
         description=f"a new random layout of {n_landmarks} landmarks every episode, Khepera field",
@@ -124,7 +204,7 @@ def _random(n_landmarks: int) -> Task:
 
 def _camera(degrees: int) -> Task:
     return Task(
-        id=f"BearingSLAM-Khepera-Camera{degrees}-v0",
+        id=versioned_id(f"BearingSLAM-Khepera-Camera{degrees}"),
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "khepera", "field_of_view_deg": degrees},
         description=f"Khepera arena, a forward camera of {degrees} deg: landmarks outside it "
@@ -140,13 +220,13 @@ TASKS: tuple[Task, ...] = (
     _random(8),
     _random(16),
     Task(
-        id="BearingSLAM-Khepera-Outliers-v0",
+        id=versioned_id("BearingSLAM-Khepera-Outliers"),
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "khepera", "noise": OUTLIER_NOISE, "fusion": "relaxed"},
         description="Khepera arena, 5% of bearings replaced by random angles, relaxed fusion",
     ),
     Task(
-        id="BearingSLAM-Khepera-Missed-v0",
+        id=versioned_id("BearingSLAM-Khepera-Missed"),
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "khepera", "noise": MISSED_NOISE, "fusion": "relaxed"},
         description="Khepera arena, each landmark missed in 20% of readings, relaxed fusion",
@@ -154,7 +234,7 @@ TASKS: tuple[Task, ...] = (
     _camera(90),
     _camera(180),
     Task(
-        id="BearingSLAM-FurnishedRoom-v0",
+        id=versioned_id("BearingSLAM-FurnishedRoom"),
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "furnished_room"},
         description="a furnished room of 2 x 1.5 m (5 landmarks): furniture blocks moves "
@@ -168,7 +248,7 @@ TASKS_BY_ID: dict[str, Task] = {task.id: task for task in TASKS}
 
 def _random_table(observation: str) -> Task:
     return Task(
-        id=f"BearingSLAM-Random3to16-{observation.capitalize()}-v0",
+        id=versioned_id(f"BearingSLAM-Random3to16-{observation.capitalize()}"),
         base_id=BASE_IDS["continuous"],
         settings={
             "scenario": "random",
@@ -186,16 +266,45 @@ def _random_table(observation: str) -> Task:
 #: evaluation env from the id alone); the suite does not card them.
 TRAINING_TASKS: tuple[Task, ...] = (_random_table("entities"), _random_table("shapes"))
 
-#: Every registered task by id: :data:`TASKS` and :data:`TRAINING_TASKS`.
+#: The older versions of every task and training task (:data:`VERSIONS`): registered, so
+#: that their figures reproduce, and not carded.
+OLDER_TASKS: tuple[Task, ...] = tuple(
+    task.at_version(version)
+    for version in VERSIONS
+    if version != VERSION
+    for task in (*TASKS, *TRAINING_TASKS)
+)
+
+#: Every registered task by id: :data:`TASKS`, :data:`TRAINING_TASKS` and
+#: :data:`OLDER_TASKS`.
 REGISTERED_TASKS_BY_ID: dict[str, Task] = {
-    task.id: task for task in (*TASKS, *TRAINING_TASKS)
+    task.id: task for task in (*TASKS, *TRAINING_TASKS, *OLDER_TASKS)
 }
 
 
 def task_named(task_id: str) -> Task:
-    """The task of an id (``"NAME-vN"`` or ``"bearing_env:NAME-vN"``); ValueError naming
-    the id and listing the tasks otherwise."""
+    """The current task of an id (``"NAME-vN"`` or ``"bearing_env:NAME-vN"``); ValueError
+    naming the id and listing the tasks otherwise (and the current id of an older one)."""
     name = task_id.rpartition(":")[2]
     if name not in TASKS_BY_ID:
-        raise ValueError(f"unknown task {task_id!r}; the tasks are {', '.join(TASKS_BY_ID)}")
+        older = REGISTERED_TASKS_BY_ID.get(name)
+        newer = (
+            f" ({name} is an older version of {versioned_id(older.name)})"
+            if older is not None and older.version != VERSION
+            else ""
+        )
+        raise ValueError(
+            f"unknown task {task_id!r}{newer}; the tasks are {', '.join(TASKS_BY_ID)}"
+        )
     return TASKS_BY_ID[name]
+
+
+def current_id(env_id: str) -> str:
+    """The current version's id of a registered bearing_env id (``BearingSLAM-v0`` ->
+    ``BearingSLAM-v1``, ``bearing_env:BearingSLAM-FurnishedRoom-v0`` ->
+    ``bearing_env:BearingSLAM-FurnishedRoom-v1``); any other id as it is. A model trained
+    on an older version is evaluated on its task's current version."""
+    prefix, colon, name = env_id.rpartition(":")
+    if name not in REGISTERED_TASKS_BY_ID and name not in BASE_ID_KINDS:
+        return env_id
+    return f"{prefix}{colon}{versioned_id(split_id(name)[0])}"

@@ -5,9 +5,9 @@ what the agents send).
 An action is one straight-line movement: a turn on the spot (radians, counter-clockwise,
 relative to the heading) and a length (metres).
 
-* :data:`CONTINUOUS` (``BearingSLAM-v0``): ``Box(-1, 1, (2,), float32)``; ``a[0]`` turns
+* :data:`CONTINUOUS` (``BearingSLAM-v1``): ``Box(-1, 1, (2,), float32)``; ``a[0]`` turns
   by ``pi * a[0]``, ``a[1]`` maps linearly onto the ``move_length`` range.
-* :data:`DISCRETE` (``BearingSLAMDiscrete-v0``): ``Discrete(n_turns * n_move_lengths)``;
+* :data:`DISCRETE` (``BearingSLAMDiscrete-v1``): ``Discrete(n_turns * n_move_lengths)``;
   action ``k`` is the ``k // n_move_lengths``-th of ``n_turns`` evenly spaced turns and
   the ``k % n_move_lengths``-th of evenly spaced lengths. Its grid fixes the space, so
   ``n_turns`` and ``n_move_lengths`` cannot change on a live env (:attr:`grid_fixed`).
@@ -46,7 +46,7 @@ def real_values(actions: Any, what: str) -> NDArray[Any]:
 
 
 class ContinuousActions:
-    """``BearingSLAM-v0``'s actions (see the module doc)."""
+    """``BearingSLAM-v1``'s actions (see the module doc)."""
 
     kind: ClassVar[str] = "continuous"
     #: Whether the settings fix the action space (none do here).
@@ -96,7 +96,7 @@ class ContinuousActions:
 
 
 class DiscreteActions:
-    """``BearingSLAMDiscrete-v0``'s actions (see the module doc)."""
+    """``BearingSLAMDiscrete-v1``'s actions (see the module doc)."""
 
     kind: ClassVar[str] = "discrete"
     grid_fixed: ClassVar[bool] = True

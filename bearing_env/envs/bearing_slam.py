@@ -1,4 +1,4 @@
-"""``BearingSLAM-v0``: active exploration for the paper's bearing-only polygon SLAM.
+"""``BearingSLAM-v1``: active exploration for the paper's bearing-only polygon SLAM.
 
 The env is a batch of one of the functional core in :mod:`bearing_env.envs.core`; its
 settings are one :class:`~bearing_env.envs.config.EnvConfig`.
@@ -107,7 +107,7 @@ def settings_from(config: EnvConfig | None, settings: Mapping[str, Any], grid: b
     if not grid and (given := sorted(set(settings) & set(GRID_SETTINGS))):
         raise TypeError(
             f"unexpected keyword argument(s) {given}: they set the discrete action grid of "
-            "BearingSLAMDiscrete-v0"
+            "BearingSLAMDiscrete-v1"
         )
     if config is None:
         return EnvConfig.create(**settings)
@@ -158,7 +158,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     Non-finite actions, actions outside `[-1, 1]^2`, and actions that are not real numbers
     (strings, bools, complex numbers) raise `ValueError`. Real actions of any dtype are
     accepted (float16, longdouble and integers are cast to float64 first).
-    `BearingSLAMDiscrete-v0` has a `Discrete` action space instead (see
+    `BearingSLAMDiscrete-v1` has a `Discrete` action space instead (see
     `BearingSLAMDiscreteEnv`).
 
     ## Observation Space
@@ -271,7 +271,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
 
     ```python
     import gymnasium as gym
-    env = gym.make("bearing_env:BearingSLAM-v0", scenario="khepera", render_mode="rgb_array")
+    env = gym.make("bearing_env:BearingSLAM-v1", scenario="khepera", render_mode="rgb_array")
     ```
 
     - `scenario`: `"random"` (default unless `landmarks` is given; a new layout of
@@ -367,6 +367,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     ## Version History
 
     * v0: Initial version.
+    * v1: the conservative transfer grows regions by a local bound instead of one
+      global radius per movement (bearing_env 0.2.0); `-v0` keeps the old bound
+      (`transfer="conservative_global"`), see `bearing_env.tasks.VERSIONS`.
     """
 
     #: The action kind: its space, decoding and encoding (:mod:`bearing_env.envs.actions`).

@@ -1,4 +1,4 @@
-"""``BearingSLAMDiscrete-v0``: the same task with a discrete set of turns and lengths."""
+"""``BearingSLAMDiscrete-v1``: the same task with a discrete set of turns and lengths."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
     """
     ## Description
 
-    `BearingSLAM-v0` (see `BearingSLAMEnv`, which documents the task, observation,
+    `BearingSLAM-v1` (see `BearingSLAMEnv`, which documents the task, observation,
     rewards, episode end and info) with a discrete action space, for value-based agents
     such as DQN.
 
@@ -59,12 +59,15 @@ class BearingSLAMDiscreteEnv(BearingSLAMEnv):
 
     ```python
     import gymnasium as gym
-    env = gym.make("bearing_env:BearingSLAMDiscrete-v0", scenario="khepera", n_turns=12)
+    env = gym.make("bearing_env:BearingSLAMDiscrete-v1", scenario="khepera", n_turns=12)
     ```
 
     ## Version History
 
     * v0: Initial version.
+    * v1: the conservative transfer grows regions by a local bound instead of one
+      global radius per movement (bearing_env 0.2.0); `-v0` keeps the old bound
+      (`transfer="conservative_global"`), see `bearing_env.tasks.VERSIONS`.
     """
 
     # Its setting attributes, the grid's read-only ones (n_turns, n_move_lengths)

@@ -1,6 +1,6 @@
-"""``BearingSLAM-v0`` as a natively batched vector environment.
+"""``BearingSLAM-v1`` as a natively batched vector environment.
 
-``gym.make_vec("BearingSLAM-v0", num_envs=64, vectorization_mode="vector_entry_point")``
+``gym.make_vec("BearingSLAM-v1", num_envs=64, vectorization_mode="vector_entry_point")``
 returns :class:`BearingSLAMVectorEnv`. It steps the functional core of
 :mod:`bearing_env.envs.core` on all its sub-envs at once; it holds no single-env objects.
 """
@@ -116,6 +116,9 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
     ## Version History
 
     * v0: Initial version.
+    * v1: the conservative transfer grows regions by a local bound instead of one
+      global radius per movement (bearing_env 0.2.0); `-v0` keeps the old bound
+      (`transfer="conservative_global"`), see `bearing_env.tasks.VERSIONS`.
     """
 
     metadata: dict[str, Any] = {  # noqa: RUF012
@@ -582,7 +585,7 @@ class BearingSLAMVectorEnv(VectorEnv[NDArray[np.float32], NDArray[Any], NDArray[
 
 
 class BearingSLAMDiscreteVectorEnv(BearingSLAMVectorEnv):
-    """``BearingSLAMDiscrete-v0`` batched: :class:`BearingSLAMVectorEnv` with the
+    """``BearingSLAMDiscrete-v1`` batched: :class:`BearingSLAMVectorEnv` with the
     :class:`~bearing_env.envs.bearing_slam_discrete.BearingSLAMDiscreteEnv` action space
     (actions are an array of ``num_envs`` discrete action indices)."""
 

@@ -211,7 +211,7 @@ class ManualControl:
     """Play a BearingSLAM env by hand in a pygame window (see the module doc).
 
     Args:
-        env: a ``BearingSLAM-v0`` or ``BearingSLAMDiscrete-v0`` env (wrapped or not) made
+        env: a ``BearingSLAM-v1`` or ``BearingSLAMDiscrete-v1`` env (wrapped or not) made
             with ``render_mode="rgb_array"``; the window shows its frames.
         seed: the first episode's seed; episode ``k`` uses ``seed + k``. None: unseeded.
 
@@ -227,8 +227,8 @@ class ManualControl:
         base = env.unwrapped
         if not isinstance(base, BearingSLAMEnv):
             raise TypeError(
-                f"manual control needs a BearingSLAM env (BearingSLAM-v0 or "
-                f"BearingSLAMDiscrete-v0), got {type(base).__name__}"
+                f"manual control needs a BearingSLAM env (BearingSLAM-v1 or "
+                f"BearingSLAMDiscrete-v1), got {type(base).__name__}"
             )
         if env.render_mode != "rgb_array":
             raise ValueError(

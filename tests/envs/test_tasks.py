@@ -1,6 +1,6 @@
 """The registered tasks (``bearing_env.tasks``): the table and the registry agree, every
 id makes, resets, steps, passes Gymnasium's and SB3's checkers without a warning, and
-makes its batched vector env."""
+makes its batched vector env; every version of an id is registered with its settings."""
 
 from __future__ import annotations
 
@@ -18,10 +18,29 @@ from gymnasium.utils.env_checker import check_env
 from bearing_env.envs.bearing_slam_vector import BearingSLAMVectorEnv
 from bearing_env.envs.config import DEFAULT_MAX_MOVES, EnvConfig
 from bearing_env.registration import ENV_IDS, VECTOR_ENTRY_POINTS, register_envs
-from bearing_env.tasks import BASE_IDS, TASKS, TASKS_BY_ID, TRAINING_TASKS, Task, task_named
+from bearing_env.tasks import (
+    BASE_ID_KINDS,
+    BASE_IDS,
+    HISTORY,
+    OLDER_TASKS,
+    REGISTERED_TASKS_BY_ID,
+    TASKS,
+    TASKS_BY_ID,
+    TRAINING_TASKS,
+    VERSION,
+    VERSIONS,
+    Task,
+    current_id,
+    split_id,
+    task_named,
+)
 from tests.extras import needs
 
 TASK_IDS = [task.id for task in TASKS]
+#: Every registered id: the base ids and the tasks, every version.
+ALL_IDS = sorted([*ENV_IDS, *REGISTERED_TASKS_BY_ID])
+#: The transfer each version's ids resolve to.
+TRANSFER_OF_VERSION = {0: "conservative_global", 1: "conservative"}
 NAME = re.compile(
     r"^(?P<kind>BearingSLAM|BearingSLAMDiscrete)"
     r"-(?P<setting>Khepera|FurnishedRoom|Random(?P<n>\d+))"
@@ -39,9 +58,12 @@ def test_the_table_and_the_registry_agree() -> None:
         if isinstance(spec.entry_point, str) and spec.entry_point.startswith("bearing_env.")
     )
     training_ids = [task.id for task in TRAINING_TASKS]
-    assert registered == sorted([*ENV_IDS, *TASK_IDS, *training_ids])
+    assert registered == ALL_IDS
+    assert sorted(REGISTERED_TASKS_BY_ID) == sorted(
+        [*TASK_IDS, *training_ids, *(task.id for task in OLDER_TASKS)]
+    )
     assert not set(training_ids) & set(TASKS_BY_ID)  # the suite cards the TASKS only
-    for task in (*TASKS, *TRAINING_TASKS):
+    for task in REGISTERED_TASKS_BY_ID.values():
         spec = gym.spec(task.id)
         assert spec.entry_point == ENV_IDS[task.base_id]
         assert spec.vector_entry_point == VECTOR_ENTRY_POINTS[task.base_id]
@@ -49,11 +71,63 @@ def test_the_table_and_the_registry_agree() -> None:
         assert spec.max_episode_steps is None
 
 
-def test_the_base_ids_are_unchanged() -> None:
-    for base in BASE_IDS.values():
+def test_every_task_is_registered_in_every_version() -> None:
+    assert VERSION == max(VERSIONS) == 1 and VERSIONS[VERSION] == {}
+    assert len(HISTORY) == len(VERSIONS)
+    for task in (*TASKS, *TRAINING_TASKS):
+        assert task.version == VERSION and task.base_id == BASE_IDS[task.action_kind]
+        assert [line.split(":")[0] for line in task.history] == [f"v{v}" for v in VERSIONS]
+        for version, added in VERSIONS.items():
+            older = REGISTERED_TASKS_BY_ID[f"{task.name}-v{version}"]
+            assert older == task.at_version(version)
+            assert split_id(older.base_id) == (split_id(task.base_id)[0], version)
+            assert older.kwargs() == {**added, **task.kwargs()}
+            assert older.description == task.description
+            assert older.history == task.history[: version + 1]
+            assert current_id(older.id) == task.id
+            assert current_id(f"bearing_env:{older.id}") == f"bearing_env:{task.id}"
+    assert current_id("CartPole-v1") == "CartPole-v1"
+
+
+def test_the_base_ids_register_their_version_only() -> None:
+    assert sorted(ENV_IDS) == sorted(BASE_ID_KINDS) == [
+        "BearingSLAM-v0", "BearingSLAM-v1", "BearingSLAMDiscrete-v0", "BearingSLAMDiscrete-v1",
+    ]  # fmt: skip
+    assert sorted(BASE_IDS.values()) == ["BearingSLAM-v1", "BearingSLAMDiscrete-v1"]
+    for base in ENV_IDS:
         spec = gym.spec(base)
-        assert spec.kwargs == {} and spec.max_episode_steps is None
+        assert spec.kwargs == VERSIONS[split_id(base)[1]] and spec.max_episode_steps is None
         assert spec.entry_point == ENV_IDS[base]
+        assert current_id(base) == BASE_IDS[BASE_ID_KINDS[base]]
+    assert gym.spec("BearingSLAM-v0").kwargs == {"transfer": "conservative_global"}
+    assert gym.spec("BearingSLAMDiscrete-v1").kwargs == {}
+
+
+@pytest.mark.filterwarnings("ignore:.*is out of date:DeprecationWarning")
+@pytest.mark.parametrize("env_id", ALL_IDS)
+def test_every_id_makes_its_version_with_the_max_moves_spec(env_id: str) -> None:
+    """Every id makes; its transfer is its version's (-v0 the global bound, -v1 the
+    default local one), a keyword overrides it, and the spec reads max_moves."""
+    version = split_id(env_id)[1]
+    env = gym.make(env_id)
+    assert env.unwrapped.config.transfer == TRANSFER_OF_VERSION[version]  # type: ignore[attr-defined]
+    assert env.spec is not None and env.spec.max_episode_steps == DEFAULT_MAX_MOVES
+    assert gym.spec(env_id).max_episode_steps is None
+    env.close()
+    other = "conservative" if version == 0 else "conservative_global"
+    overridden = gym.make(env_id, transfer=other, max_moves=7)
+    assert overridden.unwrapped.config.transfer == other  # type: ignore[attr-defined]
+    assert overridden.spec is not None and overridden.spec.max_episode_steps == 7
+    overridden.close()
+
+
+def test_an_older_version_warns_as_gymnasium_does() -> None:
+    """Gymnasium's own note on an older version: the -v0 ids stay for reproducing."""
+    with pytest.warns(DeprecationWarning, match="BearingSLAM-Khepera-v0 is out of date"):
+        gym.make("BearingSLAM-Khepera-v0").close()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        gym.make("BearingSLAM-Khepera-v1").close()
 
 
 @pytest.mark.parametrize("task", TASKS, ids=TASK_IDS)
@@ -143,7 +217,7 @@ def test_make_vec_builds_the_batched_vector_env_with_the_settings(task_id: str) 
 
 
 def test_a_task_cannot_be_changed_through_its_settings() -> None:
-    task = TASKS_BY_ID["BearingSLAM-Khepera-Outliers-v0"]
+    task = TASKS_BY_ID["BearingSLAM-Khepera-Outliers-v1"]
     with pytest.raises(TypeError):
         task.settings["scenario"] = "random"  # type: ignore[index]
     copied = task.kwargs()
@@ -153,8 +227,14 @@ def test_a_task_cannot_be_changed_through_its_settings() -> None:
 
 
 def test_an_unknown_task_is_named() -> None:
-    assert task_named("bearing_env:BearingSLAM-Random8-v0") is TASKS_BY_ID["BearingSLAM-Random8-v0"]
-    with pytest.raises(ValueError, match=r"'BearingSLAM-Random9-v0'.*BearingSLAM-Khepera-v0"):
-        task_named("BearingSLAM-Random9-v0")
+    assert task_named("bearing_env:BearingSLAM-Random8-v1") is TASKS_BY_ID["BearingSLAM-Random8-v1"]
+    with pytest.raises(ValueError, match=r"'BearingSLAM-Random9-v1'.*BearingSLAM-Khepera-v1"):
+        task_named("BearingSLAM-Random9-v1")
+    with pytest.raises(ValueError, match=r"older version of BearingSLAM-Random8-v1"):
+        task_named("BearingSLAM-Random8-v0")
     with pytest.raises(ValueError, match="base_id"):
         Task("X-v0", "CartPole-v1", {}, "no")
+    with pytest.raises(ValueError, match="base_id"):  # a base id of another version
+        Task("X-v1", "BearingSLAM-v0", {}, "no")
+    with pytest.raises(ValueError, match="versioned id"):
+        split_id("BearingSLAM")
