@@ -5,7 +5,10 @@
 held to the numba step's exact numbers. ``tests/golden/env_steps.json`` holds the hashes;
 ``tests/envs/test_golden_env.py`` compares.
 
-    python -m tests.golden_env [--update]
+    python -m tests.golden_env [--update] [NAME ...]
+
+``--update`` records the hashes of the traces run (all, or the names given) and keeps
+the others' as they were.
 """
 
 from __future__ import annotations
@@ -37,13 +40,18 @@ def recorded() -> dict[str, str]:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--update", action="store_true", help="record the current hashes")
+    parser.add_argument("names", nargs="*", help="traces to run (default: all)")
     args = parser.parse_args(argv)
-    current = {name: exact_hash(name) for name in NAMES}
+    names = args.names or NAMES
+    unknown = sorted(set(names) - set(NAMES))
+    if unknown:
+        parser.error(f"unknown traces {unknown}; the traces are {NAMES}")
+    current = {name: exact_hash(name) for name in names}
     old = recorded() if GOLDEN_FILE.exists() else {}
-    changed = [name for name in NAMES if old.get(name) != current[name]]
-    print(f"{len(NAMES)} traces, {len(changed)} differ: {changed}")
+    changed = [name for name in names if old.get(name) != current[name]]
+    print(f"{len(names)} traces, {len(changed)} differ: {changed}")
     if args.update:
-        GOLDEN_FILE.write_text(json.dumps(current, indent=1, sort_keys=True) + "\n")
+        GOLDEN_FILE.write_text(json.dumps({**old, **current}, indent=1, sort_keys=True) + "\n")
     return 1 if changed and not args.update else 0
 
 

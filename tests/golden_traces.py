@@ -4,10 +4,13 @@ A restructuring must keep behaviour. Each trace runs one setting (an id, a trans
 fusion, a noise model, the vector env in an autoreset mode, or a shipped policy) over
 fixed seeds and hashes every observation, reward, termination, truncation and info (the
 robot's map included) into one sha256. ``tests/golden/traces.json`` holds the hashes
-recorded before a change; ``tests/test_golden_traces.py`` compares.
+recorded before a change; ``tests/test_golden_traces.py`` compares. Every trace runs on
+the ``-v0`` ids (hashes recorded with bearing_env 0.1, which those ids reproduce) and on
+the ``-v1`` ids (:func:`version_traces`).
 
     python -m tests.golden_traces            # print the current hashes, and any changes
-    python -m tests.golden_traces --update   # record them (only for a deliberate change)
+    python -m tests.golden_traces --update NAME ...   # record them (new traces, or a
+                                                      # deliberate change)
 
 Floats are hashed as float32: bit for bit at the observation's own precision, and blind
 to a last-bit difference in a float64 intermediate, which another CPU's fused
@@ -99,10 +102,12 @@ def vector_env_stream(
     envs.close()
 
 
-def policy_stream(spec: str, episodes: int, seed: int, **kwargs: Any) -> Iterator[Any]:
+def policy_stream(
+    env_id: str, spec: str, episodes: int, seed: int, **kwargs: Any
+) -> Iterator[Any]:
     from bearing_env.agents.registry import make_policy
 
-    env = gym.make("BearingSLAM-v0", **kwargs)
+    env = gym.make(env_id, **kwargs)
     policy = make_policy(spec, env)
     for episode in range(episodes):
         policy.reset(seed=seed + episode)
@@ -120,44 +125,59 @@ def policy_stream(spec: str, episodes: int, seed: int, **kwargs: Any) -> Iterato
 KHEPERA = {"scenario": "khepera"}
 FAULTY = {"noise": {"kind": "uniform", "outlier_rate": 0.1, "detection_rate": 0.85}}
 
-#: name -> a function that makes the trace's stream.
-TRACES: dict[str, Callable[[], Iterator[Any]]] = {
-    "continuous-khepera-conservative-intersect": lambda: single_env_stream(
-        "BearingSLAM-v0", 3, 10, **KHEPERA
-    ),
-    "continuous-random-paper-intersect": lambda: single_env_stream(
-        "BearingSLAM-v0", 3, 11, scenario="random", n_landmarks=6, transfer="paper"
-    ),
-    "continuous-random-relaxed-faulty-entities": lambda: single_env_stream(
-        "BearingSLAM-v0", 3, 12, scenario="random", n_landmarks=(3, 8), fusion="relaxed",
-        observation="entities", **FAULTY,
-    ),
-    "continuous-khepera-gaussian-costs-area": lambda: single_env_stream(
-        "BearingSLAM-v0", 2, 13, noise="gaussian", reward="area", path_cost=0.1,
-        move_cost=0.01, **KHEPERA,
-    ),
-    "discrete-khepera-conservative-intersect": lambda: single_env_stream(
-        "BearingSLAMDiscrete-v0", 3, 14, **KHEPERA
-    ),
-    "discrete-random-paper-relaxed-faulty": lambda: single_env_stream(
-        "BearingSLAMDiscrete-v0", 3, 15, scenario="random", n_landmarks=5, transfer="paper",
-        fusion="relaxed", n_turns=12, **FAULTY,
-    ),
-    **{
-        f"vector-{env_id}-{mode}": (
-            lambda env_id=env_id, mode=mode: vector_env_stream(
-                env_id, mode, 45, 16, scenario="random", n_landmarks=(3, 6), max_moves=8,
+def version_traces(version: int) -> dict[str, Callable[[], Iterator[Any]]]:
+    """The traces on the ids of ``version``. The ``-v0`` ones keep their names from before
+    the ids had versions (their hashes were recorded then, on bearing_env 0.1's transfer,
+    which the ``-v0`` ids keep); the others add ``-v<version>`` to them (the vector traces
+    name their id already)."""
+    suffix = "" if version == 0 else f"-v{version}"
+    continuous, discrete = f"BearingSLAM-v{version}", f"BearingSLAMDiscrete-v{version}"
+    return {
+        f"continuous-khepera-conservative-intersect{suffix}": lambda: single_env_stream(
+            continuous, 3, 10, **KHEPERA
+        ),
+        f"continuous-random-paper-intersect{suffix}": lambda: single_env_stream(
+            continuous, 3, 11, scenario="random", n_landmarks=6, transfer="paper"
+        ),
+        f"continuous-random-relaxed-faulty-entities{suffix}": lambda: single_env_stream(
+            continuous, 3, 12, scenario="random", n_landmarks=(3, 8), fusion="relaxed",
+            observation="entities", **FAULTY,
+        ),
+        f"continuous-khepera-gaussian-costs-area{suffix}": lambda: single_env_stream(
+            continuous, 2, 13, noise="gaussian", reward="area", path_cost=0.1,
+            move_cost=0.01, **KHEPERA,
+        ),
+        f"discrete-khepera-conservative-intersect{suffix}": lambda: single_env_stream(
+            discrete, 3, 14, **KHEPERA
+        ),
+        f"discrete-random-paper-relaxed-faulty{suffix}": lambda: single_env_stream(
+            discrete, 3, 15, scenario="random", n_landmarks=5, transfer="paper",
+            fusion="relaxed", n_turns=12, **FAULTY,
+        ),
+        **{
+            f"vector-{env_id}-{mode}": (
+                lambda env_id=env_id, mode=mode: vector_env_stream(
+                    env_id, mode, 45, 16, scenario="random", n_landmarks=(3, 6), max_moves=8,
+                )
             )
-        )
-        for env_id in ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
-        for mode in ("next_step", "same_step", "disabled")
-    },
-    **{
-        f"policy-{spec}": (lambda spec=spec: policy_stream(spec, 2, 17, **KHEPERA))
-        for spec in ("random", "parallax", "greedy", "oracle", "pretrained:ppo_khepera")
-    },
-    "policy-lookahead": lambda: policy_stream("lookahead", 1, 18, max_moves=4, **KHEPERA),
-}
+            for env_id in (continuous, discrete)
+            for mode in ("next_step", "same_step", "disabled")
+        },
+        **{
+            f"policy-{spec}{suffix}": (
+                lambda spec=spec: policy_stream(continuous, spec, 2, 17, **KHEPERA)
+            )
+            for spec in ("random", "parallax", "greedy", "oracle", "pretrained:ppo_khepera")
+        },
+        f"policy-lookahead{suffix}": lambda: policy_stream(
+            continuous, "lookahead", 1, 18, max_moves=4, **KHEPERA
+        ),
+    }
+
+
+#: name -> a function that makes the trace's stream: every trace on the ``-v0`` ids and
+#: again on the ``-v1`` ids.
+TRACES: dict[str, Callable[[], Iterator[Any]]] = {**version_traces(0), **version_traces(1)}
 
 
 def trace_hash(name: str) -> str:
