@@ -260,6 +260,78 @@ def compare_on_ray(results: Mapping[str, Any]) -> str:
     )
 
 
+def transfer_tightness(records: Mapping[str, Any]) -> str:
+    """Single-movement regions against the exact transferred sets, one row per transfer
+    (``benchmarks/results/transfer_tightness_*.json``, ``bearing-env transfer-tightness
+    --transfer T --json``)."""
+    rows = []
+    sentences = []
+    for record in records.values():
+        settings, figures = record["settings"], record["summary"]
+        rows.append(
+            (
+                f"`{settings['transfer']}`",
+                f"{settings['edge_samples']}",
+                f"{figures['regions']}",
+                f"{figures['ratio_median']:.3g}\u00d7",
+                f"{figures['ratio_p95']:.3g}\u00d7",
+                f"{figures['ratio_max']:.3g}\u00d7",
+                f"{figures['ratio_to_reference_median']:.3g}\u00d7",
+                f"{100 * figures['contains_both']:.1f}%",
+            )
+        )
+        sentences.append(
+            measured_sentence(
+                record["measured"],
+                f"benchmarks/results/transfer_tightness_{settings['transfer']}.json",
+            )
+        )
+    first = next(iter(records.values()))["settings"]
+    header = (
+        "transfer", "samples per edge", "regions", "area \u00f7 exact, median", "95th pct",
+        "max", "area \u00f7 dense hull, median", "hold E and the hull",
+    )  # fmt: skip
+    return (
+        " ".join(sentences)
+        + f" Layouts {', '.join(first['layouts'])}; E on a {first['resolution']}\u00d7"
+        f"{first['resolution']} grid; the dense hull uses {first['reference_samples_per_edge']}"
+        " samples per edge.\n\n" + markdown_table(header, rows)
+    )
+
+
+def transfer_fused_area(summaries: Mapping[str, Any]) -> str:
+    """The fused total area after 10 and 20 moves under each transfer, per policy, from
+    comparisons on the same episodes (``docs/compare/results/transfer_*.json``, copies of
+    ``bearing-env compare``'s ``summary.json``); the last row's ratio is to the first."""
+    from bearing_env.train.compare.task_cards import config_of
+
+    configs = {name: config_of(summary) for name, summary in summaries.items()}
+    names = list(summaries)
+    base = names[0]
+    rows = []
+    for label in summaries[base]["policies"]:
+        for moves in ("10", "20"):
+            medians = [summaries[n]["policies"][label]["area_after"][moves]["median"] for n in names]
+            means = [summaries[n]["policies"][label]["area_after"][moves]["mean"] for n in names]
+            rows.append(
+                (
+                    label,
+                    moves,
+                    *(f"{median:.4g}" for median in medians),
+                    f"{medians[-1] / medians[0]:.3f}",
+                    f"{means[-1] / means[0]:.3f}",
+                )
+            )
+    columns = [f"`{configs[n].env_id.rpartition(':')[2]}`, median" for n in names]
+    header = ("policy", "after moves", *columns, "median ratio", "mean ratio")
+    config = configs[base]
+    return (
+        f"Total area of the fused map, {config.episodes} evaluation episodes per policy "
+        f"(seeds {config.seeds[0]}..{config.seeds[-1]}, the same for every id):\n\n"
+        + markdown_table(header, rows)
+    )
+
+
 def _blocks() -> dict[str, Block]:
     from bearing_env.train.compare import task_cards
     from bearing_env.train.studies import figures, observability, robust_eval
@@ -289,6 +361,10 @@ def _blocks() -> dict[str, Block]:
         ),
         "robust-eval": Block(robust_eval.RESULTS_FILE, robust_eval.markdown_robust_eval),
         "compare-on-ray": Block("benchmarks/results/bench_compare.json", compare_on_ray),
+        "transfer-tightness": Block(
+            "benchmarks/results/transfer_tightness_*.json", transfer_tightness
+        ),
+        "transfer-fused-area": Block("docs/compare/results/transfer_*.json", transfer_fused_area),
     }
 
 
