@@ -311,8 +311,9 @@ def transfer_fused_area(summaries: Mapping[str, Any]) -> str:
     rows = []
     for label in summaries[base]["policies"]:
         for moves in ("10", "20"):
-            medians = [summaries[n]["policies"][label]["area_after"][moves]["median"] for n in names]
-            means = [summaries[n]["policies"][label]["area_after"][moves]["mean"] for n in names]
+            after = [summaries[n]["policies"][label]["area_after"][moves] for n in names]
+            medians = [entry["median"] for entry in after]
+            means = [entry["mean"] for entry in after]
             rows.append(
                 (
                     label,
@@ -356,9 +357,7 @@ def _blocks() -> dict[str, Block]:
         "khepera-25cm": Block("docs/compare/results/khepera_25cm.json", compare_medians),
         "other-settings": Block("docs/compare/results/settings_*.json", compare_settings),
         "lookahead": Block("docs/compare/results/lookahead.json", compare_outcomes),
-        "observability": Block(
-            observability.RESULTS_FILES, observability.markdown_observability
-        ),
+        "observability": Block(observability.RESULTS_FILES, observability.markdown_observability),
         "robust-eval": Block(robust_eval.RESULTS_FILE, robust_eval.markdown_robust_eval),
         "compare-on-ray": Block("benchmarks/results/bench_compare.json", compare_on_ray),
         "transfer-tightness": Block(
