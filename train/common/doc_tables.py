@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from bearing_env.tasks import versioned_id
 from bearing_env.train.common.cli_parser import command_parser
 from bearing_env.train.common.provenance import measured_sentence
 
@@ -326,8 +327,14 @@ def transfer_fused_area(summaries: Mapping[str, Any]) -> str:
     columns = [f"`{configs[n].env_id.rpartition(':')[2]}`, median" for n in names]
     header = ("policy", "after moves", *columns, "median ratio", "mean ratio")
     config = configs[base]
+    sentences = [
+        measured_sentence(summary["measured"], f"docs/compare/results/{name}.json")
+        for name, summary in summaries.items()
+        if "measured" in summary
+    ]
     return (
-        f"Total area of the fused map, {config.episodes} evaluation episodes per policy "
+        "".join(f"{sentence} " for sentence in sentences)
+        + f"Total area of the fused map, {config.episodes} evaluation episodes per policy "
         f"(seeds {config.seeds[0]}..{config.seeds[-1]}, the same for every id):\n\n"
         + markdown_table(header, rows)
     )
@@ -339,7 +346,8 @@ def _blocks() -> dict[str, Block]:
 
     bench = "benchmarks/results/bench_env.json"
     report = "bearing_env.benchmarks.bench_report"
-    khepera = "docs/tasks/results/BearingSLAM-Khepera-v0.json"
+    # The Khepera task's card, in the current version.
+    khepera = f"docs/tasks/results/{versioned_id('BearingSLAM-Khepera')}.json"
     return {
         "bench-machine": Block(bench, f"{report}:markdown_machine"),
         "bench-goals": Block(bench, f"{report}:markdown_goals"),
