@@ -63,13 +63,13 @@ def test_the_generalist_plays_an_episode_with_no_env_given() -> None:
 @pytest.mark.parametrize(
     ("name", "env_id", "env_kwargs", "differing"),
     [
-        ("ppo_generalist", "BearingSLAM-v0", {"scenario": "khepera"},
+        ("ppo_generalist", "BearingSLAM-v1", {"scenario": "khepera"},
          {"observation", "max_landmarks", "scenario"}),
-        ("ppo_khepera", "BearingSLAM-v0", {}, {"scenario"}),
-        ("ppo_khepera", "BearingSLAMDiscrete-v0", {"scenario": "khepera"}, {"action"}),
-        ("ppo_random", "BearingSLAM-v0", {"scenario": "random", "n_landmarks": (4, 8)},
+        ("ppo_khepera", "BearingSLAM-v1", {}, {"scenario"}),
+        ("ppo_khepera", "BearingSLAMDiscrete-v1", {"scenario": "khepera"}, {"action"}),
+        ("ppo_random", "BearingSLAM-v1", {"scenario": "random", "n_landmarks": (4, 8)},
          {"max_landmarks"}),
-        ("ppo_khepera", "BearingSLAM-v0", {"scenario": "khepera", "move_length": 0.25},
+        ("ppo_khepera", "BearingSLAM-v1", {"scenario": "khepera", "move_length": 0.25},
          {"move_length"}),
     ],
 )  # fmt: skip
@@ -92,7 +92,7 @@ def test_an_env_of_another_task_is_refused_naming_the_settings(
 
 def test_the_generalist_message_reads_as_documented() -> None:
     with pytest.raises(TaskMismatchError) as refused:
-        SB3Policy.pretrained("ppo_generalist", gym.make("BearingSLAM-v0", scenario="khepera"))
+        SB3Policy.pretrained("ppo_generalist", gym.make("BearingSLAM-v1", scenario="khepera"))
     assert str(refused.value) == (
         "model 'ppo_generalist' was trained on another task than this env: "
         "observation 'entities' (env: 'flat'), max_landmarks 16 (env: 8), "
@@ -179,7 +179,7 @@ def test_an_exported_model_reads_the_record_beside_it(tmp_path: Path) -> None:
     assert policy.task == ModelTask("BearingSLAM-v0", {"scenario": "khepera"}, "mine", "mine.json")
     env = policy.make_env()
     with pytest.raises(TaskMismatchError, match=r"^model 'mine' .* scenario 'khepera' \(env"):
-        SB3Policy(gym.make("BearingSLAM-v0"), model)
+        SB3Policy(gym.make("BearingSLAM-v1"), model)
     observation, info = env.reset(seed=0)
     assert env.action_space.contains(policy.act(observation, info))
     env.close()
@@ -193,7 +193,7 @@ def test_a_model_without_a_record_checks_spaces_in_a_short_message(tmp_path: Pat
     with pytest.raises(ValueError, match="has no record of its task"):
         policy.make_env()
     with pytest.raises(ModelLoadError) as refused:
-        SB3Policy(gym.make("BearingSLAM-v0"), model)
+        SB3Policy(gym.make("BearingSLAM-v1"), model)
     message = str(refused.value)
     assert_short(message)
     assert "expects observations Dict(landmarks: Box(128,), robot: Box(9,))" in message

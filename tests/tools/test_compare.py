@@ -44,7 +44,7 @@ OUTPUT_FILES = (
 def small_config(episodes: int = 4, **overrides: Any) -> CompareConfig:
     settings: dict[str, Any] = {
         "policies": policies_from_specs(["random", "greedy"]),
-        "env_id": "BearingSLAM-v0",
+        "env_id": "BearingSLAM-v1",
         "env_kwargs": dict(SMALL_ENV),
         "episodes": episodes,
         "bootstrap": 200,
@@ -233,7 +233,7 @@ def test_command_line_runs_and_resumes(tmp_path: Path, capsys: pytest.CaptureFix
         "random",
         "parallax",
         "--env",
-        "BearingSLAMDiscrete-v0",
+        "BearingSLAMDiscrete-v1",
         "--env-kwargs",
         "scenario=khepera",
         "max_moves=3",
@@ -443,15 +443,15 @@ def test_the_report_gives_the_worst_case_from_the_logged_episodes(tmp_path: Path
     assert "area10_p90" in (tmp_path / "summary.csv").read_text().splitlines()[0]
 
 
-ROOM = "bearing_env:BearingSLAM-FurnishedRoom-v0"
+ROOM = "bearing_env:BearingSLAM-FurnishedRoom-v1"
 
 
 @pytest.mark.parametrize(
     ("env", "arguments", "expected", "scenario"),
     [
         (ROOM, [], {}, "furnished_room"),
-        ("bearing_env:BearingSLAM-Khepera-Camera180-v0", [], {}, "khepera"),
-        ("bearing_env:BearingSLAM-v0", [], {"scenario": "khepera"}, "khepera"),
+        ("bearing_env:BearingSLAM-Khepera-Camera180-v1", [], {}, "khepera"),
+        ("bearing_env:BearingSLAM-v1", [], {"scenario": "khepera"}, "khepera"),
         (ROOM, ["--env-kwargs", "max_moves=5"], {"max_moves": 5}, "furnished_room"),
     ],
 )

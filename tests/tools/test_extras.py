@@ -134,7 +134,7 @@ def test_compare_quick_with_every_extra_includes_the_shipped_model(tmp_path: Pat
     import_or_skip("stable_baselines3")
     from bearing_env.train.compare.cli import shipped_policies
 
-    assert shipped_policies("bearing_env:BearingSLAM-v0", {"scenario": "khepera"}) == [
+    assert shipped_policies("bearing_env:BearingSLAM-v1", {"scenario": "khepera"}) == [
         "pretrained:ppo_khepera"
     ]
 
@@ -174,7 +174,7 @@ def test_the_generalisation_script_without_the_train_extra_says_to_install_it(
 
 def test_rendering_without_pygame_names_the_render_extra(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "pygame", None)
-    env = gym.make("BearingSLAM-v0", scenario="khepera", render_mode="rgb_array")
+    env = gym.make("BearingSLAM-v1", scenario="khepera", render_mode="rgb_array")
     try:
         env.reset(seed=0)
         with pytest.raises(MissingExtraError) as error:
@@ -191,7 +191,7 @@ def test_a_shipped_model_without_sb3_names_the_train_extra(
     from bearing_env.agents import SB3Policy
 
     monkeypatch.setitem(sys.modules, "stable_baselines3", None)
-    with gym.make("BearingSLAM-v0", scenario="khepera") as env:
+    with gym.make("BearingSLAM-v1", scenario="khepera") as env:
         with pytest.raises(MissingExtraError) as error:
             SB3Policy.pretrained("ppo_khepera", env)
     assert error.value.extra == "train"

@@ -28,7 +28,7 @@ from bearing_env.train.compare.suite import (
 )
 from tests.extras import needs
 
-TWO_TASKS = ("BearingSLAM-Khepera-v0", "BearingSLAMDiscrete-Khepera-v0")
+TWO_TASKS = ("BearingSLAM-Khepera-v1", "BearingSLAMDiscrete-Khepera-v1")
 
 
 def quick_args(out: Path, docs: Path, *extra: str) -> list[str]:
@@ -86,7 +86,7 @@ def test_quick_suite_on_two_tasks_writes_the_cards_and_the_index(
     assert sorted(links(index)) == sorted(f"{task_id}.md" for task_id in TWO_TASKS)
     glance = index.split("## Baselines at a glance", 1)[1]
     assert all(task_id in glance for task_id in TWO_TASKS)
-    assert "BearingSLAM-Random8-v0" not in glance
+    assert "BearingSLAM-Random8-v1" not in glance
 
 
 def test_an_interrupted_suite_resumes_where_it_stopped(tmp_path: Path) -> None:
@@ -149,28 +149,28 @@ def test_shipped_models_run_on_the_task_they_were_trained_on() -> None:
     # ppo_khepera's record names the base id and the scenario; ppo_furnished_room's names
     # the task's own id (its settings come from the task table).
     shipped = {
-        "BearingSLAM-Khepera-v0": ["pretrained:ppo_khepera"],
-        "BearingSLAM-FurnishedRoom-v0": ["pretrained:ppo_furnished_room"],
+        "BearingSLAM-Khepera-v1": ["pretrained:ppo_khepera"],
+        "BearingSLAM-FurnishedRoom-v1": ["pretrained:ppo_furnished_room"],
     }
     for task in TASKS:
         assert task_models(task) == shipped.get(task.id, []), task.id
     configs = dict(suite_configs(build_parser().parse_args([])))
-    khepera = configs[TASKS_BY_ID["BearingSLAM-Khepera-v0"]]
+    khepera = configs[TASKS_BY_ID["BearingSLAM-Khepera-v1"]]
     assert list(khepera.policies) == [
         "random_polygonal", "parallax", "greedy_one_step", "lookahead", "ppo_khepera",
     ]  # fmt: skip
     assert khepera.policies["ppo_khepera"] == "pretrained:name='ppo_khepera'"
     assert khepera.episodes == 50 and khepera.env_kwargs == {}
-    random8 = configs[TASKS_BY_ID["BearingSLAM-Random8-v0"]]
+    random8 = configs[TASKS_BY_ID["BearingSLAM-Random8-v1"]]
     assert list(random8.policies.values()) == list(DEFAULT_POLICIES)  # no shipped model
     assert [task.id for task in configs] == [task.id for task in TASKS]
 
 
 def test_bad_input_is_named(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as exited:
-        main(["--tasks", "BearingSLAM-Random9-v0", "--out", str(tmp_path)])
+        main(["--tasks", "BearingSLAM-Random9-v1", "--out", str(tmp_path)])
     assert exited.value.code == 2
-    assert "'BearingSLAM-Random9-v0'" in capsys.readouterr().err
+    assert "'BearingSLAM-Random9-v1'" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["--episodes", "0", "--out", str(tmp_path)])
     assert "--episodes" in capsys.readouterr().err
@@ -206,7 +206,7 @@ def test_the_index_keeps_the_rows_of_tasks_this_run_did_not_compare(tmp_path: Pa
     which a later run on some of the tasks leaves in place for the others."""
     from bearing_env.train.compare.task_cards import INDEX_NAME, card_name, write_index
 
-    first, second, uncarded = (TASKS_BY_ID[t] for t in (*TWO_TASKS, "BearingSLAM-Random8-v0"))
+    first, second, uncarded = (TASKS_BY_ID[t] for t in (*TWO_TASKS, "BearingSLAM-Random8-v1"))
     docs, scratch = tmp_path / "docs", tmp_path / "scratch"
     docs.mkdir()
     scratch.mkdir()
@@ -230,7 +230,7 @@ def test_the_index_keeps_the_rows_of_tasks_this_run_did_not_compare(tmp_path: Pa
     write_index(TASKS, docs)
     glance = (docs / INDEX_NAME).read_text().split("## Baselines at a glance", 1)[1]
     table = [line for line in glance.splitlines() if line.startswith("|")]
-    rows = {line.split("|")[1].strip(): line for line in table if "-v0" in line}
+    rows = {line.split("|")[1].strip(): line for line in table if "-v1" in line}
     assert set(rows) == {first.id, second.id}  # no card, no row
     header = table[0]
     columns = [cell.strip() for cell in header.strip("|").split("|")]

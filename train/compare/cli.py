@@ -18,8 +18,10 @@ through a separate stream (``bearing_env.agents.base.policy_rng``).
 
 A ``pretrained:NAME`` model runs on the task it was trained on (its record, see
 :mod:`bearing_env.agents.model_task`): without ``--env-kwargs`` the comparison runs on
-that task; env kwargs of another task (or models of different tasks) are refused in one
-line naming the settings that differ, with exit status 2.
+that task, in its id's current version (a model trained on ``BearingSLAM-v0`` runs on
+``BearingSLAM-v1`` with its env kwargs, :func:`~bearing_env.tasks.current_id`); env
+kwargs of another task (or models of different tasks) are refused in one line naming
+the settings that differ, with exit status 2.
 
 Outputs (in ``--out``):
 
@@ -68,7 +70,7 @@ from typing import Any
 
 from bearing_env.agents.model_task import ModelTask, TaskMismatchError, setting_differences
 from bearing_env.extras import DISTRIBUTIONS, install_command
-from bearing_env.tasks import REGISTERED_TASKS_BY_ID
+from bearing_env.tasks import REGISTERED_TASKS_BY_ID, current_id
 from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import (
     COUNT,
@@ -148,7 +150,7 @@ def _add_episode_options(group: argparse._ArgumentGroup) -> None:
         default=None,
         metavar="KEY=VALUE",
         help="env kwargs (default: the task of the pretrained:NAME models in --policies, "
-        "else none for a task id such as BearingSLAM-FurnishedRoom-v0, else scenario=khepera)",
+        "else none for a task id such as BearingSLAM-FurnishedRoom-v1, else scenario=khepera)",
     )
     group.add_argument(
         "--episodes",
@@ -244,10 +246,13 @@ def _add_statistics_options(group: argparse._ArgumentGroup) -> None:
 def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
     """Specs of the shipped models trained on this env's task: the same action kind and the
     same resolved settings (the id's registered kwargs, then the env kwargs), so a model
-    trained on ``BearingSLAM-Khepera-v0`` matches ``BearingSLAM-v0`` with
+    trained on ``BearingSLAM-Khepera-v1`` matches ``BearingSLAM-v1`` with
     ``scenario="khepera"``.
 
-    ``max_moves`` is ignored: it only sets how long an episode runs.
+    ``max_moves`` is ignored: it only sets how long an episode runs. An id of an older
+    version counts as its current one (:func:`~bearing_env.tasks.current_id`), on both
+    sides: a model trained on ``BearingSLAM-v0`` with ``scenario="khepera"`` matches
+    ``BearingSLAM-Khepera-v1``.
     """
     import gymnasium as gym
 
@@ -255,7 +260,7 @@ def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
 
     def task_of(env_id: str, kwargs: dict[str, Any]) -> tuple[bool, object] | None:
         settings = {key: value for key, value in kwargs.items() if key != "max_moves"}
-        task = ModelTask(env_id.rpartition(":")[2], settings)
+        task = ModelTask(current_id(env_id.rpartition(":")[2]), settings)
         try:
             return task.discrete, task.config
         except (ValueError, TypeError, gym.error.Error):
@@ -335,7 +340,7 @@ def config_from_args(args: argparse.Namespace) -> tuple[CompareConfig, Path]:
         env_kwargs = parse_key_values(args.env_kwargs, "--env-kwargs")
     elif task is not None:
         env_kwargs = dict(task.env_kwargs)
-        env_id = task.env_id if args.env == DEFAULT_ENV_ID else args.env
+        env_id = current_id(task.env_id) if args.env == DEFAULT_ENV_ID else args.env
     if args.quick:
         env_kwargs.setdefault("max_moves", QUICK_MAX_MOVES)
     policies = args.policies or [

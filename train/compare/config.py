@@ -15,7 +15,7 @@ from bearing_env.train.common.seeds import EVAL_SEED_START, evaluation_seeds
 
 #: Evaluation episodes per policy.
 DEFAULT_EPISODES = 200
-DEFAULT_ENV_ID = "bearing_env:BearingSLAM-v0"
+DEFAULT_ENV_ID = "bearing_env:BearingSLAM-v1"
 
 DEFAULT_ENV_KWARGS: dict[str, Any] = {"scenario": "khepera"}
 

@@ -15,7 +15,7 @@ the episodes its logs lack and ends with the results an uninterrupted run gives.
 Policies: ``random`` (the paper's random polygonal trajectories), ``parallax``,
 ``greedy`` and ``lookahead``, and every model shipped in ``agents/pretrained/`` whose
 training settings are the task's (its env id's action kind and its resolved env settings,
-less ``max_moves``).
+less ``max_moves``; a model trained on an older version of an id runs on its current one).
 
 Docs (``--docs``, default ``docs/tasks``): one card per finished task,
 ``<task id>.md`` (observation, action, reward, episode end, settings, the baseline tables
@@ -23,7 +23,7 @@ with bootstrap CIs, a rendered frame and the area plot, next to it as PNGs) and 
 task table ``index.md`` (:mod:`~bearing_env.train.compare.task_cards`).
 
     bearing-env suite --episodes 50
-    bearing-env suite --quick --tasks BearingSLAM-Khepera-v0 BearingSLAM-Random8-v0
+    bearing-env suite --quick --tasks BearingSLAM-Khepera-v1 BearingSLAM-Random8-v1
 """
 
 from __future__ import annotations
@@ -38,7 +38,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from bearing_env.tasks import REGISTERED_TASKS_BY_ID, TASKS, TASKS_BY_ID, Task, task_named
+from bearing_env.tasks import (
+    REGISTERED_TASKS_BY_ID,
+    TASKS,
+    TASKS_BY_ID,
+    Task,
+    current_id,
+    task_named,
+)
 from bearing_env.train.common.cli_parser import add_no_progress, command_parser
 from bearing_env.train.common.cli_values import COUNT, NON_NEGATIVE
 from bearing_env.train.common.errors import exit_on_output_errors, fail, missing_extra
@@ -81,7 +88,9 @@ _PROCESS_ONLY_OPTIONS = ("--workers", "--stop-after")
 def task_models(task: Task) -> list[str]:
     """``pretrained:NAME`` specs of the shipped models trained on this task's settings:
     the same action kind and the same resolved :class:`EnvConfig` (``max_moves`` aside:
-    it only sets how long an episode runs)."""
+    it only sets how long an episode runs), an id of an older version taken as its
+    current one (:func:`~bearing_env.tasks.current_id`: a model trained on
+    ``BearingSLAM-v0`` with ``scenario="khepera"`` runs on ``BearingSLAM-Khepera-v1``)."""
     from bearing_env.agents import pretrained_names, pretrained_record
     from bearing_env.envs.config import EnvConfig
 
@@ -92,7 +101,7 @@ def task_models(task: Task) -> list[str]:
     specs = []
     for name in pretrained_names():
         record = pretrained_record(name)
-        trained_on = str(record.get("env_id", "")).rpartition(":")[2]
+        trained_on = current_id(str(record.get("env_id", "")).rpartition(":")[2])
         settings = dict(record.get("env_kwargs", {}))
         if trained_on in REGISTERED_TASKS_BY_ID:  # trained on a task's id: its settings first
             settings = {**REGISTERED_TASKS_BY_ID[trained_on].kwargs(), **settings}

@@ -421,6 +421,36 @@ def task_sections(
     ]
 
 
+def shipped_models_text(task: Task, config: CompareConfig) -> str:
+    """`` Shipped models: `NAME` was trained on `ID` with `k=v, ...`.`` for the
+    ``pretrained:NAME`` policies of a comparison (from their records), saying when that
+    id is another version of the task's; empty without such a policy."""
+    from bearing_env.agents import pretrained_record
+    from bearing_env.agents.registry import parse_policy_spec
+    from bearing_env.tasks import split_id
+
+    parts = []
+    for label, spec in config.policies.items():
+        parsed = parse_policy_spec(spec)
+        if parsed.kind != "pretrained":
+            continue
+        record = pretrained_record(str(parsed.options["name"]))
+        env_id = str(record.get("env_id", "")).rpartition(":")[2]
+        kwargs = ", ".join(
+            f"{key}={json.dumps(value)}" for key, value in record.get("env_kwargs", {}).items()
+        )
+        text = f"`{label}` was trained on `{env_id}`" + (f" with `{kwargs}`" if kwargs else "")
+        with contextlib.suppress(ValueError):
+            version = split_id(env_id)[1]
+            if version != task.version:
+                text += (
+                    f" (a `-v{version}` id, evaluated here on `-v{task.version}`: see the "
+                    "version history)"
+                )
+        parts.append(text)
+    return f" Shipped models: {'; '.join(parts)}." if parts else ""
+
+
 def baselines_section(task: Task, config: CompareConfig, summary: Mapping[str, Any]) -> list[str]:
     """The card's lines on the baselines: how they ran, their area and outcome tables."""
     seeds = config.seeds
@@ -440,7 +470,8 @@ def baselines_section(task: Task, config: CompareConfig, summary: Mapping[str, A
         f"{policies}. Total area: the sum of the region areas of L3, L4, ... (FL units², "
         "|L1 - L2| = 1), each capped at `area_cap`, which also counts for a landmark not "
         "yet initialised; lower is better. Confidence intervals: 95% percentile bootstrap "
-        f"of the mean ({config.bootstrap} resamples, seed {config.bootstrap_seed}).",
+        f"of the mean ({config.bootstrap} resamples, seed {config.bootstrap_seed})."
+        + shipped_models_text(task, config),
         "",
         "Mean total area [95% bootstrap CI] after n moves:",
         "",
