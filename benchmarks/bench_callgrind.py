@@ -13,7 +13,7 @@ inside one native entry point (``--toggle-collect``):
 - ``update``: ``bearing::slam::update_maps``, called by ``PolygonSLAM.update`` on the
   readings of ``bench-slam`` (4 landmarks, epsilon 2 degrees), per transfer;
 - ``step``: ``bearing::env::step_rows``, the whole native env step (moves, readings, map
-  update, rewards, observation and info arrays), on ``BearingSLAM-Khepera-v0`` with
+  update, rewards, observation and info arrays), on ``BearingSLAM-Khepera-v1`` with
   seeded random actions.
 
 Each figure is the instruction count (callgrind's Ir) divided by the movements or steps,
@@ -65,7 +65,7 @@ import gymnasium as gym
 import numpy as np
 import bearing_env
 steps = int(sys.argv[1])
-env = gym.make("BearingSLAM-Khepera-v0").unwrapped
+env = gym.make("BearingSLAM-Khepera-v1").unwrapped
 env.reset(seed=0)
 rng = np.random.default_rng(0)
 for _ in range(steps):
@@ -161,7 +161,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     counted = count(STEP_DRIVER, ENTRY_POINTS["step"], [str(args.steps)])
     per = counted["instructions"] / args.steps
     results["step_khepera"] = {**counted, "count": args.steps, "per_call": per}
-    print(f"BearingSLAM-Khepera-v0 env step (native part):   {per:12,.0f} instructions per step")
+    print(f"BearingSLAM-Khepera-v1 env step (native part):   {per:12,.0f} instructions per step")
     if args.json is not None:
         record = {"measured": measured_here("bearing-env bench-callgrind", arguments),
                   "counts": results}  # fmt: skip

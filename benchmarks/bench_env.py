@@ -1,5 +1,5 @@
 """``bearing-env bench``, the command line: env, vector env and PPO throughput of
-BearingSLAM-v0 against CartPole-v1, in one run. The figures are measured by
+BearingSLAM-v1 against CartPole-v1, in one run. The figures are measured by
 :mod:`~bearing_env.benchmarks.bench_timing` and reported (targets, JSON, table) by
 :mod:`~bearing_env.benchmarks.bench_report`.
 
@@ -18,7 +18,7 @@ the start reference.
 
 Sections:
 
-- ``single``: one env, ``gym.make("BearingSLAM-v0", ...).unwrapped``, actions from a
+- ``single``: one env, ``gym.make("BearingSLAM-v1", ...).unwrapped``, actions from a
   seeded generator, ``reset()`` at the end of each episode (resets count in the time, not
   as steps). The Khepera scenario, and the random scenario with 4, 16 and 64 landmarks
   (``max_landmarks = n``). One more row steps the Khepera env through ``gym.make``'s
@@ -36,7 +36,7 @@ Sections:
 - ``slam``: ``PolygonSLAM.update`` alone (:mod:`bearing_env.benchmarks.bench_slam`'s readings), both
   transfers, 4 and 64 landmarks.
 - ``startup``: whole fresh processes, timed from before their start to their exit: one
-  imports bearing_env, makes ``BearingSLAM-Khepera-v0``, resets and steps it once; the
+  imports bearing_env, makes ``BearingSLAM-Khepera-v1``, resets and steps it once; the
   other runs the same script on CartPole-v1 without importing bearing_env. They run
   alternately, five timed pairs after an untimed one (which writes the bytecode caches),
   with empty HOME and XDG_CACHE_HOME folders; the figure is the ratio of the medians. The
@@ -45,7 +45,7 @@ Sections:
 - ``planning``: ``agents.GreedyOneStep``'s planning time per move (its ``act()``, which
   scores 16 candidate moves on copies of the map), Khepera scenario, the median over the
   moves of several episodes. Seconds, not a ratio.
-- ``ppo``: SB3 ``PPO`` with the shipped ``ppo.yml``'s settings for BearingSLAM-v0
+- ``ppo``: SB3 ``PPO`` with the shipped ``ppo.yml``'s settings for BearingSLAM-v1
   (VecNormalize included) on ``--ppo-envs`` envs built by
   ``bearing_env.train.sb3.training_envs.make_training_env``
   for each vec env kind (batched, subproc with spawn, dummy). The rate is env steps per
@@ -57,7 +57,7 @@ Sections:
   SubprocVecEnv the median of the per-round ratios, so that a machine whose speed drifts
   during the run favours no kind.
 - ``throughput``: the table in EnvPool's and gymnax's format, rows = ``--counts`` sub-envs
-  (default 1, 64, 256, 1024), columns = CartPole-v1 steps/s, BearingSLAM-v0 steps/s (the
+  (default 1, 64, 256, 1024), columns = CartPole-v1 steps/s, BearingSLAM-v1 steps/s (the
   batched env) and their ratio, random actions sampled up front, each pair measured back
   to back; then PPO on ``--ppo-envs`` batched envs against the same SB3 PPO (the same
   hyperparameters) on CartPole-v1 in a DummyVecEnv, in ``--ppo-rounds`` interleaved rounds.
@@ -72,7 +72,7 @@ b. batched env, 64 sub-envs (Khepera, 4 landmarks): total env steps/s >= 50% of
 c. 64 landmarks at >= 1/16 of the 4-landmark single-env rate;
 d. PPO on the batched env >= 2x the env steps/s of PPO on SubprocVecEnv, same n_envs;
 e. ``PolygonSLAM.update``, 4 landmarks, conservative: >= 50% of CartPole-v1's step rate;
-f. a fresh process that imports bearing_env, makes BearingSLAM-Khepera-v0 and steps once
+f. a fresh process that imports bearing_env, makes BearingSLAM-Khepera-v1 and steps once
    takes <= 1.5x the same script on CartPole-v1 (no bearing_env import), side by side;
 g. ``GreedyOneStep`` plans a move in <= 0.5 ms (median);
 h. PPO on 16 batched envs >= 0.7x the env steps/s of the same SB3 PPO on CartPole-v1,
@@ -161,12 +161,12 @@ def _int_list(
 
 
 def _check_env_kwargs(env_kwargs: dict[str, Any]) -> None:
-    """Build (and close) one BearingSLAM-v0 env with ``env_kwargs``: an unknown or bad
+    """Build (and close) one BearingSLAM-v1 env with ``env_kwargs``: an unknown or bad
     kwarg fails now, in one line, not after minutes of measurements."""
     import gymnasium as gym
 
     try:
-        gym.make("BearingSLAM-v0", **env_kwargs).close()
+        gym.make("BearingSLAM-v1", **env_kwargs).close()
     except (TypeError, ValueError) as error:
         raise ValueError(f"--env-kwargs: {error}") from None
 
@@ -174,7 +174,7 @@ def _check_env_kwargs(env_kwargs: dict[str, Any]) -> None:
 def build_parser() -> argparse.ArgumentParser:
     parser = command_parser(
         "bearing-env bench",
-        "BearingSLAM-v0 single-env, vector-env and PPO throughput, each as a ratio "
+        "BearingSLAM-v1 single-env, vector-env and PPO throughput, each as a ratio "
         "to CartPole-v1 steps/s measured in the same run; printed as a table and written to "
         "JSON. (The world-model update() benchmark: bearing-env bench --slam.)",
     )
@@ -390,7 +390,7 @@ def run(settings: Settings) -> dict[str, Any]:
         log("[slam] PolygonSLAM.update alone")
         results["slam"] = bench_slam_updates(bench)
     if "startup" in settings.sections:
-        log("[startup] fresh processes, start to exit: BearingSLAM-Khepera-v0 vs CartPole-v1")
+        log("[startup] fresh processes, start to exit: BearingSLAM-Khepera-v1 vs CartPole-v1")
         results["startup"] = bench_startup(QUICK_STARTUP_RUNS if settings.quick else STARTUP_RUNS)
     if "planning" in settings.sections:
         log("[planning] GreedyOneStep.act on Khepera")

@@ -30,7 +30,7 @@ DEFAULT_JSON = Path("outputs") / "bench_env.json"
 #: 2: no ``fallback`` fields (targets, vector and PPO rows), no ``measured_with`` (PPO
 #: rows) and no ``settings.vector_entry_point``: the batched env always exists, so nothing
 #: falls back. (The format-1 files under ``benchmarks/results/`` carry them, all false.)
-#: 3: the startup section times whole fresh processes of BearingSLAM-Khepera-v0 against
+#: 3: the startup section times whole fresh processes of BearingSLAM-Khepera-v1 against
 #: the same script on CartPole-v1 (:func:`~bearing_env.benchmarks.bench_timing.bench_startup`:
 #: ``ratio_to_cartpole``, ``numba_imported``, ...); formats 1 and 2 timed the first step
 #: alone (``warm_first_step_s``, ``cold_first_step_s``), which :func:`startup_section`
@@ -43,7 +43,7 @@ TARGETS: dict[str, str] = {
     "c": "single env, 64 landmarks >= 1/16 of the 4-landmark rate",
     "d": "PPO on the batched env >= 2x PPO on SubprocVecEnv (same n_envs)",
     "e": "PolygonSLAM.update, 4 landmarks, conservative: >= 50% of CartPole-v1",
-    "f": "a fresh process that imports bearing_env, makes BearingSLAM-Khepera-v0 and steps "
+    "f": "a fresh process that imports bearing_env, makes BearingSLAM-Khepera-v1 and steps "
     "once: <= 1.5x the same script with CartPole-v1 (no bearing_env import), side by side",
     "g": "GreedyOneStep planning per move (median): <= 0.5 ms",
     "h": "PPO on 16 batched envs >= 0.7x the same SB3 PPO on CartPole-v1 "
@@ -407,7 +407,7 @@ def plain_table(
 THROUGHPUT_HEADER: tuple[str, ...] = (
     "sub-envs",
     "CartPole-v1 steps/s",
-    "BearingSLAM-v0 steps/s",
+    "BearingSLAM-v1 steps/s",
     "ratio",
 )
 THROUGHPUT_NUMERIC = frozenset({1, 2, 3})
@@ -448,7 +448,7 @@ def throughput_notes(section: dict[str, Any]) -> list[str]:
     """What the throughput table's ratio and PPO row mean."""
     lines = [
         "",
-        "ratio: BearingSLAM-v0 (batched BearingSLAMVectorEnv, vector_entry_point) / CartPole-v1 "
+        "ratio: BearingSLAM-v1 (batched BearingSLAMVectorEnv, vector_entry_point) / CartPole-v1 "
         "with the same number of sub-envs, measured back to back; actions sampled up front.",
     ]
     ppo = section["ppo"]
@@ -456,7 +456,7 @@ def throughput_notes(section: dict[str, Any]) -> list[str]:
         lines.append(section["ppo_note"])
     else:
         lines.append(
-            f"PPO: SB3 PPO, ppo.yml's BearingSLAM-v0 settings on {ppo['n_envs']} batched envs and "
+            f"PPO: SB3 PPO, ppo.yml's BearingSLAM-v1 settings on {ppo['n_envs']} batched envs and "
             f"on CartPole-v1 ({ppo['cartpole']['kind']} vec env, the same hyperparameters); "
             f"the median of {len(ppo['bearing_slam']['rounds'])} interleaved rounds, the ratio "
             f"the median of the per-round ratios (target >= {TARGET_THRESHOLDS['h']:g})."
@@ -530,7 +530,7 @@ GOAL_NAMES: dict[str, str] = {
     "c": "single env, 64 landmarks ÷ 4 landmarks",
     "d": "PPO on the batched env ÷ PPO on `SubprocVecEnv` (16 envs)",
     "e": "`PolygonSLAM.update`, 4 landmarks, conservative",
-    "f": "fresh process: import, make `BearingSLAM-Khepera-v0`, one step ÷ the same with "
+    "f": "fresh process: import, make `BearingSLAM-Khepera-v1`, one step ÷ the same with "
     "CartPole-v1",
     "g": "`GreedyOneStep` planning per move (median)",
     "h": "PPO on the batched env ÷ PPO on CartPole-v1 (16 envs)",
@@ -662,7 +662,7 @@ def startup_text(results: dict[str, Any], markdown: bool = False) -> str:
 def markdown_throughput(results: dict[str, Any]) -> str:
     """The throughput section in EnvPool's and gymnax's format."""
     section = results["throughput"]
-    header = ("sub-envs", "CartPole-v1 steps/s", "BearingSLAM-v0 steps/s", "ratio")
+    header = ("sub-envs", "CartPole-v1 steps/s", "BearingSLAM-v1 steps/s", "ratio")
     return _markdown(header, throughput_rows(section))
 
 

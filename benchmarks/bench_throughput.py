@@ -3,7 +3,7 @@ steps/s with random actions for 1, 64, 256 and 1024 sub-envs, each next to CartP
 stepped with as many sub-envs in the same run, and PPO training steps/s on the batched env
 next to SB3 PPO on CartPole-v1 with the same hyperparameters and number of envs.
 
-- Env steps: ``gym.make_vec("BearingSLAM-v0", num_envs=N, vectorization_mode=
+- Env steps: ``gym.make_vec("BearingSLAM-v1", num_envs=N, vectorization_mode=
   "vector_entry_point")`` (the batched ``BearingSLAMVectorEnv``) against
   ``gym.make_vec("CartPole-v1", num_envs=N, ...)`` with Gymnasium's own batched
   ``CartPoleVectorEnv`` (``vector_entry_point``; a ``SyncVectorEnv`` if the installed
@@ -12,7 +12,7 @@ next to SB3 PPO on CartPole-v1 with the same hyperparameters and number of envs.
   env is warmed up for :data:`WARMUP_FRACTION` of ``--seconds`` first. Rates count env
   transitions summed over the sub-envs: in NEXT_STEP autoreset mode (both envs' default)
   the reset-only sub-step after an episode's end is timed but not counted.
-- PPO: SB3 ``PPO`` with ``ppo.yml``'s BearingSLAM-v0 settings (VecNormalize included) on
+- PPO: SB3 ``PPO`` with ``ppo.yml``'s BearingSLAM-v1 settings (VecNormalize included) on
   ``--ppo-envs`` batched envs (``make_training_env``'s ``batched`` kind) and, with the
   same settings (n_steps, batch_size, n_epochs, policy and net_arch, learning rate, ...),
   on CartPole-v1 in a ``DummyVecEnv`` of as many envs, timed in interleaved rounds
@@ -112,7 +112,7 @@ def bench_env_steps(
     bench: Bench, counts: Sequence[int], env_kwargs: dict[str, Any]
 ) -> list[dict[str, Any]]:
     """For each N in ``counts``: CartPole-v1 with N sub-envs, then the batched
-    BearingSLAM-v0 env with N sub-envs, and the ratio of their rates."""
+    BearingSLAM-v1 env with N sub-envs, and the ratio of their rates."""
     cartpole_mode = cartpole_vectorization_mode()
     rows: list[dict[str, Any]] = []
     for num_envs in counts:
@@ -137,7 +137,7 @@ def bench_env_steps(
         )
         log(
             f"  throughput {num_envs:5d} envs: CartPole-v1 {cartpole_figure['steps_per_s']:12,.0f}"
-            f"  BearingSLAM-v0 {bearing_figure['steps_per_s']:12,.0f} steps/s ({ratio:.3f})"
+            f"  BearingSLAM-v1 {bearing_figure['steps_per_s']:12,.0f} steps/s ({ratio:.3f})"
         )
     return rows
 
@@ -150,7 +150,7 @@ def bench_ppo_against_cartpole(
     overrides: dict[str, Any],
     rounds: int,
 ) -> dict[str, Any]:
-    """PPO on ``n_envs`` batched BearingSLAM-v0 envs and on CartPole-v1 (DummyVecEnv, the
+    """PPO on ``n_envs`` batched BearingSLAM-v1 envs and on CartPole-v1 (DummyVecEnv, the
     same hyperparameters), in interleaved rounds; their rows and the median round ratio."""
     runs: list[PPORun] = []
     try:
@@ -168,7 +168,7 @@ def bench_ppo_against_cartpole(
         for run in runs:
             run.close()
     ratio = median_round_ratio(runs[0], runs[1])
-    log(f"  throughput PPO: BearingSLAM-v0 / CartPole-v1 = {ratio:.3f} (median round)")
+    log(f"  throughput PPO: BearingSLAM-v1 / CartPole-v1 = {ratio:.3f} (median round)")
     return {
         "n_envs": n_envs,
         "bearing_slam": bearing_row,

@@ -1,4 +1,4 @@
-"""The timing of ``bearing-env bench``: every measured figure of BearingSLAM-v0 (single
+"""The timing of ``bearing-env bench``: every measured figure of BearingSLAM-v1 (single
 env, batched vector env, world model, a fresh process's start-up, planning, PPO training) and the
 CartPole-v1 reference each figure is divided by. What each section measures is in
 :mod:`bearing_env.benchmarks.bench_env`'s docstring.
@@ -25,7 +25,7 @@ from gymnasium.vector import AutoresetMode
 from bearing_env.benchmarks.bench_slam import cartpole_steps_per_second
 from bearing_env.train.common.cli_values import json_safe
 
-ENV_ID = "BearingSLAM-v0"
+ENV_ID = "BearingSLAM-v1"
 SECTIONS: tuple[str, ...] = (
     "single",
     "vector",
@@ -54,7 +54,7 @@ STARTUP_RUNS = 5
 #: The same with --quick.
 QUICK_STARTUP_RUNS = 1
 #: The env the startup section's fresh processes make and step.
-STARTUP_ENV_ID = "BearingSLAM-Khepera-v0"
+STARTUP_ENV_ID = "BearingSLAM-Khepera-v1"
 
 
 def log(message: str) -> None:
@@ -315,7 +315,7 @@ def process_seconds(script: str, environment: dict[str, str]) -> tuple[float, bo
 
 
 def bench_startup(runs: int = STARTUP_RUNS) -> dict[str, Any]:
-    """Time whole fresh processes (start to exit) that make and step BearingSLAM-Khepera-v0,
+    """Time whole fresh processes (start to exit) that make and step BearingSLAM-Khepera-v1,
     and the same script on CartPole-v1 without bearing_env, alternately, ``runs`` pairs
     after one untimed pair (which writes the bytecode caches; its bearing_env run, from
     empty HOME and XDG_CACHE_HOME folders, is kept as the cold figure)."""
@@ -590,8 +590,8 @@ def build_ppo_run(
 ) -> PPORun:
     """Build PPO on one vec env kind and warm it up (one rollout and one update).
 
-    ``env_id`` other than BearingSLAM-v0 (CartPole-v1 in the throughput section) trains
-    that env, with its default kwargs, on BearingSLAM-v0's hyperparameters."""
+    ``env_id`` other than BearingSLAM-v1 (CartPole-v1 in the throughput section) trains
+    that env, with its default kwargs, on BearingSLAM-v1's hyperparameters."""
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
 

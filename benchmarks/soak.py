@@ -12,7 +12,7 @@ action space.
 
     python -m bearing_env.benchmarks.soak --steps 1000000
     bearing-env soak --steps 20000 --seed 3
-    bearing-env soak --steps 100000 --task BearingSLAM-FurnishedRoom-v0
+    bearing-env soak --steps 100000 --task BearingSLAM-FurnishedRoom-v1
     bearing-env soak --steps 100000 --fusion robust
 
 With ``--task`` every configuration is that registered task as it is (its noise must be
@@ -50,7 +50,7 @@ from bearing_env.train.common.errors import exit_on_output_errors
 from bearing_env.train.common.files import write_json_atomically
 from bearing_env.train.common.progress import progress_bar
 
-IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
+IDS = ("BearingSLAM-v1", "BearingSLAMDiscrete-v1")
 
 
 @dataclass
@@ -202,7 +202,7 @@ def make_parser() -> argparse.ArgumentParser:
         "--task",
         type=_task_id,
         default=None,
-        help="soak this registered task only, e.g. BearingSLAM-FurnishedRoom-v0 "
+        help="soak this registered task only, e.g. BearingSLAM-FurnishedRoom-v1 "
         "(default: random configurations)",
     )
     parser.add_argument(

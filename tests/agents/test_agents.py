@@ -33,7 +33,7 @@ from bearing_env.agents.vector import VectorPolicy
 from bearing_env.slam import world_to_fl
 from tests.extras import needs
 
-ENV_IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
+ENV_IDS = ("BearingSLAM-v1", "BearingSLAMDiscrete-v1")
 HEURISTICS = (RandomPolygonal, Parallax, GreedyOneStep, GreedyOracle, Lookahead, LookaheadOracle)
 #: Policies that must act on the robot's knowledge only.
 ROBOT_POLICIES = (RandomPolygonal, Parallax, GreedyOneStep, Lookahead)
@@ -81,7 +81,7 @@ def test_policy_runs_full_episodes(env_id: str, policy_class: type) -> None:
 
 @pytest.mark.parametrize("policy_class", HEURISTICS, ids=lambda c: c.__name__)
 def test_policy_runs_on_random_layouts_with_more_landmarks(policy_class: type) -> None:
-    env = gym.make("BearingSLAM-v0", n_landmarks=6, max_moves=5, max_episode_steps=5)
+    env = gym.make("BearingSLAM-v1", n_landmarks=6, max_moves=5, max_episode_steps=5)
     _, info, moves = play(env, policy_class(env), seed=11)
     success = bool(np.all(info["landmark_area"] <= env.unwrapped.target_area))
     assert moves == 5 or (moves < 5 and success)
@@ -89,14 +89,14 @@ def test_policy_runs_on_random_layouts_with_more_landmarks(policy_class: type) -
 
 @pytest.mark.parametrize("policy_class", HEURISTICS, ids=lambda c: c.__name__)
 def test_policy_is_deterministic_for_a_seed(policy_class: type) -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=6, max_episode_steps=6)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", max_moves=6, max_episode_steps=6)
     first, _, _ = play(env, policy_class(env), seed=5)
     second, _, _ = play(env, policy_class(env), seed=5)
     assert same_actions(first, second)
 
 
 def test_random_polygonal_lengths_are_configurable() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera", move_length=(0.1, 0.3))
+    env = gym.make("BearingSLAM-v1", scenario="khepera", move_length=(0.1, 0.3))
     codec = ActionCodec(env)
     fixed = RandomPolygonal(env, length=0.2)
     fixed.reset(seed=0)
@@ -116,7 +116,7 @@ def test_random_polygonal_lengths_are_configurable() -> None:
 def test_policy_rng_is_independent_of_the_env_stream() -> None:
     # The env seeds default_rng(seed); a policy on the same stream would turn in step
     # with the noise. Its first turn must not be the env's first uniform draw.
-    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    env = gym.make("BearingSLAM-v1", scenario="khepera")
     policy = RandomPolygonal(env)
     policy.reset(seed=42)
     observation, info = env.reset(seed=42)
@@ -125,15 +125,15 @@ def test_policy_rng_is_independent_of_the_env_stream() -> None:
 
 
 def test_greedy_candidate_sets() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    env = gym.make("BearingSLAM-v1", scenario="khepera")
     assert len(GreedyOneStep(env).candidates) == 16  # 8 turns x 2 lengths
     assert len(GreedyOneStep(env, n_turns=16, lengths=1).candidates) == 16
-    discrete = gym.make("BearingSLAMDiscrete-v0", scenario="khepera")
+    discrete = gym.make("BearingSLAMDiscrete-v1", scenario="khepera")
     # The table's 8 turns x its 2 longest lengths; lengths=3 is the whole table.
     assert len(GreedyOneStep(discrete).candidates) == 16
     every = GreedyOneStep(discrete, lengths=3).candidates
     assert sorted(c.action for c in every) == list(range(discrete.action_space.n))
-    fixed = gym.make("BearingSLAM-v0", scenario="khepera", move_length=0.25)
+    fixed = gym.make("BearingSLAM-v1", scenario="khepera", move_length=0.25)
     assert len(GreedyOneStep(fixed).candidates) == 8  # equal lengths are one candidate
 
 
@@ -221,7 +221,7 @@ def test_robot_policies_never_touch_the_world_or_info(env_id: str, policy_class:
 
 @pytest.mark.parametrize("policy_class", ROBOT_POLICIES, ids=lambda c: c.__name__)
 def test_corrupting_the_truth_does_not_change_robot_policies(policy_class: type) -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=10, max_episode_steps=10)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", max_moves=10, max_episode_steps=10)
     rng = np.random.default_rng(0)
     for seed in (1, 2):
         reference, _, _ = play(env, policy_class(env), seed)
@@ -234,7 +234,7 @@ def test_corrupting_the_truth_does_not_change_robot_policies(policy_class: type)
 @pytest.mark.parametrize("oracle_class", ORACLES, ids=lambda c: c.__name__)
 def test_the_oracle_does_read_the_truth(oracle_class: type) -> None:
     # The swap above is a real test: the privileged oracles' choices do change with it.
-    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=6, max_episode_steps=6)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", max_moves=6, max_episode_steps=6)
     assert oracle_class.privileged and not GreedyOneStep.privileged and not Lookahead.privileged
     reference, _, _ = play(env, oracle_class(env), seed=1)
     rng = np.random.default_rng(0)
@@ -248,7 +248,7 @@ def test_the_oracle_does_read_the_truth(oracle_class: type) -> None:
 
 def test_a_poisoned_info_does_fail_on_ground_truth() -> None:
     # The whitelist above is a real test: reading any other key of it fails.
-    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    env = gym.make("BearingSLAM-v1", scenario="khepera")
     _, info = env.reset(seed=0)
     poisoned = PoisonedInfo(info)
     assert poisoned["robot_map"] is info["robot_map"]
@@ -311,7 +311,7 @@ def test_no_phantom_landmarks_when_the_count_varies(seed: int) -> None:
     # One reader, built once, for episodes of 3 to 8 landmarks: the count is read from
     # each observation's present flags (it used to be fixed at build time, which gave
     # phantom landmarks at bearing 0 in the empty slots).
-    env = gym.make("BearingSLAM-v0", n_landmarks=(3, 8))
+    env = gym.make("BearingSLAM-v1", n_landmarks=(3, 8))
     reader = ObservationReader(env)
     counts = set()
     for episode in range(6):
@@ -350,7 +350,7 @@ def test_triangulation_in_the_robot_frame() -> None:
 
 
 def test_greedy_belief_tracks_the_true_pose_and_scale() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=10, max_episode_steps=10)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", max_moves=10, max_episode_steps=10)
     policy = GreedyOneStep(env)
     base = env.unwrapped
     position_errors, heading_errors = [], []
@@ -384,7 +384,7 @@ def test_greedy_belief_tracks_the_true_pose_and_scale() -> None:
 
 
 def test_codec_round_trips_continuous_actions() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera", move_length=(0.1, 0.3))
+    env = gym.make("BearingSLAM-v1", scenario="khepera", move_length=(0.1, 0.3))
     codec = ActionCodec(env)
     for turn, length in ((0.0, 0.1), (1.0, 0.2), (-2.5, 0.3), (math.pi - 1e-3, 0.25)):
         action = codec.encode(turn, length)
@@ -401,7 +401,7 @@ def base_decode(env: gym.Env, action: Any) -> tuple[float, float]:
 
 
 def test_codec_maps_to_the_nearest_discrete_action() -> None:
-    env = gym.make("BearingSLAMDiscrete-v0", scenario="khepera")
+    env = gym.make("BearingSLAMDiscrete-v1", scenario="khepera")
     codec = ActionCodec(env)
     table_turns = env.unwrapped.turn_angles
     table_lengths = env.unwrapped.move_lengths
@@ -416,7 +416,7 @@ def test_codec_maps_to_the_nearest_discrete_action() -> None:
 
 
 def test_policy_specs_parse_and_build() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    env = gym.make("BearingSLAM-v1", scenario="khepera")
     spec = parse_policy_spec("greedy:n_turns=12,lengths=(0.2, 0.3),label=g12")
     assert spec.kind == "greedy" and spec.options == {"n_turns": 12, "lengths": (0.2, 0.3)}
     assert spec.label == "g12"
@@ -455,7 +455,7 @@ def tiny_ppo(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("ppo")
     venv = VecNormalize(
         make_vec_env(
-            "BearingSLAM-v0", n_envs=1, seed=0, env_kwargs={"scenario": "khepera", "max_moves": 5}
+            "BearingSLAM-v1", n_envs=1, seed=0, env_kwargs={"scenario": "khepera", "max_moves": 5}
         ),
         norm_reward=False,
     )
@@ -480,7 +480,7 @@ def tiny_dqn(tmp_path_factory: pytest.TempPathFactory) -> Path:
     from stable_baselines3 import DQN
 
     folder = tmp_path_factory.mktemp("dqn")
-    env = gym.make("BearingSLAMDiscrete-v0", scenario="khepera", max_moves=5, max_episode_steps=5)
+    env = gym.make("BearingSLAMDiscrete-v1", scenario="khepera", max_moves=5, max_episode_steps=5)
     model = DQN(
         "MlpPolicy",
         env,
@@ -497,7 +497,7 @@ def tiny_dqn(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @needs("train")
 def test_sb3_policy_runs_episodes_with_its_vecnormalize(tiny_ppo: Path) -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=6, max_episode_steps=6)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", max_moves=6, max_episode_steps=6)
     policy = SB3Policy(env, tiny_ppo)
     assert policy.algo == "PPO"
     assert policy.vecnormalize_path == tiny_ppo.parent / "vecnormalize.pkl"
@@ -519,7 +519,7 @@ def test_sb3_policy_runs_episodes_with_its_vecnormalize(tiny_ppo: Path) -> None:
 
 @needs("train")
 def test_sb3_policy_runs_a_dqn_on_the_discrete_id(tiny_dqn: Path) -> None:
-    env = gym.make("BearingSLAMDiscrete-v0", scenario="khepera", max_moves=5, max_episode_steps=5)
+    env = gym.make("BearingSLAMDiscrete-v1", scenario="khepera", max_moves=5, max_episode_steps=5)
     policy = SB3Policy(env, tiny_dqn.with_suffix(""))  # SB3-style path without .zip
     assert policy.algo == "DQN" and policy.obs_normalizer is None
     actions, _, moves = play(env, policy, seed=0)
@@ -528,7 +528,7 @@ def test_sb3_policy_runs_a_dqn_on_the_discrete_id(tiny_dqn: Path) -> None:
 
 @needs("train")
 def test_sb3_policy_load_errors(tiny_ppo: Path, tmp_path: Path) -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    env = gym.make("BearingSLAM-v1", scenario="khepera")
     with pytest.raises(FileNotFoundError, match="not found"):
         SB3Policy(env, tmp_path / "missing.zip")
     with pytest.raises(FileNotFoundError, match="no SB3 model in directory"):
@@ -557,10 +557,10 @@ def test_sb3_policy_load_errors(tiny_ppo: Path, tmp_path: Path) -> None:
     wrong_stats.write_bytes(pickle.dumps({"not": "vecnormalize"}))
     with pytest.raises(ModelLoadError, match="not VecNormalize"):
         SB3Policy(env, tiny_ppo, vecnormalize=wrong_stats)
-    discrete = gym.make("BearingSLAMDiscrete-v0", scenario="khepera")
+    discrete = gym.make("BearingSLAMDiscrete-v1", scenario="khepera")
     with pytest.raises(ModelLoadError, match="outputs actions"):
         SB3Policy(discrete, tiny_ppo)
-    wide = gym.make("BearingSLAM-v0", scenario="khepera", max_landmarks=10)
+    wide = gym.make("BearingSLAM-v1", scenario="khepera", max_landmarks=10)
     with pytest.raises(ModelLoadError, match="expects observations"):
         SB3Policy(wide, tiny_ppo)
     assert issubclass(ModelLoadError, ValueError)
@@ -596,8 +596,8 @@ def test_vector_policy_acts_like_one_policy_per_sub_env(env_id: str, policy_clas
 
 def test_vector_policy_runs_on_varying_counts_and_sync_vector_envs() -> None:
     for vector_env in (
-        gym.make_vec("BearingSLAM-v0", num_envs=2, n_landmarks=(3, 8), max_moves=4),
-        gym.make_vec("BearingSLAM-v0", num_envs=2, vectorization_mode="sync", scenario="khepera"),
+        gym.make_vec("BearingSLAM-v1", num_envs=2, n_landmarks=(3, 8), max_moves=4),
+        gym.make_vec("BearingSLAM-v1", num_envs=2, vectorization_mode="sync", scenario="khepera"),
     ):
         policy = VectorPolicy(vector_env, GreedyOneStep)
         observations, infos = vector_env.reset(seed=1)
@@ -605,7 +605,7 @@ def test_vector_policy_runs_on_varying_counts_and_sync_vector_envs() -> None:
         for _ in range(9):  # through an autoreset
             observations, _, _, _, infos = vector_env.step(policy.act(observations, infos))
     with pytest.raises(TypeError, match="VectorEnv"):
-        VectorPolicy(gym.make("BearingSLAM-v0"), GreedyOneStep)  # type: ignore[arg-type]
+        VectorPolicy(gym.make("BearingSLAM-v1"), GreedyOneStep)  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
@@ -634,7 +634,7 @@ def test_policies_act_alike_on_the_entity_observation(env_id: str, policy_class:
 def test_lookahead_of_depth_one_in_one_world_is_the_greedy_planner() -> None:
     # One move ahead, scored at the estimates only, over GreedyOneStep's candidates: the
     # same decisions (the search is a generalisation, not a different rule).
-    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=10, max_episode_steps=10)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", max_moves=10, max_episode_steps=10)
     for seed in (2, 5):
         greedy, _, _ = play(env, GreedyOneStep(env), seed)
         one_step, _, _ = play(env, Lookahead(env, depth=1, hypotheses=1, n_turns=8), seed)
@@ -642,7 +642,7 @@ def test_lookahead_of_depth_one_in_one_world_is_the_greedy_planner() -> None:
 
 
 def test_lookahead_options_and_planning_times() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=5, max_episode_steps=5)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", max_moves=5, max_episode_steps=5)
     policy = Lookahead(env, depth=3, width=4, n_turns=12, lengths=2, hypotheses=3)
     assert len(policy.candidates) == 24
     _, _, moves = play(env, policy, seed=4)
@@ -663,7 +663,7 @@ def test_lookahead_options_and_planning_times() -> None:
 
 
 def test_hypotheses_change_the_plans_and_follow_the_seed() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=8, max_episode_steps=8)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", max_moves=8, max_episode_steps=8)
     single, _, _ = play(env, Lookahead(env, hypotheses=1), seed=6)
     first, _, _ = play(env, Lookahead(env, hypotheses=4), seed=6)
     again, _, _ = play(env, Lookahead(env, hypotheses=4), seed=6)
@@ -687,7 +687,7 @@ def test_the_planner_scores_moves_with_the_potential_the_env_rewards(reward: str
     from bearing_env.agents.heuristics import GreedyOneStep
     from bearing_env.agents.planning import uncertainty_potential
 
-    env = gym.make("BearingSLAM-v0", scenario="khepera", reward=reward)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", reward=reward)
     env.reset(seed=5)
     env.action_space.seed(5)
     planner = GreedyOneStep(env)

@@ -50,7 +50,7 @@ CONFIG_FIELDS = ("extractor_class", "policy_class", "conf_file", "kind")
 
 def entity_batch(max_landmarks: int, seeds: range) -> dict[str, torch.Tensor]:
     env = gym.make(
-        "BearingSLAM-v0", n_landmarks=(3, 6), max_landmarks=max_landmarks, observation="entities"
+        "BearingSLAM-v1", n_landmarks=(3, 6), max_landmarks=max_landmarks, observation="entities"
     )
     env.action_space.seed(0)
     robots, tables = [], []
@@ -65,7 +65,7 @@ def entity_batch(max_landmarks: int, seeds: range) -> dict[str, torch.Tensor]:
 
 @pytest.mark.parametrize("extractor_class", EXTRACTORS)
 def test_features_ignore_the_order_of_rows_and_the_padding(extractor_class: type) -> None:
-    space = gym.make("BearingSLAM-v0", max_landmarks=8, observation="entities").observation_space
+    space = gym.make("BearingSLAM-v1", max_landmarks=8, observation="entities").observation_space
     torch.manual_seed(0)
     extractor = extractor_class(space, hidden=16, features_dim=8).eval()
     batch = entity_batch(8, range(4))
@@ -88,7 +88,7 @@ def test_features_ignore_the_order_of_rows_and_the_padding(extractor_class: type
 
 @pytest.mark.parametrize("extractor_class", EXTRACTORS)
 def test_extractor_refuses_the_flat_observation(extractor_class: type) -> None:
-    flat = gym.make("BearingSLAM-v0").observation_space
+    flat = gym.make("BearingSLAM-v1").observation_space
     with pytest.raises(
         TypeError, match=f"{extractor_class.__name__} needs .*observation='entities'"
     ):
@@ -101,7 +101,7 @@ def test_extractor_refuses_a_table_of_another_kind(
     extractor_class: type, kind: str, told: str
 ) -> None:
     # 8 slots: 88 shape values are also 11 rows of 8, so the row size alone would pass.
-    space = gym.make("BearingSLAM-v0", max_landmarks=8, observation=kind).observation_space
+    space = gym.make("BearingSLAM-v1", max_landmarks=8, observation=kind).observation_space
     with pytest.raises(ValueError, match=f"not rows of {table_width(told)} columns"):
         extractor_class(space, hidden=16, features_dim=8, observation=told)
     with pytest.raises(ValueError, match=r"observation must be one of .*got 'flat'"):
@@ -110,7 +110,7 @@ def test_extractor_refuses_a_table_of_another_kind(
 
 
 def test_attention_heads_must_divide_the_width() -> None:
-    space = gym.make("BearingSLAM-v0", observation="entities").observation_space
+    space = gym.make("BearingSLAM-v1", observation="entities").observation_space
     with pytest.raises(
         ValueError, match=r"hidden \(10\) must be a positive multiple of heads \(4\)"
     ):
@@ -118,7 +118,7 @@ def test_attention_heads_must_divide_the_width() -> None:
 
 
 def test_attention_features_of_an_empty_table_are_finite() -> None:
-    space = gym.make("BearingSLAM-v0", max_landmarks=8, observation="entities").observation_space
+    space = gym.make("BearingSLAM-v1", max_landmarks=8, observation="entities").observation_space
     torch.manual_seed(0)
     extractor = LandmarkAttentionExtractor(space, hidden=16, features_dim=8).eval()
     batch = entity_batch(8, range(2))
@@ -163,7 +163,7 @@ def test_a_tiny_run_trains_and_its_model_plays_other_landmark_counts(
     assert type(result.model.policy.features_extractor) is extractor_class
     for count in (3, 16):
         env = gym.make(
-            "BearingSLAM-v0",
+            "BearingSLAM-v1",
             n_landmarks=count,
             max_landmarks=16,
             observation=kind,

@@ -17,7 +17,7 @@ from bearing_env.agents.visibility import travel_until
 
 from .test_agents import PoisonedWorld, play, play_with_truth_swapped, same_actions
 
-CAMERA180 = "bearing_env:BearingSLAM-Khepera-Camera180-v0"
+CAMERA180 = "bearing_env:BearingSLAM-Khepera-Camera180-v1"
 #: Evaluation episodes of the 180 degree task (compare's seeds) where the old bootstrap
 #: maps no landmark in 20 moves and the hypothesised worlds map both.
 SEEDS_WHERE_IT_HELPS = (1_000_000, 1_000_002, 1_000_004, 1_000_009)
@@ -40,14 +40,14 @@ def _final_total_area(env: gym.Env, policy: Any, seed: int) -> float:
 def test_the_panoramic_planners_plan_no_hypothesised_worlds() -> None:
     """With the paper's camera and no obstacles nothing of the new path is built (the
     golden traces check that the moves are the same as before)."""
-    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    env = gym.make("BearingSLAM-v1", scenario="khepera")
     for policy in (GreedyOneStep(env), Lookahead(env)):
         assert policy.before_map is None
         assert not policy.avoid_bumps
     limited = gym.make(CAMERA180)
     assert GreedyOneStep(limited).before_map is not None
     assert GreedyOneStep(limited, bootstrap_worlds=0).before_map is None
-    room = gym.make("bearing_env:BearingSLAM-FurnishedRoom-v0")
+    room = gym.make("bearing_env:BearingSLAM-FurnishedRoom-v1")
     assert GreedyOneStep(room).avoid_bumps
 
 

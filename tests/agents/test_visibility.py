@@ -16,7 +16,7 @@ from bearing_env.agents.visibility import BearingMemory, VisibilityPredictor, ke
 
 
 def _predictor(**settings: object) -> VisibilityPredictor:
-    return VisibilityPredictor(gym.make("BearingSLAM-v0", scenario="khepera", **settings))
+    return VisibilityPredictor(gym.make("BearingSLAM-v1", scenario="khepera", **settings))
 
 
 def test_the_panoramic_camera_predicts_everything_seen() -> None:
@@ -79,7 +79,7 @@ def test_keep_in_view_prefers_turns_that_keep_l1_and_l2_in_view() -> None:
 
 
 def test_a_forward_camera_looks_around_then_turns_toward_l1_and_l2() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera", field_of_view_deg=90)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", field_of_view_deg=90)
     codec = ActionCodec(env)
     half_fov = math.radians(45)
     view = ObservationView(0.1, False, False, np.zeros(4), np.zeros(4, dtype=bool))
@@ -106,7 +106,7 @@ def test_planners_change_frames_with_a_forward_camera(
     policy: type[GreedyOneStep] | type[Parallax],
 ) -> None:
     """Over a few episodes they find L1 and L2 and keep them in view over moves."""
-    env = gym.make("bearing_env:BearingSLAM-Khepera-Camera90-v0", sensor_info=True)
+    env = gym.make("bearing_env:BearingSLAM-Khepera-Camera90-v1", sensor_info=True)
     agent = policy(env)
     frames = 0
     for seed in range(1_000_000, 1_000_005):  # the first evaluation episodes of compare
@@ -127,7 +127,7 @@ def test_the_oracles_true_sensor_misses_what_the_camera_cannot_see() -> None:
     from bearing_env.agents.env_access import world_of
     from bearing_env.agents.visibility import TrueSensor
 
-    env = gym.make("bearing_env:BearingSLAM-Khepera-Camera90-v0")
+    env = gym.make("bearing_env:BearingSLAM-Khepera-Camera90-v1")
     env.reset(seed=4)
     world = world_of(env)
     sensor = TrueSensor(world)
@@ -153,7 +153,7 @@ def test_the_oracles_true_moves_stop_at_the_furniture_as_the_env_does() -> None:
     from bearing_env.agents.env_access import world_of
     from bearing_env.agents.visibility import TrueSensor
 
-    env = gym.make("bearing_env:BearingSLAM-FurnishedRoom-v0")
+    env = gym.make("bearing_env:BearingSLAM-FurnishedRoom-v1")
     codec = ActionCodec(env)
     blocked = 0
     for seed in range(6):

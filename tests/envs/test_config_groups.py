@@ -78,7 +78,7 @@ def test_create_routes_each_keyword_to_its_group() -> None:
     [
         (lambda: EnvConfig.create(epsilon_degrees=2.0), r"'epsilon_degrees'.*'epsilon_deg'"),
         (lambda: BearingSLAMEnv(max_move=3), r"'max_move'.*'max_moves'"),
-        (lambda: gym.make("BearingSLAM-v0", zzz=1), r"'zzz'"),
+        (lambda: gym.make("BearingSLAM-v1", zzz=1), r"'zzz'"),
         (lambda: BearingSLAMVectorEnv(2, landmark_count=4), r"'landmark_count'"),
     ],
 )

@@ -30,19 +30,15 @@ from bearing_env.envs.bearing_slam import (
     observation_size,
     observation_slices,
 )
+from bearing_env.registration import ENV_IDS as ALL_BASE_IDS
 from bearing_env.registration import register_envs
 from bearing_env.slam.batch import RELAXED_STATE_ARRAYS, ROBUST_STATE_ARRAYS, STATE_ARRAYS
-from bearing_env.tasks import REGISTERED_TASKS_BY_ID
+from bearing_env.tasks import BASE_IDS, REGISTERED_TASKS_BY_ID
 from tests.extras import needs
 
-#: The base ids, one per action kind (the task ids built on them: tests/envs/test_tasks.py).
-ENV_IDS = sorted(
-    spec.id
-    for spec in gym.registry.values()
-    if isinstance(spec.entry_point, str)
-    and spec.entry_point.startswith("bearing_env.")
-    and spec.id not in REGISTERED_TASKS_BY_ID
-)
+#: The current base ids, one per action kind (the task ids built on them and the older
+#: versions: tests/envs/test_tasks.py).
+ENV_IDS = sorted(BASE_IDS.values())
 INFO_KEYS = {
     "landmark_area",
     "landmark_error",
@@ -59,7 +55,7 @@ INFO_KEYS = {
 
 
 def test_both_ids_are_registered_without_a_time_limit() -> None:
-    assert ENV_IDS == ["BearingSLAM-v0", "BearingSLAMDiscrete-v0"]
+    assert ENV_IDS == ["BearingSLAM-v1", "BearingSLAMDiscrete-v1"]
     for env_id in ENV_IDS:
         assert gym.spec(env_id).max_episode_steps is None
         env = gym.make(env_id)
@@ -101,14 +97,14 @@ def test_registration_can_run_twice_silently() -> None:
         register_envs()
         bearing_env.register_envs()
     registered = sorted(i for i in gym.registry if i.startswith("BearingSLAM"))
-    assert registered == sorted([*ENV_IDS, *REGISTERED_TASKS_BY_ID])
+    assert registered == sorted([*ALL_BASE_IDS, *REGISTERED_TASKS_BY_ID])
 
 
 def test_make_by_module_prefixed_id_without_importing_first() -> None:
     code = (
         "import sys, gymnasium as gym\n"
         "assert 'bearing_env' not in sys.modules\n"
-        "for i in ('BearingSLAM-v0', 'BearingSLAMDiscrete-v0'):\n"
+        "for i in ('BearingSLAM-v1', 'BearingSLAMDiscrete-v1'):\n"
         "    env = gym.make('bearing_env:' + i, n_landmarks=8)\n"
         "    obs, _ = env.reset(seed=0)\n"
         "    env.action_space.seed(0)\n"
@@ -269,7 +265,7 @@ def test_sb3_subproc_vec_env_with_spawn() -> None:
 
     venv = make_vec_env(
         # A spawned worker has not imported bearing_env: the module prefix does it.
-        "bearing_env:BearingSLAMDiscrete-v0",
+        "bearing_env:BearingSLAMDiscrete-v1",
         n_envs=2,
         seed=0,
         vec_env_cls=SubprocVecEnv,
@@ -656,11 +652,11 @@ def test_ppo_learns_a_few_hundred_steps(env_id: str) -> None:
 
 
 def test_a_landmark_count_range_draws_a_count_per_episode() -> None:
-    env = gym.make("BearingSLAM-v0", n_landmarks=(4, 8))
+    env = gym.make("BearingSLAM-v1", n_landmarks=(4, 8))
     env.action_space.seed(0)
     assert (
         env.observation_space.shape
-        == gym.make("BearingSLAM-v0", n_landmarks=8).observation_space.shape
+        == gym.make("BearingSLAM-v1", n_landmarks=8).observation_space.shape
     )
     counts = set()
     for seed in range(30):
@@ -677,13 +673,13 @@ def test_a_landmark_count_range_draws_a_count_per_episode() -> None:
     again, _ = env.reset(seed=11)
     np.testing.assert_array_equal(first, again)
     with pytest.raises(ValueError, match="fixed landmark positions"):
-        gym.make("BearingSLAM-v0", scenario="khepera", n_landmarks=(4, 6))
+        gym.make("BearingSLAM-v1", scenario="khepera", n_landmarks=(4, 6))
     with pytest.raises(ValueError, match="n_landmarks"):
-        gym.make("BearingSLAM-v0", n_landmarks=(6, 4))
+        gym.make("BearingSLAM-v1", n_landmarks=(6, 4))
 
 
 def test_the_map_and_the_ground_truth_are_public_and_apart() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    env = gym.make("BearingSLAM-v1", scenario="khepera")
     assert env.unwrapped.world is None  # no ground truth before the first reset
     env.reset(seed=0)
     world, slam = env.unwrapped.world, env.unwrapped.slam
@@ -774,7 +770,7 @@ def test_the_envs_own_arrays_are_writable_after_a_read_only_unpickle(env_id: str
 
 
 def test_packed_obstacles_are_not_pickled_but_made_again() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="furnished_room").unwrapped
+    env = gym.make("BearingSLAM-v1", scenario="furnished_room").unwrapped
     env.reset(seed=0)
     packed = env.config.layout.packed_obstacles
     clone = _read_only_clone(env)
@@ -788,7 +784,7 @@ def test_a_read_only_unpickle_steps_in_a_fresh_process(tmp_path: Path) -> None:
     """Ray's case: the env arrives in a new process whose numba kernels load from the
     cache, with read-only buffers (once a segfault in the step kernel: the parallel
     runtime unstarted, see ``tests/slam/test_parallel_runtime.py``)."""
-    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=5)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", max_moves=5)
     env.reset(seed=11)
     env.action_space.seed(5)
     actions = [env.action_space.sample() for _ in range(4)]
@@ -891,9 +887,9 @@ def test_entity_observation_on_the_vector_env(env_id: str) -> None:
 
 def test_observation_kind_is_validated_and_fixed() -> None:
     with pytest.raises(ValueError, match="unknown observation 'image'"):
-        gym.make("BearingSLAM-v0", observation="image")
+        gym.make("BearingSLAM-v1", observation="image")
     with pytest.raises(TypeError, match="observation must be a str"):
-        gym.make("BearingSLAM-v0", observation=1)
+        gym.make("BearingSLAM-v1", observation=1)
     env = BearingSLAMEnv(observation="entities")
     assert env.observation_kind == "entities"
     with pytest.raises(AttributeError, match="read-only"):
@@ -907,7 +903,7 @@ def test_reading_the_generator_mid_episode_changes_nothing_but_the_draws_it_make
     back, so a draw from it is the one it would be had the env drawn move by move, and the
     episode goes on the same when nothing is drawn."""
     actions = np.random.default_rng(3).uniform(-1, 1, (8, 2)).astype(np.float32)
-    read, plain = (gym.make("BearingSLAM-v0", scenario="khepera").unwrapped for _ in range(2))
+    read, plain = (gym.make("BearingSLAM-v1", scenario="khepera").unwrapped for _ in range(2))
     read.reset(seed=5)
     plain.reset(seed=5)
     for k, action in enumerate(actions):

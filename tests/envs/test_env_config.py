@@ -117,7 +117,7 @@ def test_the_largest_accepted_area_cap_keeps_area_rewards_finite() -> None:
 
 
 @pytest.mark.parametrize(
-    ("env_id", "extra"), [("BearingSLAM-v0", {}), ("BearingSLAMDiscrete-v0", {"n_turns": 4})]
+    ("env_id", "extra"), [("BearingSLAM-v1", {}), ("BearingSLAMDiscrete-v1", {"n_turns": 4})]
 )
 def test_an_env_from_a_config_equals_one_from_keywords(env_id: str, extra: dict[str, Any]) -> None:
     kwargs = {"scenario": "khepera", "path_cost": 0.5, "noise": "gaussian", **extra}

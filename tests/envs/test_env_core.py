@@ -128,7 +128,7 @@ def test_the_robot_map_codec_round_trips_a_map_through_an_info(fusion: str) -> N
         )
 
 
-@pytest.mark.parametrize("env_id", ["BearingSLAM-v0", "BearingSLAMDiscrete-v0"])
+@pytest.mark.parametrize("env_id", ["BearingSLAM-v1", "BearingSLAMDiscrete-v1"])
 def test_the_action_spec_is_the_one_home_of_spaces_decoding_and_encoding(env_id: str) -> None:
     """The env, its vector env and the agents' codec share one action spec: encode gives
     an action of the env's space that decodes to the nearest movement on its grid."""

@@ -15,14 +15,14 @@ from hypothesis import strategies as st
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.envs import BearingSLAMDiscreteVectorEnv, BearingSLAMVectorEnv
-from bearing_env.registration import ENV_IDS
 from bearing_env.slam import PolygonSLAM
 from bearing_env.slam.batch import BatchedPolygonSLAM
+from bearing_env.tasks import BASE_IDS
 from tests.extras import needs
 
 VECTOR_CLASSES = {
-    "BearingSLAM-v0": BearingSLAMVectorEnv,
-    "BearingSLAMDiscrete-v0": BearingSLAMDiscreteVectorEnv,
+    "BearingSLAM-v1": BearingSLAMVectorEnv,
+    "BearingSLAMDiscrete-v1": BearingSLAMDiscreteVectorEnv,
 }
 
 
@@ -66,7 +66,7 @@ def make_pair(
     return batched, reference
 
 
-@pytest.mark.parametrize("env_id", sorted(ENV_IDS))
+@pytest.mark.parametrize("env_id", sorted(BASE_IDS.values()))
 def test_make_vec_returns_the_batched_env_with_the_spec_time_limit(env_id: str) -> None:
     env = gym.make_vec(env_id, num_envs=3, scenario="khepera")
     assert isinstance(env, VECTOR_CLASSES[env_id])
@@ -77,7 +77,7 @@ def test_make_vec_returns_the_batched_env_with_the_spec_time_limit(env_id: str) 
     env.close()
 
 
-@pytest.mark.parametrize("env_id", sorted(ENV_IDS))
+@pytest.mark.parametrize("env_id", sorted(BASE_IDS.values()))
 @pytest.mark.parametrize("mode", [AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP])
 @pytest.mark.parametrize(
     "kwargs",
@@ -119,7 +119,7 @@ def test_reproduces_sync_vector_env_exactly(
 
 
 def test_many_landmarks_reproduce_the_single_env_exactly() -> None:
-    batched, reference = make_pair("BearingSLAM-v0", 3, AutoresetMode.NEXT_STEP, n_landmarks=24)
+    batched, reference = make_pair("BearingSLAM-v1", 3, AutoresetMode.NEXT_STEP, n_landmarks=24)
     assert_same(batched.reset(seed=2), reference.reset(seed=2))
     batched.action_space.seed(1)
     for _ in range(12):
@@ -132,7 +132,7 @@ def test_a_batch_large_enough_for_the_threads_matches_single_envs() -> None:
 
     # The map update is split over threads from this size (when there are two).
     batched, reference = make_pair(
-        "BearingSLAM-v0", PARALLEL_MIN_MAPS, AutoresetMode.NEXT_STEP, scenario="khepera"
+        "BearingSLAM-v1", PARALLEL_MIN_MAPS, AutoresetMode.NEXT_STEP, scenario="khepera"
     )
     assert_same(batched.reset(seed=11), reference.reset(seed=11))
     batched.action_space.seed(11)
@@ -144,9 +144,9 @@ def test_a_batch_large_enough_for_the_threads_matches_single_envs() -> None:
 def test_landmark_count_ranges_match_single_envs_with_padded_infos() -> None:
     n, slots = 4, 8
     batched = gym.make_vec(
-        "BearingSLAM-v0", num_envs=n, vectorization_mode="vector_entry_point", n_landmarks=(3, 6)
+        "BearingSLAM-v1", num_envs=n, vectorization_mode="vector_entry_point", n_landmarks=(3, 6)
     )
-    singles = [gym.make("BearingSLAM-v0", n_landmarks=(3, 6)) for _ in range(n)]
+    singles = [gym.make("BearingSLAM-v1", n_landmarks=(3, 6)) for _ in range(n)]
     observations, infos = batched.reset(seed=40)
     for i, env in enumerate(singles):
         observation, info = env.reset(seed=40 + i)
@@ -179,7 +179,7 @@ def test_landmark_count_ranges_match_single_envs_with_padded_infos() -> None:
 
 def test_time_limit_truncates_like_gym_make() -> None:
     env = gym.make_vec(
-        "BearingSLAM-v0", num_envs=2, vectorization_mode="vector_entry_point", max_episode_steps=3
+        "BearingSLAM-v1", num_envs=2, vectorization_mode="vector_entry_point", max_episode_steps=3
     )
     env.reset(seed=0)
     actions = np.zeros((2, 2), dtype=np.float32)
@@ -265,7 +265,7 @@ def test_pickle_round_trip_continues_identically() -> None:
 
 
 def _step_in_subprocess(queue: Any) -> None:
-    env = gym.make_vec("BearingSLAM-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    env = gym.make_vec("BearingSLAM-v1", num_envs=2, vectorization_mode="vector_entry_point")
     env.reset(seed=3)
     observations, *_ = env.step(np.zeros((2, 2), dtype=np.float32))
     queue.put(observations)
@@ -279,7 +279,7 @@ def test_make_vec_in_a_spawned_process() -> None:
     observations = queue.get(timeout=120)
     process.join(timeout=60)
     assert process.exitcode == 0
-    env = gym.make_vec("BearingSLAM-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    env = gym.make_vec("BearingSLAM-v1", num_envs=2, vectorization_mode="vector_entry_point")
     env.reset(seed=3)
     expected, *_ = env.step(np.zeros((2, 2), dtype=np.float32))
     assert np.array_equal(observations, expected)
@@ -314,7 +314,7 @@ def test_sub_envs_with_settings_changed_by_set_attr_step_like_single_envs() -> N
     costs = [0.0, 2.0, 0.0, 5.0]
     batched = BearingSLAMVectorEnv(4, scenario="khepera")
     batched.set_attr("path_cost", costs)
-    singles = [gym.make("BearingSLAM-v0", scenario="khepera", path_cost=c) for c in costs]
+    singles = [gym.make("BearingSLAM-v1", scenario="khepera", path_cost=c) for c in costs]
     batched.reset(seed=6)
     for i, env in enumerate(singles):
         env.reset(seed=6 + i)
@@ -340,10 +340,10 @@ def test_sub_envs_with_settings_changed_by_set_attr_step_like_single_envs() -> N
 @pytest.mark.parametrize(
     ("env_id", "mode", "kwargs"),
     [
-        ("BearingSLAM-v0", AutoresetMode.NEXT_STEP, {"scenario": "khepera"}),
-        ("BearingSLAM-v0", AutoresetMode.SAME_STEP, {"scenario": "khepera"}),
-        ("BearingSLAM-v0", AutoresetMode.DISABLED, {"scenario": "khepera"}),
-        ("BearingSLAMDiscrete-v0", AutoresetMode.DISABLED, {"observation": "entities"}),
+        ("BearingSLAM-v1", AutoresetMode.NEXT_STEP, {"scenario": "khepera"}),
+        ("BearingSLAM-v1", AutoresetMode.SAME_STEP, {"scenario": "khepera"}),
+        ("BearingSLAM-v1", AutoresetMode.DISABLED, {"scenario": "khepera"}),
+        ("BearingSLAMDiscrete-v1", AutoresetMode.DISABLED, {"observation": "entities"}),
     ],
     ids=["next-step", "same-step", "disabled", "disabled-discrete-entities"],
 )
@@ -383,7 +383,7 @@ def test_masked_resets_reproduce_sync_vector_env_exactly(
 
 def test_disabled_mode_refuses_to_step_an_ended_sub_env_until_it_is_reset() -> None:
     batched, reference = make_pair(
-        "BearingSLAM-v0", 2, AutoresetMode.DISABLED, scenario="khepera", max_moves=2
+        "BearingSLAM-v1", 2, AutoresetMode.DISABLED, scenario="khepera", max_moves=2
     )
     assert batched.metadata["autoreset_mode"] == AutoresetMode.DISABLED
     actions = np.zeros((2, 2), dtype=np.float32)
@@ -434,7 +434,7 @@ def test_disabled_mode_refuses_to_step_an_ended_sub_env_until_it_is_reset() -> N
 def test_a_malformed_reset_is_refused_like_sync_vector_env_and_changes_nothing(
     options: Any, error: type[Exception], shown: str
 ) -> None:
-    batched, reference = make_pair("BearingSLAM-v0", 3, AutoresetMode.NEXT_STEP)
+    batched, reference = make_pair("BearingSLAM-v1", 3, AutoresetMode.NEXT_STEP)
     twin = BearingSLAMVectorEnv(3, max_episode_steps=20)
     for env in (batched, reference, twin):
         env.reset(seed=1)
@@ -560,7 +560,7 @@ def test_discrete_actions_that_are_not_numbers_raise_like_the_single_env(actions
     env.reset(seed=0)
     with pytest.raises(ValueError, match="action"):
         env.step(actions)
-    single = gym.make("BearingSLAMDiscrete-v0", scenario="khepera").unwrapped
+    single = gym.make("BearingSLAMDiscrete-v1", scenario="khepera").unwrapped
     single.reset(seed=0)
     with pytest.raises(ValueError, match="action"):
         single.step(np.asarray(actions)[0])

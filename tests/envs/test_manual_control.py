@@ -48,7 +48,7 @@ def pygame() -> Any:
     return pygame
 
 
-def make_control(env_id: str = "BearingSLAM-v0", seed: int = 0, **settings: Any) -> ManualControl:
+def make_control(env_id: str = "BearingSLAM-v1", seed: int = 0, **settings: Any) -> ManualControl:
     settings.setdefault("scenario", "khepera")
     env = gym.make(env_id, render_mode="rgb_array", **settings)
     return ManualControl(env, seed=seed)
@@ -195,7 +195,7 @@ def test_clicks_off_the_field_do_nothing(pygame: Any, control: ManualControl) ->
 def test_r_starts_the_next_episode_with_the_next_seed(pygame: Any, control: ManualControl) -> None:
     play(pygame, control, [key(pygame, "K_SPACE"), key(pygame, "K_RETURN"), key(pygame, "K_r")])
     assert control.moves == 0 and control.episode == 1 and control.episode_return == 0.0
-    fresh = gym.make("BearingSLAM-v0", scenario="khepera")
+    fresh = gym.make("BearingSLAM-v1", scenario="khepera")
     fresh.reset(seed=1)
     world = control.env.unwrapped.world
     np.testing.assert_array_equal(world.position, fresh.unwrapped.world.position)
@@ -223,7 +223,7 @@ def test_an_ended_episode_takes_no_more_moves(pygame: Any) -> None:
 
 
 def test_the_discrete_env_steps_through_its_tables(pygame: Any) -> None:
-    with make_control("BearingSLAMDiscrete-v0", n_turns=8, n_move_lengths=3) as control:
+    with make_control("BearingSLAMDiscrete-v1", n_turns=8, n_move_lengths=3) as control:
         env = control.env.unwrapped
         heading = env.world.heading
         start = control.aim
@@ -294,6 +294,6 @@ def test_the_docs_list_every_key() -> None:
 
 def test_a_window_needs_an_rgb_array_bearing_env() -> None:
     with pytest.raises(ValueError, match="render_mode='rgb_array'"):
-        ManualControl(gym.make("BearingSLAM-v0"))
+        ManualControl(gym.make("BearingSLAM-v1"))
     with pytest.raises(TypeError, match="CartPoleEnv"):
         ManualControl(gym.make("CartPole-v1", render_mode="rgb_array"))

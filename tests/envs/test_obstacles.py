@@ -98,7 +98,7 @@ def test_scenarios_keep_landmarks_and_starts_out_of_the_obstacles(scenario: str)
     config = EnvConfig.create(scenario=scenario)
     assert config.obstacles == SCENARIOS[scenario].obstacles and config.obstacles
     vertices, starts = config.layout.packed_obstacles
-    env = gym.make("BearingSLAM-v0", scenario=scenario)
+    env = gym.make("BearingSLAM-v1", scenario=scenario)
     margin = config.arena.wall_margin
     for seed in range(30):
         env.reset(seed=seed)
@@ -112,7 +112,7 @@ def test_scenarios_keep_landmarks_and_starts_out_of_the_obstacles(scenario: str)
 def test_random_layouts_avoid_random_obstacles() -> None:
     settings: dict[str, Any] = {"n_landmarks": 8, "obstacles": {"random": 6, "seed": 1}}
     vertices, starts = EnvConfig.create(scenario="random", **settings).layout.packed_obstacles
-    env = gym.make("BearingSLAM-v0", scenario="random", **settings)
+    env = gym.make("BearingSLAM-v1", scenario="random", **settings)
     for seed in range(20):
         env.reset(seed=seed)
         for landmark in env.unwrapped.world.landmarks:  # type: ignore[attr-defined]
@@ -121,7 +121,7 @@ def test_random_layouts_avoid_random_obstacles() -> None:
 
 
 def test_a_move_into_an_obstacle_is_blocked_and_the_info_says_so() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="l_corridor", sensor_info=True)
+    env = gym.make("BearingSLAM-v1", scenario="l_corridor", sensor_info=True)
     vertices, starts = env.unwrapped.config.layout.packed_obstacles  # type: ignore[attr-defined]
     margin = env.unwrapped.config.arena.wall_margin  # type: ignore[attr-defined]
     blocked = 0
@@ -146,7 +146,7 @@ def test_missed_readings_are_the_ones_out_of_view_range_or_sight() -> None:
     from bearing_env.sensing import visible
 
     env = gym.make(
-        "BearingSLAM-v0", scenario="furnished_room", field_of_view_deg=90, max_range=1.2,
+        "BearingSLAM-v1", scenario="furnished_room", field_of_view_deg=90, max_range=1.2,
         sensor_info=True,
     )
     config = env.unwrapped.config  # type: ignore[attr-defined]
@@ -174,7 +174,7 @@ def test_the_defaults_keep_the_panoramic_sensor_and_the_infos() -> None:
     config = EnvConfig.create()
     assert config.field_of_view_deg == 360.0 and config.max_range == math.inf
     assert config.obstacles == () and not config.sensor_info
-    env = gym.make("BearingSLAM-v0")
+    env = gym.make("BearingSLAM-v1")
     _, info = env.reset(seed=0)
     assert "seen" not in info and "blocked" not in info
     env.close()
@@ -182,8 +182,8 @@ def test_the_defaults_keep_the_panoramic_sensor_and_the_infos() -> None:
 
 @pytest.mark.parametrize(
     "task_id",
-    ["BearingSLAM-Khepera-Camera90-v0", "BearingSLAM-Khepera-Camera180-v0",
-     "BearingSLAM-FurnishedRoom-v0"],
+    ["BearingSLAM-Khepera-Camera90-v1", "BearingSLAM-Khepera-Camera180-v1",
+     "BearingSLAM-FurnishedRoom-v1"],
 )  # fmt: skip
 def test_the_vector_env_is_bit_exact_on_the_new_tasks(task_id: str) -> None:
     batched, reference = make_pair(task_id, 3, gym.vector.AutoresetMode.NEXT_STEP, sensor_info=True)
@@ -200,7 +200,7 @@ def test_the_vector_env_is_bit_exact_on_the_new_tasks(task_id: str) -> None:
 def test_the_frame_shows_the_obstacles_the_field_of_view_and_the_missed_landmarks() -> None:
     from bearing_env.rendering import MISSED, OBSTACLE, FieldLayout
 
-    env = gym.make("BearingSLAM-v0", scenario="furnished_room", field_of_view_deg=90,
+    env = gym.make("BearingSLAM-v1", scenario="furnished_room", field_of_view_deg=90,
                    render_mode="rgb_array")  # fmt: skip
     env.reset(seed=2)
     env.action_space.seed(2)
@@ -219,7 +219,7 @@ def test_the_frame_shows_the_obstacles_the_field_of_view_and_the_missed_landmark
     for landmark, is_missed in zip(world.landmarks, missed, strict=True):
         px, py = layout.to_pixels(landmark).astype(int)
         assert (tuple(frame[py, px]) == MISSED) == is_missed
-    panoramic = gym.make("BearingSLAM-v0", scenario="furnished_room", render_mode="rgb_array")
+    panoramic = gym.make("BearingSLAM-v1", scenario="furnished_room", render_mode="rgb_array")
     panoramic.reset(seed=2)
     # The yellow wedge tints the field ahead of the camera only with a limited one.
     assert not np.array_equal(frame, panoramic.render())

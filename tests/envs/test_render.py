@@ -19,7 +19,7 @@ import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.envs import BearingSLAMEnv
 from bearing_env.rendering import FIELD, Renderer, landmark_colour
 
-ENV_IDS = ["BearingSLAM-v0", "BearingSLAMDiscrete-v0"]
+ENV_IDS = ["BearingSLAM-v1", "BearingSLAMDiscrete-v1"]
 
 
 def frame_after(env: gym.Env, moves: int, seed: int = 0) -> np.ndarray:
@@ -51,7 +51,7 @@ def test_rgb_array_frame_has_the_right_shape_and_content(env_id: str) -> None:
 
 
 def test_frames_change_as_the_robot_moves() -> None:
-    env = gym.make("BearingSLAM-v0", render_mode="rgb_array")
+    env = gym.make("BearingSLAM-v1", render_mode="rgb_array")
     env.reset(seed=1)
     first = env.render()
     env.step(np.array([0.3, 0.5], dtype=np.float32))
@@ -63,7 +63,7 @@ def test_frames_change_as_the_robot_moves() -> None:
 
 def test_frame_size_is_constant_over_episodes_and_layouts() -> None:
     # RecordVideo and GIF writers need one frame size per env.
-    env = gym.make("BearingSLAM-v0", n_landmarks=12, render_mode="rgb_array")
+    env = gym.make("BearingSLAM-v1", n_landmarks=12, render_mode="rgb_array")
     shapes = {frame_after(env, moves=moves, seed=seed).shape for seed, moves in [(0, 0), (1, 9)]}
     assert len(shapes) == 1
     env.close()
@@ -78,7 +78,7 @@ def test_huge_regions_and_many_landmarks_render() -> None:
 
 
 def test_human_mode_draws_a_window_and_returns_none() -> None:
-    env = gym.make("BearingSLAM-v0", render_mode="human")
+    env = gym.make("BearingSLAM-v1", render_mode="human")
     env.action_space.seed(0)
     env.reset(seed=0)  # human mode renders on reset and step
     env.step(env.action_space.sample())
@@ -110,7 +110,7 @@ def test_record_video(tmp_path: os.PathLike[str]) -> None:
     # moviepy is in the dev extra, so this runs wherever the tests do.
     from gymnasium.wrappers import RecordVideo
 
-    env = gym.make("BearingSLAM-v0", scenario="khepera", render_mode="rgb_array")
+    env = gym.make("BearingSLAM-v1", scenario="khepera", render_mode="rgb_array")
     folder = os.path.join(tmp_path, "videos")
     env = RecordVideo(env, folder, episode_trigger=lambda episode: episode == 0)
     env.action_space.seed(0)
@@ -128,7 +128,7 @@ def test_record_video(tmp_path: os.PathLike[str]) -> None:
 def test_the_field_layout_maps_pixels_back_to_the_world() -> None:
     from bearing_env.rendering import FieldLayout
 
-    env = gym.make("BearingSLAM-v0", scenario="khepera", render_mode="rgb_array")
+    env = gym.make("BearingSLAM-v1", scenario="khepera", render_mode="rgb_array")
     env.reset(seed=0)
     env.render()
     renderer = env.unwrapped._renderer

@@ -243,7 +243,7 @@ MAP_POLICIES = (Parallax, GreedyOneStep, GreedyOracle, Lookahead, LookaheadOracl
 
 @pytest.mark.parametrize("policy_class", MAP_POLICIES)
 def test_the_planners_that_read_the_map_refuse_an_env_without_it(policy_class: type) -> None:
-    env = gym.make("BearingSLAM-v0", **SETTINGS, robot_map_info=False)
+    env = gym.make("BearingSLAM-v1", **SETTINGS, robot_map_info=False)
     message = (
         rf'^{policy_class.__name__} needs info\["robot_map"\]; make the env with '
         r"robot_map_info=True \(the default\)$"
@@ -253,11 +253,11 @@ def test_the_planners_that_read_the_map_refuse_an_env_without_it(policy_class: t
     vector_env = BearingSLAMVectorEnv(2, **SETTINGS, robot_map_info=False)
     with pytest.raises(RobotMapUnavailableError, match=message):
         VectorPolicy(vector_env, policy_class)
-    policy_class(gym.make("BearingSLAM-v0", **SETTINGS))  # with the map: built as ever
+    policy_class(gym.make("BearingSLAM-v1", **SETTINGS))  # with the map: built as ever
 
 
 def test_a_map_read_from_an_info_without_it_names_the_setting() -> None:
-    reader = MapReader(gym.make("BearingSLAM-v0", **SETTINGS))
+    reader = MapReader(gym.make("BearingSLAM-v1", **SETTINGS))
     _, info = BearingSLAMEnv(**SETTINGS, robot_map_info=False).reset(seed=0)
     with pytest.raises(KeyError, match="robot_map_info=True"):
         reader.read(info, 4)
@@ -274,7 +274,7 @@ def play(policy: Any, env: gym.Env[Any, Any]) -> int:
 
 
 def test_the_random_policy_plays_without_the_map() -> None:
-    env = gym.make("BearingSLAM-v0", **SETTINGS, robot_map_info=False)
+    env = gym.make("BearingSLAM-v1", **SETTINGS, robot_map_info=False)
     assert play(RandomPolygonal(env), env) == SETTINGS["max_moves"]
     vector_env = BearingSLAMVectorEnv(2, **SETTINGS, robot_map_info=False)
     policy = VectorPolicy(vector_env, RandomPolygonal)
@@ -285,5 +285,5 @@ def test_the_random_policy_plays_without_the_map() -> None:
 
 @needs("train", "stable_baselines3", "torch")
 def test_a_shipped_model_plays_without_the_map() -> None:
-    env = gym.make("BearingSLAM-v0", scenario="khepera", max_moves=3, robot_map_info=False)
+    env = gym.make("BearingSLAM-v1", scenario="khepera", max_moves=3, robot_map_info=False)
     assert play(SB3Policy.pretrained("ppo_khepera", env), env) == 3

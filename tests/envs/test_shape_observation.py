@@ -104,7 +104,7 @@ def test_the_axis_and_elongation_of_known_shapes() -> None:
     assert kernel_shape(needle)[0] == ELONGATION_LIMIT
 
 
-@pytest.mark.parametrize("env_id", ["BearingSLAM-v0", "BearingSLAMDiscrete-v0"])
+@pytest.mark.parametrize("env_id", ["BearingSLAM-v1", "BearingSLAMDiscrete-v1"])
 def test_the_shape_table_is_the_entity_table_with_the_regions_shapes(env_id: str) -> None:
     kwargs = {"n_landmarks": (3, 6), "max_landmarks": SLOTS}
     entity_env = gym.make(env_id, observation="entities", **kwargs)
@@ -147,8 +147,8 @@ def test_the_shape_table_is_the_entity_table_with_the_regions_shapes(env_id: str
 def test_the_shape_observation_on_the_vector_env_is_the_single_envs() -> None:
     # One landmark count: SyncVectorEnv cannot batch infos of varying sizes.
     kwargs = {"scenario": "random", "n_landmarks": 5, "observation": "shapes"}
-    batched = gym.make_vec("BearingSLAM-v0", num_envs=3, **kwargs)
-    reference = gym.make_vec("BearingSLAM-v0", num_envs=3, vectorization_mode="sync", **kwargs)
+    batched = gym.make_vec("BearingSLAM-v1", num_envs=3, **kwargs)
+    reference = gym.make_vec("BearingSLAM-v1", num_envs=3, vectorization_mode="sync", **kwargs)
     assert batched.observation_space == reference.observation_space
     batched.action_space.seed(3)
     first, _ = batched.reset(seed=3)

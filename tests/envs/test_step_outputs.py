@@ -27,7 +27,7 @@ SETTINGS: dict[str, dict[str, Any]] = {
 
 @pytest.mark.parametrize("name", sorted(SETTINGS))
 def test_a_single_env_step_is_not_changed_by_the_next_steps(name: str) -> None:
-    env = gym.make("BearingSLAM-v0", **SETTINGS[name], max_moves=5)
+    env = gym.make("BearingSLAM-v1", **SETTINGS[name], max_moves=5)
     first = env.reset(seed=3)
     env.action_space.seed(3)
     kept: list[tuple[Any, Any]] = [(first, copy.deepcopy(first))]  # resets reuse them too
@@ -48,7 +48,7 @@ def test_a_single_env_step_is_not_changed_by_the_next_steps(name: str) -> None:
 @pytest.mark.parametrize("name", sorted(SETTINGS))
 def test_a_batched_step_is_not_changed_by_the_next_steps(name: str) -> None:
     # Episodes of 5 moves: autoresets write their first observations among the steps'.
-    envs = gym.make_vec("BearingSLAM-v0", num_envs=3, **SETTINGS[name], max_moves=5)
+    envs = gym.make_vec("BearingSLAM-v1", num_envs=3, **SETTINGS[name], max_moves=5)
     first = envs.reset(seed=5)
     envs.action_space.seed(5)
     kept: list[tuple[Any, Any]] = [(first, copy.deepcopy(first))]

@@ -121,6 +121,20 @@ def test_every_id_makes_its_version_with_the_max_moves_spec(env_id: str) -> None
     overridden.close()
 
 
+@pytest.mark.filterwarnings("ignore:.*is out of date:DeprecationWarning")
+@pytest.mark.parametrize("env_id", sorted(ENV_IDS))
+def test_the_batched_vector_env_of_every_version_has_its_transfer(env_id: str) -> None:
+    version = split_id(env_id)[1]
+    envs = gym.make_vec(env_id, num_envs=2, vectorization_mode="vector_entry_point")
+    assert [c.transfer for c in envs.get_attr("config")] == [TRANSFER_OF_VERSION[version]] * 2
+    envs.close()
+    envs = gym.make_vec(
+        env_id, num_envs=2, vectorization_mode="vector_entry_point", transfer="paper"
+    )
+    assert [c.transfer for c in envs.get_attr("config")] == ["paper"] * 2
+    envs.close()
+
+
 def test_an_older_version_warns_as_gymnasium_does() -> None:
     """Gymnasium's own note on an older version: the -v0 ids stay for reproducing."""
     with pytest.warns(DeprecationWarning, match="BearingSLAM-Khepera-v0 is out of date"):

@@ -280,7 +280,7 @@ def test_a_world_copy_keeps_the_camera_and_the_obstacles() -> None:
     from bearing_env.agents.env_access import world_of
 
     env = gym.make(
-        "bearing_env:BearingSLAM-FurnishedRoom-v0", field_of_view_deg=90, sensor_info=True
+        "bearing_env:BearingSLAM-FurnishedRoom-v1", field_of_view_deg=90, sensor_info=True
     )
     codec = ActionCodec(env)
     rng = np.random.default_rng(0)

@@ -262,7 +262,7 @@ def test_env_relaxed_passes_the_checkers_and_reports_outliers() -> None:
         "fusion": "relaxed",
         "noise": {"kind": "uniform", "outlier_rate": 0.2},
     }
-    env = gym.make("BearingSLAM-v0", **kwargs)
+    env = gym.make("BearingSLAM-v1", **kwargs)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env.unwrapped)

@@ -332,9 +332,9 @@ def test_a_reset_forgets_the_grown_bound_and_the_history(vector: bool) -> None:
         "target_area": 1e-12,
     }
     env = (
-        gym.make_vec("BearingSLAM-v0", num_envs=2, **kwargs)
+        gym.make_vec("BearingSLAM-v1", num_envs=2, **kwargs)
         if vector
-        else gym.make("BearingSLAM-v0", **kwargs)
+        else gym.make("BearingSLAM-v1", **kwargs)
     )
 
     def maps() -> list[PolygonSLAM]:

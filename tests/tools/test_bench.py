@@ -190,7 +190,7 @@ def test_the_targets_are_the_current_ones() -> None:
     assert bench_report.UPPER_BOUND_TARGETS == {"f", "g"}
     for key, threshold in [("a", "20%"), ("e", "50%"), ("h", "0.7x"), ("f", "1.5x")]:
         assert threshold in bench_report.TARGETS[key]
-    assert "BearingSLAM-Khepera-v0" in bench_report.TARGETS["f"]
+    assert "BearingSLAM-Khepera-v1" in bench_report.TARGETS["f"]
     assert "compil" not in " ".join(bench_report.TARGETS.values())
 
 
@@ -331,7 +331,7 @@ def check_startup(results: dict[str, Any], runs: int) -> dict[str, Any]:
     check_common(results, {"startup"})
     startup: dict[str, Any] = results["startup"]
     assert set(startup) == STARTUP_KEYS
-    assert startup["env_id"] == "BearingSLAM-Khepera-v0"
+    assert startup["env_id"] == "BearingSLAM-Khepera-v1"
     assert startup["runs"] == runs
     assert len(startup["bearing_env_runs_s"]) == len(startup["cartpole_runs_s"]) == runs
     for key in ("bearing_env", "cartpole"):
@@ -378,7 +378,7 @@ def test_quick_startup_times_whole_processes_alternately_after_an_untimed_pair(
         assert environment["PATH"] == os.environ["PATH"]
     assert not Path(calls[0][1]["HOME"]).exists()  # temporary folders, removed after
     assert startup == {
-        "env_id": "BearingSLAM-Khepera-v0",
+        "env_id": "BearingSLAM-Khepera-v1",
         "runs": 3,
         "bearing_env_runs_s": [0.5, 0.7, 0.6],  # the untimed pair's 0.9 and 0.3 left out
         "cartpole_runs_s": [0.4, 0.2, 0.5],
@@ -395,7 +395,7 @@ def test_quick_startup_times_whole_processes_alternately_after_an_untimed_pair(
 
 def test_startup_scripts_make_and_step_the_env_and_report_numba() -> None:
     bearing, cartpole = (bench_timing.STARTUP_SCRIPTS[k] for k in ("bearing_env", "cartpole"))
-    assert 'gym.make("BearingSLAM-Khepera-v0")' in bearing and "import bearing_env" in bearing
+    assert 'gym.make("BearingSLAM-Khepera-v1")' in bearing and "import bearing_env" in bearing
     assert 'gym.make("CartPole-v1")' in cartpole and "bearing_env" not in cartpole
     for script in (bearing, cartpole):
         assert "env.reset(seed=0)" in script and "env.step(" in script
@@ -506,7 +506,7 @@ def test_targets_print_in_their_own_units() -> None:
 
 def new_startup(ratio: float = 1.25, numba: bool = False) -> dict[str, Any]:
     return {
-        "env_id": "BearingSLAM-Khepera-v0",
+        "env_id": "BearingSLAM-Khepera-v1",
         "runs": 3,
         "bearing_env_runs_s": [0.5, 0.6, 0.4],
         "cartpole_runs_s": [0.4, 0.3, 0.5],
@@ -521,7 +521,7 @@ def new_startup(ratio: float = 1.25, numba: bool = False) -> dict[str, Any]:
 def test_the_docs_state_the_startup_ratio_and_numba() -> None:
     results = {"format": bench_report.JSON_FORMAT, "startup": new_startup()}
     text = bench_report.markdown_startup(results)
-    assert "fresh process" in text and "`BearingSLAM-Khepera-v0`" in text
+    assert "fresh process" in text and "`BearingSLAM-Khepera-v1`" in text
     assert "0.50 s, 1.25x CartPole-v1 (0.40 s" in text
     assert "0.50 / 0.60 / 0.40 s; CartPole-v1 0.40 / 0.30 / 0.50 s" in text
     assert "empty HOME and cache folders: 0.75 s" in text

@@ -81,7 +81,7 @@ def test_throughput_with_the_ppo_pair(
     bearing, cartpole = ppo["bearing_slam"], ppo["cartpole"]
     labels = {ref["label"] for ref in results["cartpole_references"]}
     assert {"ppo/batched", "ppo/CartPole-v1 dummy", "throughput/round 2"} <= labels
-    assert (bearing["kind"], bearing["env_id"]) == ("batched", "BearingSLAM-v0")
+    assert (bearing["kind"], bearing["env_id"]) == ("batched", "BearingSLAM-v1")
     assert (cartpole["kind"], cartpole["env_id"]) == ("dummy", "CartPole-v1")
     assert bearing["env_kwargs"] == {"scenario": "khepera"} and cartpole["env_kwargs"] == {}
     for row in (bearing, cartpole):

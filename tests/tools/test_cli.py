@@ -66,7 +66,7 @@ def test_hyperparams_prints_the_shipped_file_from_any_folder(tmp_path) -> None:
     path = Path(result.stdout.strip())
     assert path.is_absolute() and path.name == "ppo.yml"
     assert path.parent.parent == Path(bearing_env.train.sb3.__file__).parent
-    assert "BearingSLAM-v0:" in path.read_text()
+    assert "BearingSLAM-v1:" in path.read_text()
 
 
 def test_hyperparams_rejects_an_algorithm_without_a_file(tmp_path) -> None:

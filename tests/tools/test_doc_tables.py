@@ -79,7 +79,7 @@ def edit_a_number(path: Path, block: str | None = None) -> None:
         ("docs/results.md", "robust-eval"),
         ("docs/environment.md", "observability"),
         ("docs/scaling.md", "compare-on-ray"),
-        ("docs/tasks/BearingSLAM-Khepera-v0.md", None),
+        ("docs/tasks/BearingSLAM-Khepera-v1.md", None),
     ],
 )
 def test_a_hand_edited_number_fails_the_check_and_is_written_back(

@@ -71,7 +71,7 @@ def test_the_design_document_covers_the_method_and_the_env_contract() -> None:
     for needle in (
         "## 2. The method", "## 3. The environment contract", "## 4. Measured facts",
         "T(h1, h2)(z) = (z \u2212 h1) / (h2 \u2212 h1)", "FR", "FL", "centroid", "`\"paper\"`",
-        "`\"conservative\"`", "on_inconsistency", "BearingSLAM-v0", "BearingSLAMDiscrete-v0",
+        "`\"conservative\"`", "on_inconsistency", "BearingSLAM-v1", "BearingSLAMDiscrete-v1",
         "Terminated", "Truncated", "landmark_contains_truth", "Determinism", "Rendering",
     ):
         assert needle in text, needle

@@ -126,7 +126,7 @@ def test_the_api_reference_documents_the_public_names(site: Path) -> None:
 def test_the_readme_is_short_and_has_the_first_hour() -> None:
     text = README.read_text(encoding="utf-8")
     assert len(text.splitlines()) <= README_MAX_LINES
-    for needle in ("pip install", 'gym.make("BearingSLAM-v0"', "make demo", "make test",
+    for needle in ("pip install", 'gym.make("BearingSLAM-v1"', "make demo", "make test",
                    "bearing-env compare", "bearing-env train", "## Citation",
                    "Uncertainty Analysis of a Landmark Initialization Method",
                    "docs/figures/"):

@@ -289,7 +289,7 @@ def test_train_on_a_full_disk_names_the_file(
 def _make_discrete(**kwargs: Any) -> None:
     import gymnasium as gym
 
-    gym.make("bearing_env:BearingSLAMDiscrete-v0", **kwargs)
+    gym.make("bearing_env:BearingSLAMDiscrete-v1", **kwargs)
 
 
 def _replicate(count: Any) -> None:
@@ -344,7 +344,7 @@ def test_continuous_actions_of_any_real_dtype_step_like_float64(dtype: str) -> N
     import numpy as np
 
     def first_step(action: Any) -> Any:
-        env = gym.make("bearing_env:BearingSLAM-v0", scenario="khepera")
+        env = gym.make("bearing_env:BearingSLAM-v1", scenario="khepera")
         env.reset(seed=3)
         return env.step(action)[0]
 
@@ -360,7 +360,7 @@ def test_non_numeric_continuous_actions_are_refused_by_value(action: list[Any]) 
     import gymnasium as gym
     import numpy as np
 
-    env = gym.make("bearing_env:BearingSLAM-v0", scenario="khepera")
+    env = gym.make("bearing_env:BearingSLAM-v1", scenario="khepera")
     env.reset(seed=0)
     with pytest.raises(ValueError, match="must be real numbers"):
         env.step(np.array(action))

@@ -9,7 +9,7 @@ from the repository's folders. Checked:
   and the wheel's own RECORD);
 - the sdist installs the very files of the wheel (same paths, same sha256), so what the
   wheel's venv shows holds for the sdist's;
-- ``import bearing_env; gym.make("BearingSLAM-v0")`` works in both; in the wheel's venv
+- ``import bearing_env; gym.make("BearingSLAM-v1")`` works in both; in the wheel's venv
   it also resets and steps;
 - the native core comes compiled in the wheel: a fresh process steps at once, and no
   JIT compiler (numba, llvmlite) is imported;
@@ -76,7 +76,7 @@ import importlib.util, json
 import gymnasium as gym
 import bearing_env
 import sys
-env = gym.make("BearingSLAM-v0")
+env = gym.make("BearingSLAM-v1")
 report = {"observation_space": str(env.observation_space)}
 if "--step" in sys.argv:
     observation, info = env.reset(seed=3)
@@ -315,7 +315,7 @@ def test_the_readme_quick_start_runs_as_written_from_the_wheel(
     installed: dict[str, InstalledRun],
 ) -> None:
     block = readme_quick_start()
-    assert 'gym.make("BearingSLAM-v0"' in block and "env.step(" in block
+    assert 'gym.make("BearingSLAM-v1"' in block and "env.step(" in block
     result = _checked(installed["wheel"].results["quick_start"])
     assert "Traceback" not in result.stderr
     # It prints the final areas and containment flags of L3 and L4.

@@ -59,7 +59,7 @@ def cli_arguments(run: Path, *extra: str) -> list[str]:
 def settings(run: Path, **changes: Any) -> TrainSettings:
     base: dict[str, Any] = {
         "algo": "ppo",
-        "env_id": "BearingSLAM-v0",
+        "env_id": "BearingSLAM-v1",
         "output": run,
         "hyperparam_overrides": dict(HYPERPARAMS),
         "timesteps": BUDGET,
@@ -196,7 +196,7 @@ def dqn_settings(run: Path, **changes: Any) -> TrainSettings:
     return settings(
         run,
         algo="dqn",
-        env_id="BearingSLAMDiscrete-v0",
+        env_id="BearingSLAMDiscrete-v1",
         hyperparam_overrides=dict(DQN_HYPERPARAMS),
         timesteps=200,
         checkpoint_freq=10_000,

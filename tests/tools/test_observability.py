@@ -13,7 +13,7 @@ from shapely.geometry import Point, Polygon
 from bearing_env.train.studies import observability
 from tests.extras import needs
 
-KHEPERA = "bearing_env:BearingSLAM-Khepera-v0"
+KHEPERA = "bearing_env:BearingSLAM-Khepera-v1"
 #: A small grid: (starts per side, headings, lengths).
 SMALL = (8, 12, 2)
 
@@ -53,7 +53,7 @@ def test_readings_miss_exactly_what_lies_outside_the_view() -> None:
 
 
 def test_starts_keep_clear_of_walls_obstacles_and_landmarks() -> None:
-    layout = observability.layout_of("bearing_env:BearingSLAM-FurnishedRoom-v0", {})
+    layout = observability.layout_of("bearing_env:BearingSLAM-FurnishedRoom-v1", {})
     movements = observability.candidate_movements(layout, 20, 4, 1)
     arena = layout.config.layout.arena
     margin = arena.wall_margin
@@ -100,26 +100,26 @@ def test_the_command_prints_the_table_and_draws_the_arenas(
 ) -> None:
     path, figures = tmp_path / "observability.png", tmp_path / "observability.json"
     observability.main(
-        ["--env", "BearingSLAM-Khepera-v0", "--fov", "360", "90", "--per-side", "6",
+        ["--env", "BearingSLAM-Khepera-v1", "--fov", "360", "90", "--per-side", "6",
          "--headings", "8", "--lengths", "2", "--plot", str(path), "--json", str(figures),
          "--no-progress"]
     )  # fmt: skip
     out = capsys.readouterr().out
-    assert "BearingSLAM-Khepera-v0: one movement" in out
+    assert "BearingSLAM-Khepera-v1: one movement" in out
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     written = json.loads(figures.read_text())
-    assert written["env"] == "BearingSLAM-Khepera-v0"
+    assert written["env"] == "BearingSLAM-Khepera-v1"
     wide, narrow = written["fovs"]["360"], written["fovs"]["90"]
     assert wide["movements"] == narrow["movements"] == wide["starts"] * 8 * 2
     assert len(wide["updates"]) == 2  # L3 and L4
     assert wide["frame_changes"] > narrow["frame_changes"]
     assert wide["starts_mapping_any"] > 0.5
     measured = written["measured"]
-    assert measured["command"].startswith("bearing-env observability --env BearingSLAM-Khepera-v0")
+    assert measured["command"].startswith("bearing-env observability --env BearingSLAM-Khepera-v1")
     assert {"commit", "date", "machine"} <= measured.keys()
     # The environment page's table reads the file as it is written.
     table = observability.markdown_observability({"observability_khepera": written})
-    assert "| `BearingSLAM-Khepera-v0` (" in table and "| 360° |" in table and "| 90° |" in table
+    assert "| `BearingSLAM-Khepera-v1` (" in table and "| 360° |" in table and "| 90° |" in table
     assert f"Measured by `{measured['command']}`" in table
 
 

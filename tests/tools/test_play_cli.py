@@ -44,9 +44,9 @@ def test_help_names_the_options_their_defaults_and_the_keys(
     assert status == 0
     text = " ".join(out.split())
     assert text.startswith("usage: bearing-env play")
-    for option in ("--env {BearingSLAM-v0,BearingSLAMDiscrete-v0}", "--env-kwargs", "--seed"):
+    for option in ("--env {BearingSLAM-v1,BearingSLAMDiscrete-v1}", "--env-kwargs", "--seed"):
         assert option in text
-    assert "default BearingSLAM-v0" in text and "default: scenario=khepera" in text
+    assert "default BearingSLAM-v1" in text and "default: scenario=khepera" in text
     assert "(default 0)" in text
     assert "escape: quit" in text and "click: move toward the point" in text
 

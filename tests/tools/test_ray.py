@@ -30,7 +30,7 @@ skip_module_without("ray")
 import ray
 
 from bearing_env.agents.registry import make_policy, spec_files, with_files
-from bearing_env.registration import ENV_IDS
+from bearing_env.tasks import BASE_IDS
 from bearing_env.train.compare.cli import main, reproducing_command
 from bearing_env.train.compare.comparison import run_comparison
 from bearing_env.train.compare.config import CompareConfig, policies_from_specs
@@ -72,7 +72,7 @@ def cluster() -> Iterator[Any]:
 def comparison() -> CompareConfig:
     return CompareConfig(
         policies=policies_from_specs(POLICIES),
-        env_id="BearingSLAM-v0",
+        env_id="BearingSLAM-v1",
         env_kwargs=dict(SMALL_ENV),
         episodes=12,
         bootstrap=200,
@@ -127,7 +127,7 @@ def step_in_a_task(env: gym.Env, actions: list[Any]) -> list[tuple[Any, ...]]:
     return rollout(env, actions)
 
 
-@pytest.mark.parametrize("env_id", sorted(ENV_IDS))
+@pytest.mark.parametrize("env_id", sorted(BASE_IDS.values()))
 def test_an_env_through_the_object_store_steps_like_the_original(cluster: Any, env_id: str) -> None:
     env = gym.make(f"bearing_env:{env_id}", **SMALL_ENV)
     env.reset(seed=11)
@@ -182,7 +182,7 @@ def test_ctrl_c_of_a_ray_comparison_keeps_its_episodes_and_resumes(
     address = ray.get_runtime_context().gcs_address
     command = [
         sys.executable, "-m", "bearing_env.train.compare.cli", "--policies", *POLICIES,
-        "--env", "BearingSLAM-v0", "--env-kwargs", "scenario=khepera", "max_moves=5",
+        "--env", "BearingSLAM-v1", "--env-kwargs", "scenario=khepera", "max_moves=5",
         "--episodes", "12", "--bootstrap", "200", "--no-progress", "--no-plots",
         "--executor", "ray", "--ray-address", address, "--out", str(tmp_path),
     ]  # fmt: skip
@@ -254,7 +254,7 @@ def test_a_policy_files_travel_as_bytes_and_act_alike(tmp_path: Path) -> None:
     for option, path in copies.items():
         assert path.is_relative_to(tmp_path)
         assert path.read_bytes() == files[option].read_bytes()
-    env = gym.make("bearing_env:BearingSLAM-v0", scenario="khepera")
+    env = gym.make("bearing_env:BearingSLAM-v1", scenario="khepera")
     original, moved = make_policy(spec, env), make_policy(copied, env)
     assert moved.name == original.name == "ppo_khepera"
     observation, info = env.reset(seed=3)
@@ -271,7 +271,7 @@ def test_a_policy_files_travel_as_bytes_and_act_alike(tmp_path: Path) -> None:
 # --------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("env_id", sorted(ENV_IDS))
+@pytest.mark.parametrize("env_id", sorted(BASE_IDS.values()))
 def test_rllib_ppo_trains_an_iteration_with_a_remote_env_runner(
     cluster: Any, env_id: str, tmp_path: Path
 ) -> None:

@@ -66,7 +66,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env compare": ("parse", ()),
     "bearing-env compare --quick": ("parse", ()),
     "bearing-env play": ("parse", ()),
-    "bearing-env play --env BearingSLAMDiscrete-v0 --env-kwargs scenario=khepera n_turns=12": (
+    "bearing-env play --env BearingSLAMDiscrete-v1 --env-kwargs scenario=khepera n_turns=12": (
         "parse",
         (),
     ),
@@ -89,7 +89,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
         ("--steps", "30", "--fusion", "robust", "--no-progress"),
     ),
     "bearing-env soak": ("run", ("--steps", "30", "--no-progress")),
-    "bearing-env soak --steps 100000 --task BearingSLAM-FurnishedRoom-v0": (
+    "bearing-env soak --steps 100000 --task BearingSLAM-FurnishedRoom-v1": (
         "run",
         ("--steps", "30", "--no-progress"),
     ),
@@ -108,11 +108,11 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
         "copy",
         (),
     ),
-    "bearing-env compare --episodes 100 --workers 2 --env BearingSLAMDiscrete-v0 "
+    "bearing-env compare --episodes 100 --workers 2 --env BearingSLAMDiscrete-v1 "
     "--out outputs/compare_khepera_discrete": ("parse", ()),
     "bearing-env compare --episodes 100 --workers 2 --env-kwargs scenario=random "
     "n_landmarks=6 --out outputs/compare_random6": ("parse", ()),
-    "bearing-env train --algo ppo --env BearingSLAM-Khepera-v0 --seed 0 --eval-freq 250000 "
+    "bearing-env train --algo ppo --env BearingSLAM-Khepera-v1 --seed 0 --eval-freq 250000 "
     "--output runs/ppo_khepera": ("parse", ()),
     "bearing-env train --algo ppo --output runs/ppo_khepera --export "
     "agents/pretrained/ppo_khepera --export-only": ("parse", ()),
@@ -123,9 +123,9 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "agents/pretrained/ppo_random --export-only": ("parse", ()),
     "python -m bearing_env.train.studies.generalisation --model ppo_random --counts 3 4 6 8 10 "
     "--episodes 50": ("parse", ()),
-    "python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-Khepera-v0 "
+    "python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-Khepera-v1 "
     '--conf-file "$(bearing-env hyperparams ppo)"': ("zoo", ()),
-    "python -m rl_zoo3.enjoy --gym-packages bearing_env --algo ppo --env BearingSLAM-Khepera-v0 "
+    "python -m rl_zoo3.enjoy --gym-packages bearing_env --algo ppo --env BearingSLAM-Khepera-v1 "
     "-f logs": ("zoo", ()),
     'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_entities)" '
     "--seed 0 --eval-freq 100000 --output runs/ppo_generalist": ("parse", ()),
@@ -140,7 +140,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env figures --only robust --out docs/figures": ("parse", ()),
     "bearing-env robust-eval": ("parse", ()),
     "bearing-env robust-eval --episodes 200": ("parse", ()),
-    "bearing-env train --algo ppo --env BearingSLAM-Khepera-v0 "
+    "bearing-env train --algo ppo --env BearingSLAM-Khepera-v1 "
     "--init-from pretrained:ppo_khepera --timesteps 2000000 "
     "--output runs/ppo_khepera_finetune": ("parse", ()),
     "bearing-env observability": ("parse", ()),
@@ -149,6 +149,8 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--iterations 4 --episodes 50 --output runs/distill_khepera": ("parse", ()),
     "bearing-env train --algo ppo --env BearingSLAM-FurnishedRoom-v0 --seed 0 --eval-freq 250000 "
     "--output runs/ppo_furnished_room": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAM-v0 --env-kwargs scenario=khepera --seed 0 "
+    "--eval-freq 250000 --output runs/ppo_khepera": ("parse", ()),
     "bearing-env train --algo ppo --env BearingSLAM-FurnishedRoom-v0 --output "
     "runs/ppo_furnished_room --export agents/pretrained/ppo_furnished_room --export-only": (
         "parse",
@@ -169,7 +171,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env compare --episodes 2000 --executor ray --ray-address auto "
     "--out outputs/compare_2000": ("parse", ()),
     "bearing-env rllib": ("parse", ()),
-    "bearing-env rllib --env BearingSLAM-v0 --iterations 50 --output runs/rllib_ppo": (
+    "bearing-env rllib --env BearingSLAM-v1 --iterations 50 --output runs/rllib_ppo": (
         "parse",
         (),
     ),
@@ -190,11 +192,11 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     'bearing-env compare --policies greedy oracle lookahead lookahead_oracle': ('parse', ()),
     'bearing-env docs-tables': ('parse', ()),
     'bearing-env generalisation': ('help', ()),
-    'bearing-env suite --tasks BearingSLAM-FurnishedRoom-v0 --workers 2': ('parse', ()),
-    'bearing-env suite --tasks BearingSLAM-Khepera-v0 --workers 2': ('parse', ()),
+    'bearing-env suite --tasks BearingSLAM-FurnishedRoom-v1 --workers 2': ('parse', ()),
+    'bearing-env suite --tasks BearingSLAM-Khepera-v1 --workers 2': ('parse', ()),
     "python -m bearing_env.train.studies.generalisation --model ppo_generalist --counts 3 8 12 "
     "16 --episodes 200 --out outputs/generalisation_generalist": ("parse", ()),
-    "python -m rl_zoo3.train --algo ppo --env BearingSLAM-Random3to16-Entities-v0 "
+    "python -m rl_zoo3.train --algo ppo --env BearingSLAM-Random3to16-Entities-v1 "
     '--gym-packages bearing_env --conf-file "$(bearing-env hyperparams ppo_entities)"': (
         "zoo",
         (),

@@ -71,7 +71,7 @@ def test_the_soak_counts_misses_and_exceptions_and_exits_1(monkeypatch, capsys):
         (["--seed", "-2"], "--seed"),
         (["--json", "{a_file}/x.json"], "--json"),
         (["--fusion", "relaxed"], "--fusion"),
-        (["--fusion", "robust", "--task", "BearingSLAM-Khepera-v0"], "--fusion"),
+        (["--fusion", "robust", "--task", "BearingSLAM-Khepera-v1"], "--fusion"),
     ],
 )
 def test_the_soak_refuses_bad_values_in_one_line(argv, named, capsys, tmp_path):
@@ -86,9 +86,9 @@ def test_the_soak_refuses_bad_values_in_one_line(argv, named, capsys, tmp_path):
 def test_a_task_soak_runs_that_task_only(capsys):
     import pytest
 
-    report = soak.run(120, seed=2, episodes=2, task="BearingSLAM-FurnishedRoom-v0")
+    report = soak.run(120, seed=2, episodes=2, task="BearingSLAM-FurnishedRoom-v1")
     assert report.steps >= 120 and report.defects == 0 and report.containment_checks > 0
-    soak.main(["--steps", "40", "--task", "BearingSLAM-Khepera-Camera90-v0", "--no-progress"])
-    assert "BearingSLAM-Khepera-Camera90-v0" in capsys.readouterr().out
+    soak.main(["--steps", "40", "--task", "BearingSLAM-Khepera-Camera90-v1", "--no-progress"])
+    assert "BearingSLAM-Khepera-Camera90-v1" in capsys.readouterr().out
     with pytest.raises(SystemExit):
         soak.main(["--steps", "10", "--task", "Nope-v0"])

@@ -105,7 +105,7 @@ def test_compare_prints_its_tables_whole_at_80_columns(
 
     config = CompareConfig(
         policies=policies_from_specs(["random", "greedy"]),
-        env_id="BearingSLAM-v0",
+        env_id="BearingSLAM-v1",
         env_kwargs={"scenario": "khepera", "max_moves": 3},
         episodes=3,
         bootstrap=50,

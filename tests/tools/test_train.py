@@ -431,7 +431,7 @@ def test_corrupt_statistics_and_checkpoint_name_the_path(
 ) -> None:
     stats = tmp_path / "vecnormalize.pkl"
     stats.write_bytes(b"\x80\x04 truncated pickle")
-    venv = make_validation_env("BearingSLAM-v0", {"scenario": "khepera"}, 1)
+    venv = make_validation_env("BearingSLAM-v1", {"scenario": "khepera"}, 1)
     with pytest.raises(ModelLoadError, match=re.escape(str(stats))):
         load_vecnormalize(stats, venv)
     with pytest.raises(FileNotFoundError, match=re.escape("missing.pkl")):
@@ -493,7 +493,7 @@ def test_export_writes_the_pretrained_layout(
     assert exported.source == "best"
     assert (folder / "ppo_tiny.zip").read_bytes() == (run / "best" / BEST_MODEL_NAME).read_bytes()
     metadata = json.loads((folder / "ppo_tiny.json").read_text())
-    assert metadata["algo"] == "ppo" and metadata["env_id"] == "BearingSLAM-Khepera-v0"
+    assert metadata["algo"] == "ppo" and metadata["env_id"] == "BearingSLAM-Khepera-v1"
     assert metadata["env_kwargs"] == {}
     assert metadata["files"] == {
         "model": "ppo_tiny.zip",
@@ -501,10 +501,10 @@ def test_export_writes_the_pretrained_layout(
     }
 
     # The exported files act like the run's best model, through agents.SB3Policy.
-    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    env = gym.make("BearingSLAM-v1", scenario="khepera")
     policy = SB3Policy(env, folder / "ppo_tiny.zip")
     best = load_model(run / "best" / BEST_MODEL_NAME, "ppo")
-    venv = make_validation_env("BearingSLAM-v0", {"scenario": "khepera"}, 1)
+    venv = make_validation_env("BearingSLAM-v1", {"scenario": "khepera"}, 1)
     stats = load_vecnormalize(run / "best" / "vecnormalize.pkl", venv)
     observation, info = env.reset(seed=VALIDATION_SEED_START)
     expected, _ = best.predict(stats.normalize_obs(observation), deterministic=True)
@@ -526,7 +526,7 @@ def test_exported_models_load_by_name_and_join_the_comparison(
     export_run(tiny_runs["ppo"].run_dir, folder / "ppo_tiny")
     assert pretrained_names() == ["ppo_tiny"]
 
-    env = gym.make("BearingSLAM-v0", scenario="khepera")
+    env = gym.make("BearingSLAM-v1", scenario="khepera")
     by_name = SB3Policy.pretrained("ppo_tiny", env)
     by_spec = make_policy("pretrained:ppo_tiny", env)
     by_path = SB3Policy(env, folder / "ppo_tiny.zip")
@@ -540,26 +540,26 @@ def test_exported_models_load_by_name_and_join_the_comparison(
 
     # Compared by default only where it was trained: the same action kind and settings,
     # by the task id or by the base id with the task's kwargs.
-    assert matching_pretrained("BearingSLAM-Khepera-v0", {}) == ["pretrained:ppo_tiny"]
-    assert matching_pretrained("bearing_env:BearingSLAM-v0", {"scenario": "khepera"}) == [
+    assert matching_pretrained("BearingSLAM-Khepera-v1", {}) == ["pretrained:ppo_tiny"]
+    assert matching_pretrained("bearing_env:BearingSLAM-v1", {"scenario": "khepera"}) == [
         "pretrained:ppo_tiny"
     ]
-    assert matching_pretrained("BearingSLAM-v0", {"scenario": "khepera", "max_moves": 10}) == [
+    assert matching_pretrained("BearingSLAM-v1", {"scenario": "khepera", "max_moves": 10}) == [
         "pretrained:ppo_tiny"
     ]
-    assert matching_pretrained("BearingSLAM-v0", {"scenario": "random"}) == []
+    assert matching_pretrained("BearingSLAM-v1", {"scenario": "random"}) == []
     # Records are JSON: a tuple-valued kwarg must still match its JSON list.
     record = folder / "ppo_tiny.json"
     metadata = json.loads(record.read_text())
-    metadata["env_id"] = "BearingSLAM-v0"
+    metadata["env_id"] = "BearingSLAM-v1"
     metadata["env_kwargs"] = {"scenario": "random", "n_landmarks": [4, 8], "max_landmarks": 10}
     record.write_text(json.dumps(metadata))
     assert matching_pretrained(
-        "BearingSLAM-v0", {"scenario": "random", "n_landmarks": (4, 8), "max_landmarks": 10}
+        "BearingSLAM-v1", {"scenario": "random", "n_landmarks": (4, 8), "max_landmarks": 10}
     ) == ["pretrained:ppo_tiny"]
     # Settings that do not resolve match no model (the comparison reports them).
-    assert matching_pretrained("BearingSLAM-v0", {"scenario": "khepera", "n_landmarks": 6}) == []
-    assert matching_pretrained("BearingSLAMDiscrete-v0", {"scenario": "khepera"}) == []
+    assert matching_pretrained("BearingSLAM-v1", {"scenario": "khepera", "n_landmarks": 6}) == []
+    assert matching_pretrained("BearingSLAMDiscrete-v1", {"scenario": "khepera"}) == []
 
 
 # --------------------------------------------------------------------------------------
@@ -595,16 +595,16 @@ def test_hyperparameters_are_preprocessed_by_rl_zoo3() -> None:
     assert parse_hyperparameters({"n_timesteps": 10, "normalize": False}).normalize is None
     # SB3 takes them as they are: the model's learning rate follows the schedule.
     kwargs = {k: v for k, v in parsed.algorithm_kwargs.items() if k not in ("policy", "train_freq")}
-    model = PPO("MlpPolicy", "BearingSLAM-v0", n_steps=8, batch_size=8, device="cpu", **kwargs)
+    model = PPO("MlpPolicy", "BearingSLAM-v1", n_steps=8, batch_size=8, device="cpu", **kwargs)
     assert model.lr_schedule(0.5) == pytest.approx(5e-4)
 
 
 def test_using_rl_zoo3_leaves_gymnasium_unpatched() -> None:
     """rl-zoo3 replaces TimeLimit on import; the trainer's use of it must not leak."""
-    read_hyperparameters("ppo", "BearingSLAM-v0")
+    read_hyperparameters("ppo", "BearingSLAM-v1")
     algorithm_class_for("ppo")
     assert gym.wrappers.TimeLimit.__module__.startswith("gymnasium.")
-    env = gym.make("BearingSLAM-v0", max_episode_steps=1)
+    env = gym.make("BearingSLAM-v1", max_episode_steps=1)
     env.reset(seed=0)
     env.action_space.seed(0)
     info = env.step(env.action_space.sample())[4]
@@ -640,7 +640,7 @@ def test_seed_ranges_are_disjoint_and_validation_episodes_repeat() -> None:
     with pytest.raises(ValueError):
         training_seed_start(TRAINING_SEED_LIMIT, 0, 1)
 
-    env = EpisodeSeedCycle(gym.make("BearingSLAM-v0"), [VALIDATION_SEED_START, 900_001])
+    env = EpisodeSeedCycle(gym.make("BearingSLAM-v1"), [VALIDATION_SEED_START, 900_001])
     first = [env.reset()[0] for _ in range(3)]
     env.rewind_episode_seeds()
     again = env.reset()[0]
@@ -651,7 +651,7 @@ def test_seed_ranges_are_disjoint_and_validation_episodes_repeat() -> None:
 
 
 def test_env_factory_raises_the_time_limit_with_max_moves() -> None:
-    env = EnvFactory("BearingSLAM-v0", {"scenario": "khepera", "max_moves": 23})()
+    env = EnvFactory("BearingSLAM-v1", {"scenario": "khepera", "max_moves": 23})()
     assert env.spec is not None and env.spec.max_episode_steps == 23
     env.reset(seed=1)
     moves, done = 0, False
@@ -689,7 +689,7 @@ def test_rl_zoo3_envs_run_max_moves() -> None:
     no registered TimeLimit, max_moves=40 runs 40 moves there too."""
     from bearing_env.train.sb3.zoo import _experiment_manager
 
-    manager = _experiment_manager("ppo", "BearingSLAM-v0")
+    manager = _experiment_manager("ppo", "BearingSLAM-v1")
     manager.env_kwargs = {"scenario": "khepera", "max_moves": 40, "target_area": 1e-9}
     envs = manager.create_envs(n_envs=1, no_log=True)
     envs.seed(5)

@@ -34,7 +34,7 @@ from bearing_env.train.sb3.train import TrainSettings, train
 from bearing_env.train.sb3.training_envs import EnvFactory, resolve_vec_env_kind
 from bearing_env.train.sb3.vec_env import GymnasiumVecEnv, make_batched_vec_env
 
-ENV_IDS = ("BearingSLAM-v0", "BearingSLAMDiscrete-v0")
+ENV_IDS = ("BearingSLAM-v1", "BearingSLAMDiscrete-v1")
 ENDING_KWARGS: dict[str, Any] = {"scenario": "khepera", "target_area": 0.5, "max_moves": 10}
 N_ENVS = 3
 N_STEPS = 120
@@ -176,7 +176,7 @@ def test_sync_fallback_reproduces_dummy_vec_env_with_ragged_infos() -> None:
     and ``VecMonitor``. Random layouts of 3 to 6 landmarks report info arrays
     (``landmark_area`` ...) of different lengths, which Gymnasium alone cannot stack."""
     kwargs = {"scenario": "random", "n_landmarks": (3, 6), "target_area": 0.5, "max_moves": 10}
-    env_id = "BearingSLAMDiscrete-v0"
+    env_id = "BearingSLAMDiscrete-v1"
     adapted = make_batched_vec_env(env_id, kwargs, N_ENVS, monitor_path=None)
     reference = reference_vec_env(env_id, kwargs)
     try:
@@ -208,8 +208,8 @@ def test_training_vec_env_reproduces_dummy_vec_env(env_id: str) -> None:
 
 
 def test_reset_and_step_follow_the_vec_env_api() -> None:
-    venv = GymnasiumVecEnv(sync_vector_env("BearingSLAM-v0", {"scenario": "khepera"}))
-    single = gym.make("BearingSLAM-v0", scenario="khepera")
+    venv = GymnasiumVecEnv(sync_vector_env("BearingSLAM-v1", {"scenario": "khepera"}))
+    single = gym.make("BearingSLAM-v1", scenario="khepera")
     try:
         assert venv.num_envs == N_ENVS
         assert venv.observation_space == single.observation_space
@@ -235,7 +235,7 @@ def test_reset_and_step_follow_the_vec_env_api() -> None:
 
 
 def test_attributes_and_methods_reach_the_sub_envs() -> None:
-    venv = GymnasiumVecEnv(sync_vector_env("BearingSLAM-v0", {"scenario": "khepera"}))
+    venv = GymnasiumVecEnv(sync_vector_env("BearingSLAM-v1", {"scenario": "khepera"}))
     try:
         assert venv.get_attr("area_cap") == [10.0] * N_ENVS  # a sub-env attribute
         assert venv.get_attr("area_cap", indices=[2]) == [10.0]
@@ -258,7 +258,7 @@ def test_attributes_and_methods_reach_the_sub_envs() -> None:
 def test_a_vector_env_without_sub_env_access_serves_only_whole_batch_requests() -> None:
     """A plain ``VectorWrapper`` has neither ``get_attr`` nor ``call``: its own attributes
     stand for every sub-env, and a request for some sub-envs only is refused."""
-    venv = GymnasiumVecEnv(VectorWrapper(sync_vector_env("BearingSLAM-v0", {})))
+    venv = GymnasiumVecEnv(VectorWrapper(sync_vector_env("BearingSLAM-v1", {})))
     try:
         assert venv.get_attr("num_envs", indices=[0, 2]) == [N_ENVS, N_ENVS]
         with pytest.raises(AttributeError, match="area_cap"):
@@ -291,7 +291,7 @@ class RecordingVectorEnv(VectorWrapper):
 
 
 def test_seeds_and_options_are_used_once() -> None:
-    recorder = RecordingVectorEnv(sync_vector_env("BearingSLAM-v0", {"scenario": "random"}))
+    recorder = RecordingVectorEnv(sync_vector_env("BearingSLAM-v1", {"scenario": "random"}))
     venv = GymnasiumVecEnv(recorder)
     try:
         assert venv.seed(7) == [7, 8, 9]
@@ -314,12 +314,12 @@ def test_seeds_and_options_are_used_once() -> None:
 
 def test_a_vector_env_in_another_autoreset_mode_is_refused() -> None:
     for mode in (AutoresetMode.NEXT_STEP, AutoresetMode.DISABLED):
-        vector_env = sync_vector_env("BearingSLAM-v0", {}, n_envs=1, autoreset_mode=mode)
+        vector_env = sync_vector_env("BearingSLAM-v1", {}, n_envs=1, autoreset_mode=mode)
         with pytest.raises(ValueError, match="SAME_STEP"):
             GymnasiumVecEnv(vector_env)
         vector_env.close()
     with pytest.raises(TypeError, match="VectorEnv"):
-        GymnasiumVecEnv(gym.make("BearingSLAM-v0"))  # type: ignore[arg-type]
+        GymnasiumVecEnv(gym.make("BearingSLAM-v1"))  # type: ignore[arg-type]
 
 
 class DropFinalKey(VectorWrapper):
@@ -338,7 +338,7 @@ class DropFinalKey(VectorWrapper):
 
 @pytest.mark.parametrize("key", ["final_obs", "final_info"])
 def test_a_finished_episode_without_its_final_observation_or_info_raises(key: str) -> None:
-    vector_env = sync_vector_env("BearingSLAM-v0", {"max_moves": 2}, n_envs=2)
+    vector_env = sync_vector_env("BearingSLAM-v1", {"max_moves": 2}, n_envs=2)
     venv = GymnasiumVecEnv(DropFinalKey(vector_env, key))
     try:
         venv.reset()
@@ -352,8 +352,8 @@ def test_a_finished_episode_without_its_final_observation_or_info_raises(key: st
 @pytest.mark.parametrize(
     ("env_id", "algorithm", "kwargs"),
     [
-        ("BearingSLAM-v0", PPO, {"n_steps": 16, "batch_size": 32, "n_epochs": 1}),
-        ("BearingSLAMDiscrete-v0", DQN, {"learning_starts": 16, "batch_size": 16}),
+        ("BearingSLAM-v1", PPO, {"n_steps": 16, "batch_size": 32, "n_epochs": 1}),
+        ("BearingSLAMDiscrete-v1", DQN, {"learning_starts": 16, "batch_size": 16}),
     ],
 )
 def test_sb3_learns_on_it_with_vecnormalize(
@@ -375,11 +375,11 @@ def test_sb3_learns_on_it_with_vecnormalize(
 def test_a_registered_vector_entry_point_is_used(
     stub_vector_entry_point: list[dict[str, Any]],
 ) -> None:
-    venv = make_batched_vec_env("bearing_env:BearingSLAM-v0", {"max_moves": 7}, 2, None)
+    venv = make_batched_vec_env("bearing_env:BearingSLAM-v1", {"max_moves": 7}, 2, None)
     venv.close()
     assert stub_vector_entry_point == [
         {
-            "env_id": "BearingSLAM-v0",
+            "env_id": "BearingSLAM-v1",
             "num_envs": 2,
             "max_moves": 7,
             "autoreset_mode": AutoresetMode.SAME_STEP,
@@ -390,22 +390,22 @@ def test_a_registered_vector_entry_point_is_used(
 def test_auto_is_batched_only_with_a_vector_entry_point(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    spec = gym.spec("BearingSLAM-v0")
+    spec = gym.spec("BearingSLAM-v1")
     monkeypatch.setattr(spec, "vector_entry_point", None)
-    assert resolve_vec_env_kind("auto", "BearingSLAM-v0") == "subproc"
+    assert resolve_vec_env_kind("auto", "BearingSLAM-v1") == "subproc"
     monkeypatch.setattr(spec, "vector_entry_point", "module:Class")
-    assert resolve_vec_env_kind("auto", "bearing_env:BearingSLAM-v0") == "batched"
-    assert resolve_vec_env_kind("dummy", "BearingSLAM-v0") == "dummy"
+    assert resolve_vec_env_kind("auto", "bearing_env:BearingSLAM-v1") == "batched"
+    assert resolve_vec_env_kind("dummy", "BearingSLAM-v1") == "dummy"
     with pytest.raises(ValueError, match="auto"):
-        resolve_vec_env_kind("threads", "BearingSLAM-v0")
-    assert TrainSettings("ppo", "BearingSLAM-v0", Path("x")).vec_env == "auto"
+        resolve_vec_env_kind("threads", "BearingSLAM-v1")
+    assert TrainSettings("ppo", "BearingSLAM-v1", Path("x")).vec_env == "auto"
     assert train_cli.build_parser().parse_args(["--algo", "ppo"]).vec_env == "auto"
 
 
 def run_cli(output: Path, timesteps: int, *extra: str) -> dict[str, Any]:
     train_cli.main(
         [
-            "--algo", "ppo", "--env", "BearingSLAM-v0", "--output", str(output),
+            "--algo", "ppo", "--env", "BearingSLAM-v1", "--output", str(output),
             "--n-envs", "2", "--seed", "4",
             "--timesteps", str(timesteps), "--hyperparams", *TINY_PPO,
             "--eval-freq", "32", "--eval-episodes", "1", "--checkpoint-freq", "32",
@@ -429,7 +429,7 @@ def test_train_batched_writes_its_outputs_and_resumes(tmp_path: Path) -> None:
         assert (run / name).is_file(), name
     assert sorted(path.name for path in (run / "monitor").iterdir()) == ["batched.monitor.csv"]
     headers, lines = monitor_rows(run / "monitor" / "batched.monitor.csv")
-    assert len(headers) == 1 and json.loads(headers[0][1:])["env_id"] == "BearingSLAM-v0"
+    assert len(headers) == 1 and json.loads(headers[0][1:])["env_id"] == "BearingSLAM-v1"
     assert lines[1] == "r,l,t,is_success"
     episodes = len(lines) - 2
     assert episodes >= 2  # 32 steps per env, 20-move episodes
@@ -456,7 +456,7 @@ def test_batched_and_dummy_train_the_same_model(tmp_path: Path) -> None:
     """The same seeds give the same data, hence bit for bit the same PPO model."""
     settings = TrainSettings(
         algo="ppo",
-        env_id="BearingSLAM-v0",
+        env_id="BearingSLAM-v1",
         output=tmp_path / "dummy",
         hyperparam_overrides=parse_key_values(TINY_PPO, "--hyperparams"),
         timesteps=64,

@@ -15,7 +15,7 @@ gives a YAML's ``env_kwargs`` to its training envs only, so an entry with settin
 own evaluated on the id's defaults without ``--eval-env-kwargs`` and failed here, as the
 ``ppo_entities`` command did (``norm_obs_keys`` on a Box observation). Every shipped
 entry is keyed by a registered id whose kwargs carry its settings (``ppo.yml``:
-``BearingSLAM-Khepera-v0``; ``ppo_entities.yml``: ``BearingSLAM-Random3to16-Entities-v0``),
+``BearingSLAM-Khepera-v1``; ``ppo_entities.yml``: ``BearingSLAM-Random3to16-Entities-v1``),
 so no command needs that flag: rl-zoo3 makes the evaluation env from the id;
 :func:`test_the_plain_command_trains_and_evaluates_each_task_keyed_file` runs that plain
 form for every single-entry file, whatever the docs show, and
@@ -185,7 +185,7 @@ COMMANDS = documented_commands()
 
 def test_the_docs_show_the_zoo_commands_this_test_must_run() -> None:
     labels = {command.label for command in COMMANDS}
-    assert {"train-ppo-ppo", "train-ppo-ppo_entities", "enjoy-ppo-BearingSLAM-Khepera-v0"} <= labels
+    assert {"train-ppo-ppo", "train-ppo-ppo_entities", "enjoy-ppo-BearingSLAM-Khepera-v1"} <= labels
     assert all("--eval-env-kwargs" not in c.argv for c in COMMANDS)
     text = (
         "Train:\n\n```bash\npython -m rl_zoo3.train --algo ppo \\\n    --env E  # why\n```\n"

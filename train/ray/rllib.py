@@ -1,7 +1,7 @@
 """``bearing-env rllib``: train PPO with RLlib, on this machine or a Ray cluster.
 
-    bearing-env rllib --env BearingSLAM-v0 --iterations 50
-    bearing-env rllib --env BearingSLAMDiscrete-v0 --env-kwargs scenario=random \\
+    bearing-env rllib --env BearingSLAM-v1 --iterations 50
+    bearing-env rllib --env BearingSLAMDiscrete-v1 --env-kwargs scenario=random \\
         --num-env-runners 4 --ray-address HEAD_IP:6379
     bearing-env rllib --output runs/rllib_ppo --resume --iterations 100
 
@@ -69,10 +69,10 @@ METRICS = ("episode_return_mean", "episode_len_mean", "num_episodes")
 
 @dataclass(frozen=True)
 class RLlibSettings:
-    """One PPO run. ``env_id`` is a registered id (``BearingSLAM-v0``, with or without the
+    """One PPO run. ``env_id`` is a registered id (``BearingSLAM-v1``, with or without the
     ``bearing_env:`` prefix)."""
 
-    env_id: str = "BearingSLAM-v0"
+    env_id: str = "BearingSLAM-v1"
     env_kwargs: dict[str, Any] = field(default_factory=lambda: dict(DEFAULT_ENV_KWARGS))
     iterations: int = 20
     seed: int = 0

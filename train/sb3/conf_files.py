@@ -4,7 +4,7 @@ The files are package data of ``bearing_env.train.sb3`` (``hyperparams/<algo>.ym
 through :mod:`bearing_env.shipped`), so they exist in site-packages as well as in a
 checkout. ``bearing-env hyperparams ppo`` prints the path of ``ppo.yml``, for rl-zoo3::
 
-    python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-Khepera-v0 \\
+    python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-Khepera-v1 \\
         --conf-file "$(bearing-env hyperparams ppo)"
 
 (rl-zoo3 gives an entry's ``env_kwargs`` to its training envs only and makes its

@@ -4,8 +4,8 @@ DQN with stable-baselines3 as :class:`TrainSettings` say. Its command line is
 :mod:`bearing_env.train.sb3.run_record`.
 
     bearing-env train --algo ppo                                   # PPO, Khepera scenario
-    bearing-env train --algo sac --env BearingSLAM-Khepera-v0 --timesteps 200000
-    bearing-env train --algo dqn --env BearingSLAMDiscrete-v0 --env-kwargs scenario=random
+    bearing-env train --algo sac --env BearingSLAM-Khepera-v1 --timesteps 200000
+    bearing-env train --algo dqn --env BearingSLAMDiscrete-v1 --env-kwargs scenario=random
     bearing-env train --algo ppo --output runs/ppo_khepera --resume --timesteps 2000000
     bearing-env train --algo ppo --output runs/ppo_khepera --export-only \
         --export agents/pretrained/ppo_khepera
@@ -16,10 +16,10 @@ entry per env id holding ``n_envs``, ``n_timesteps``, ``policy``, ``normalize``,
 ``policy_kwargs`` (a Python expression string) and the algorithm's constructor arguments
 (``lin_<x>`` is a schedule decaying linearly from ``x`` to 0); an entry may hold
 ``env_kwargs`` too, but the shipped ones are keyed by the id whose registered kwargs
-carry the settings (``BearingSLAM-Khepera-v0``), so that the same files run under
+carry the settings (``BearingSLAM-Khepera-v1``), so that the same files run under
 rl-zoo3, which makes its evaluation env from the id alone::
 
-    python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-Khepera-v0 \\
+    python -m rl_zoo3.train --gym-packages bearing_env --algo ppo --env BearingSLAM-Khepera-v1 \\
         --conf-file "$(bearing-env hyperparams ppo)"
 
 ``--env-kwargs k=v ...`` is merged over the entry's ``env_kwargs`` (rl-zoo3 replaces them

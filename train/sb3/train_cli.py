@@ -49,7 +49,7 @@ EXIT_INTERRUPTED = 130
 def build_parser() -> argparse.ArgumentParser:
     parser = command_parser(
         "bearing-env train",
-        "Train PPO/SAC (BearingSLAM-Khepera-v0) or DQN (BearingSLAMDiscrete-Khepera-v0) with "
+        "Train PPO/SAC (BearingSLAM-Khepera-v1) or DQN (BearingSLAMDiscrete-Khepera-v1) with "
         "stable-baselines3; hyperparameters from the shipped <algo>.yml (rl-zoo3 format; "
         "bearing-env hyperparams ALGO prints its path). "
         "Ctrl-C saves a checkpoint; --resume continues from it.",
@@ -73,7 +73,7 @@ def _add_experiment_options(group: argparse._ArgumentGroup) -> None:
     add(
         "--env",
         help="env id: the key of the YAML entry and the env (default: a file's one entry's "
-        "id, else BearingSLAM-Khepera-v0; for dqn BearingSLAMDiscrete-Khepera-v0)",
+        "id, else BearingSLAM-Khepera-v1; for dqn BearingSLAMDiscrete-Khepera-v1)",
     )
     add(
         "--env-kwargs",

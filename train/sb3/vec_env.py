@@ -52,7 +52,7 @@ MONITOR_INFO_KEYWORDS: tuple[str, ...] = ("is_success",)
 def env_spec(env_id: str) -> EnvSpec:
     """The registered spec of ``env_id``, importing ``module`` first for ``module:Id``.
 
-    ``gym.spec`` alone does not understand the ``bearing_env:BearingSLAM-v0`` form that
+    ``gym.spec`` alone does not understand the ``bearing_env:BearingSLAM-v1`` form that
     ``gym.make`` and ``gym.make_vec`` accept.
     """
     module, _, name = env_id.rpartition(":")

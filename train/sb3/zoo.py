@@ -41,9 +41,9 @@ from bearing_env.validation import int_at_least, is_integer
 #: trains on by default: the Khepera task ids, whose registered kwargs carry the scenario
 #: (the shipped files are keyed by them, as rl-zoo3 needs).
 DEFAULT_ENV_IDS: dict[str, str] = {
-    "ppo": "BearingSLAM-Khepera-v0",
-    "sac": "BearingSLAM-Khepera-v0",
-    "dqn": "BearingSLAMDiscrete-Khepera-v0",
+    "ppo": "BearingSLAM-Khepera-v1",
+    "sac": "BearingSLAM-Khepera-v1",
+    "dqn": "BearingSLAMDiscrete-Khepera-v1",
 }
 
 #: rl-zoo3 keys that this trainer does not implement (rl-zoo3 itself does).
@@ -109,7 +109,7 @@ def rl_zoo3_module(name: str) -> ModuleType:
 def default_env_id(algo: str, conf_file: Path | None = None) -> str:
     """The env id a run trains on when ``--env`` is not given: the one entry's key of a
     hyperparameter file with a single entry (``ppo_entities.yml``:
-    ``BearingSLAM-Random3to16-Entities-v0``), else the algorithm's default
+    ``BearingSLAM-Random3to16-Entities-v1``), else the algorithm's default
     (:data:`DEFAULT_ENV_IDS`)."""
     if conf_file is not None and conf_file.is_file():
         import yaml  # type: ignore[import-untyped]  # why: pyyaml ships no types
@@ -124,7 +124,7 @@ def default_env_id(algo: str, conf_file: Path | None = None) -> str:
 
 
 def hyperparams_key(env_id: str) -> str:
-    """The file key of an env id: ``bearing_env:BearingSLAM-v0`` -> ``BearingSLAM-v0``."""
+    """The file key of an env id: ``bearing_env:BearingSLAM-v1`` -> ``BearingSLAM-v1``."""
     return env_id.split(":")[-1]
 
 
@@ -222,7 +222,7 @@ def parse_hyperparameters(raw: Mapping[str, Any], algo: str = "ppo") -> Hyperpar
     if not isinstance(env_kwargs, dict):
         raise ValueError(f"env_kwargs must be a mapping, got {env_kwargs!r}")
     entry["env_kwargs"] = env_kwargs
-    manager = _experiment_manager(algo, DEFAULT_ENV_IDS.get(algo, "BearingSLAM-v0"))
+    manager = _experiment_manager(algo, DEFAULT_ENV_IDS.get(algo, "BearingSLAM-v1"))
     try:
         kwargs, *_ = manager._preprocess_hyperparams(entry)
     except Exception as error:  # rl-zoo3 raises what eval() or float() raised

@@ -116,7 +116,7 @@ def main(argv: list[str] | None = None) -> None:
     rendering = available("pygame")
 
     env = gym.make(
-        "BearingSLAM-v0",
+        "BearingSLAM-v1",
         scenario="khepera",
         move_length=MOVE_LENGTH,
         max_moves=args.moves,

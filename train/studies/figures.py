@@ -117,7 +117,7 @@ def random_polygonal_trace(
 
     # The paper's runs have a fixed number of movements: no early stop on success.
     kwargs = {"target_area": NEVER_SUCCEEDS, **env_kwargs, "max_moves": moves}
-    env = make_env("bearing_env:BearingSLAM-v0", kwargs)
+    env = make_env("bearing_env:BearingSLAM-v1", kwargs)
     base = bearing_env_of(env)
     policy = RandomPolygonal(env)
     bearing_block = observation_slices(base.config.observations.max_landmarks)["bearings"]

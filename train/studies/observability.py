@@ -17,8 +17,8 @@ region no larger than ``area_cap`` (the only ones the reward can see: a larger o
 capped), and the share of start positions from which some movement does. The plot
 colours each start by how many landmarks its best movement maps within ``area_cap``.
 
-    bearing-env observability --env BearingSLAM-Khepera-v0 --fov 360 180 90
-    bearing-env observability --env BearingSLAM-FurnishedRoom-v0 --fov 360 90 --plot out.png
+    bearing-env observability --env BearingSLAM-Khepera-v1 --fov 360 180 90
+    bearing-env observability --env BearingSLAM-FurnishedRoom-v1 --fov 360 90 --plot out.png
 
 ``--json`` writes the figures with the command, commit, date and machine that measured
 them; the environment page's table is written from ``docs/figures/observability_*.json``
@@ -429,7 +429,7 @@ def plot(env_id: str, results: dict[float, dict[str, Any]], path: Path) -> Path:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = command_parser("bearing-env observability", doc_summary(__doc__))
-    parser.add_argument("--env", default="BearingSLAM-Khepera-v0", help="a registered task id")
+    parser.add_argument("--env", default="BearingSLAM-Khepera-v1", help="a registered task id")
     parser.add_argument(
         "--fov", type=float, nargs="+", default=[360.0, 180.0, 90.0], metavar="DEG",
         help="fields of view to compare, degrees in (0, 360]",

@@ -4,7 +4,7 @@ The keys and the window are :mod:`bearing_env.envs.manual_control`'s (docs/play.
 left/right turn the next move, up/down change its length, space or enter moves, a left
 click on the field moves toward the point, ``r`` starts the next episode, escape quits.
 
-    python -m bearing_env.train.studies.play [--env BearingSLAM-v0] [--env-kwargs K=V ...]
+    python -m bearing_env.train.studies.play [--env BearingSLAM-v1] [--env-kwargs K=V ...]
         [--seed 0]
 """
 
@@ -18,13 +18,13 @@ import gymnasium as gym
 
 import bearing_env  # noqa: F401  (registers the ids)
 from bearing_env.envs.manual_control import KEY_HELP, TURN_STEP_DEG, ManualControl
-from bearing_env.registration import ENV_IDS
+from bearing_env.tasks import BASE_IDS
 from bearing_env.train.common.cli_parser import command_parser
 from bearing_env.train.common.cli_values import SEED, parse_key_values
 from bearing_env.train.common.errors import exit_on_missing_extra, fail, require
 
 PROG = "bearing-env play"
-DEFAULT_ENV_ID = "BearingSLAM-v0"
+DEFAULT_ENV_ID = "BearingSLAM-v1"
 #: The env settings without ``--env-kwargs``: the paper's real arena.
 DEFAULT_ENV_KWARGS: dict[str, Any] = {"scenario": "khepera"}
 
@@ -41,7 +41,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--env",
         default=DEFAULT_ENV_ID,
-        choices=sorted(ENV_IDS),
+        choices=sorted(BASE_IDS.values()),
         help="env id (default %(default)s)",
     )
     parser.add_argument(

@@ -79,7 +79,7 @@ def final_scores(
     from bearing_env.train.compare.runner import make_env, run_episode
 
     kwargs = {"target_area": NEVER_SUCCEEDS, "epsilon_deg": 2.0, **env_kwargs}
-    env = make_env("bearing_env:BearingSLAM-v0", {**kwargs, "max_moves": MOVES})
+    env = make_env("bearing_env:BearingSLAM-v1", {**kwargs, "max_moves": MOVES})
     policy = make_policy(policy_name, env)
     run_episode(policy, env, seeds[0] - 1)  # warm-up: compilation stays out of the time
     held = regions = 0
@@ -114,7 +114,7 @@ def step_ratio(rounds: int = 5, steps: int = 400) -> float:
     noise = NOISES["outliers 5%"]
     envs: dict[str, gym.Env] = {
         label: make_env(
-            "bearing_env:BearingSLAM-v0",
+            "bearing_env:BearingSLAM-v1",
             {"scenario": "khepera", "noise": noise, "max_moves": MOVES, **fusion},
         )
         for label, fusion in FUSIONS.items()
