@@ -92,6 +92,20 @@ def test_a_run_writes_every_output(tmp_path: Path) -> None:
     assert len(csv_lines) == 1 + 2 * 4
 
 
+@needs("train", "matplotlib")
+def test_plots_are_written_when_no_landmark_is_ever_mapped(tmp_path: Path) -> None:
+    """A 90-degree camera maps nothing in a few episodes: every error is missing and every
+    area at the cap, and the error plot (no positive value for a log axis) still draws."""
+    config = small_config(
+        episodes=2, env_id="bearing_env:BearingSLAM-Khepera-Camera90-v1", env_kwargs={}
+    )
+    result = run(config, tmp_path, plots=True)
+    curves = result.summary["policies"]["greedy_one_step"]["curves"]
+    assert set(curves["error_mean"]) == {None}
+    for name in ("area_vs_moves.png", "error_vs_moves.png"):
+        assert (tmp_path / name).stat().st_size > 0, name
+
+
 def test_the_harness_is_deterministic(tmp_path: Path) -> None:
     config = small_config()
     run(config, tmp_path / "a")

@@ -349,6 +349,7 @@ def plot_curves(summary: Mapping[str, Any], config: CompareConfig, out: Path) ->
         ("error", "mean error of initialised landmarks (FL units, log)", "error_vs_moves.png"),
     ):
         figure, axes = plt.subplots(figsize=(7.0, 4.3), dpi=110)
+        positive = False  # a log axis needs a positive value (none: no landmark mapped)
         for index, (label, stats) in enumerate(summary["policies"].items()):
             curves = stats["curves"]
             x = np.arange(len(curves[f"{metric}_mean"]))
@@ -368,7 +369,10 @@ def plot_curves(summary: Mapping[str, Any], config: CompareConfig, out: Path) ->
                 lw=0,
             )
             axes.plot(x, array(f"{metric}_median"), color=colour, lw=1.2, ls="--")
-        axes.set_yscale("log")
+            means = array(f"{metric}_mean")
+            positive = positive or bool(np.any(np.isfinite(means) & (means > 0)))
+        if positive:
+            axes.set_yscale("log")
         axes.xaxis.set_major_locator(MaxNLocator(integer=True))
         axes.set_xlabel("moves")
         axes.set_ylabel(ylabel)
