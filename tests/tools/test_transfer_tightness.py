@@ -8,6 +8,7 @@ import json
 import math
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -175,21 +176,143 @@ def test_the_command_runs_end_to_end_and_writes_the_json(
     assert len(written["resolution_checks"]) == 8
 
 
-def test_a_region_that_misses_the_exact_set_is_reported_and_exits_1(
-    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
-) -> None:
+def shrink_every_region(monkeypatch: pytest.MonkeyPatch, factor: float) -> None:
+    """Make every drawn region ``factor`` times its size about its vertices' mean."""
     draw = tightness.draw_movement
 
-    def shrunk(rng: np.random.Generator) -> tightness.Movement | str:
-        movement = draw(rng)
+    def shrunk(
+        rng: np.random.Generator, mapping: tightness.Mapping | None = None
+    ) -> tightness.Movement | str:
+        movement = draw(rng, mapping)
         if isinstance(movement, str):
             return movement
         centre = movement.region.mean()
-        return replace(movement, region=centre + 0.5 * (movement.region - centre))
+        return replace(movement, region=centre + factor * (movement.region - centre))
 
     monkeypatch.setattr(tightness, "draw_movement", shrunk)
+
+
+def test_a_region_that_misses_the_exact_set_is_reported_and_exits_1(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    shrink_every_region(monkeypatch, 0.5)
     with pytest.raises(SystemExit) as stopped:
         tightness.main(["--movements", "2", "--resolution", "40", "--no-progress"])
     assert stopped.value.code == 1
     out = capsys.readouterr().out
     assert "every grid point of E: 0.0%" in out and "not contained:" in out
+
+
+# ----------------------------------------------------------------------------------------
+# --containment-only
+# ----------------------------------------------------------------------------------------
+
+
+def test_the_fast_containment_test_agrees_with_region_holds_to_one_image() -> None:
+    # The region is the reference hull itself: it holds every image, and shrunk by 1e-7
+    # (a hundred times the tolerance) it misses a few hull vertices only, which the patch
+    # shortcut must still find; likewise today's region, and it shrunk by half.
+    for movement in draw_movements(2, seed=5):
+        images = tightness.reference_images(
+            movement.target_fr, movement.l1_fr, movement.l2_fr, per_edge=20
+        )
+        hull = tightness.reference_hull(
+            movement.target_fr, movement.l1_fr, movement.l2_fr, per_edge=20
+        )
+        centre = hull.mean()
+        for region, holds in [
+            (hull, True),
+            (centre + (1.0 - 1e-7) * (hull - centre), False),
+            (movement.region, True),
+            (centre + 0.5 * (movement.region - centre), False),
+        ]:
+            assert tightness.region_holds(region, images.ravel()) is holds
+            assert tightness.region_holds_all(region, images) is holds
+            outside, worst = tightness.worst_excess(region, images)
+            assert (outside > 0) is not holds and (worst > 1e-9) is not holds
+
+
+def run_containment_command(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], *extra: str, movements: int = 3
+) -> tuple[int | str | None, str, dict[str, Any]]:
+    path = tmp_path / "containment.json"
+    argv = ["--containment-only", "--movements", str(movements), "--json", str(path)]
+    argv.append("--no-progress")
+    code: int | str | None = 0
+    try:
+        tightness.main([*argv, *extra])
+    except SystemExit as stopped:
+        code = stopped.code
+    return code, capsys.readouterr().out, json.loads(path.read_text())
+
+
+def test_containment_only_checks_todays_regions_and_writes_the_counts(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, written = run_containment_command(tmp_path, capsys, "--seed", "3")
+    assert code == 0 and "misses: 0 regions" in out
+    assert written["measured"]["command"].startswith(
+        "bearing-env transfer-tightness --containment-only"
+    )
+    figures = written["summary"]
+    assert figures["regions"] == 3 and figures["movements_drawn"] >= 3
+    assert figures["misses"] == 0 and written["misses"] == [] and not figures["interrupted"]
+    assert figures["reference_images_checked"] >= 3 * 3 * 300 * 300  # >= 3 edges a region
+    assert figures["grid_points_in_e_checked"] > 0
+    assert written["settings"]["transfer"] == "conservative"
+    assert written["settings"]["resolution"] == tightness.CONTAINMENT_RESOLUTION
+
+
+def test_containment_only_reports_a_shrunk_region_as_a_miss_and_exits_1(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    shrink_every_region(monkeypatch, 0.9)
+    code, out, written = run_containment_command(tmp_path, capsys, movements=1)
+    assert code == 1 and "misses: 1 regions" in out and "not contained: {" in out
+    assert written["summary"]["reference_misses"] == 1
+    miss = written["misses"][0]
+    assert miss["seed"] == 0 and miss["draw"] >= 1 and not miss["holds_reference"]
+    assert miss["reference_images_outside"] > 0 and miss["reference_worst_outside"] > 1e-9
+    assert len(miss["region"]) >= 3 and len(miss["target_fr"]) >= 3
+
+
+def test_containment_only_keeps_its_counts_on_ctrl_c(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    check = tightness.check_containment
+    calls = []
+
+    def interrupted(*args: Any) -> tightness.ContainmentCheck:
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return check(*args)
+
+    monkeypatch.setattr(tightness, "check_containment", interrupted)
+    code, out, written = run_containment_command(tmp_path, capsys)
+    assert code == 0 and "(interrupted)" in out
+    assert written["summary"]["interrupted"] and written["summary"]["regions"] == 1
+
+
+def test_merge_sums_runs_and_refuses_a_repeated_seed() -> None:
+    def payload(seed: int, regions: int, misses: list[dict[str, Any]]) -> dict[str, Any]:
+        found = tightness.ContainmentRun(
+            movements_drawn=2 * regions, regions=regions, reference_images_checked=10 * regions,
+            grid_points_in_e_checked=3 * regions, box_growths_max=seed, misses=len(misses),
+            reference_misses=len(misses), no_region={"no_move": seed + 1}, seconds=1.0,
+        )  # fmt: skip
+        settings = {
+            "transfer": "conservative", "edge_samples": 3, "resolution": 24,
+            "reference_samples_per_edge": 100, "seed": seed,
+        }  # fmt: skip
+        summary = tightness.containment_summary(found)
+        return {"settings": settings, "summary": summary, "misses": misses}
+
+    merged = tightness.merge_containment([payload(0, 5, []), payload(1, 7, [{"draw": 4}])])
+    figures = merged["summary"]
+    assert figures["regions"] == 12 and figures["movements_drawn"] == 24
+    assert figures["reference_images_checked"] == 120 and figures["misses"] == 1
+    assert figures["no_region"] == {"no_move": 3} and figures["box_growths_max"] == 1
+    assert merged["misses"] == [{"draw": 4}] and merged["settings"]["seeds"] == [0, 1]
+    with pytest.raises(ValueError, match="same seed"):
+        tightness.merge_containment([payload(0, 5, []), payload(0, 7, [])])
