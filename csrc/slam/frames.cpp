@@ -207,13 +207,21 @@ int64_t transfer_region(const cplx* target, int64_t n_target, const FrameChange&
         // distance**3 as numba unrolls it: (1.0 * d) * (d * d).
         const double cube = (1.0 * distance) * (distance * distance);
         double radius = (v2 * delta1 * delta1 + v1 * delta2 * delta2) / (4.0 * cube);
+        // A relative margin far above rounding error keeps the bound a bound in floats.
+        double margin = 1e-9 * (1.0 + v1 / distance);
         // Both bounds are valid; the local one is tighter wherever it is finite.
         if (frame.local != nullptr) {
             const double local = local_growth(target, n_target, *frame.local);
             if (local < radius) radius = local;
+            // The samples off their edges move images by up to about
+            // 65 u (M / D + 48) (1 + V1 / D), M the largest vertex modulus of A_L1 and A_L2
+            // (docs/world_model.md, "Rounding"): covered whatever M / D.
+            double largest = 0.0;
+            for (int64_t j = 0; j < n1; ++j) largest = std::max(largest, abs(a1[j]));
+            for (int64_t j = 0; j < n2; ++j) largest = std::max(largest, abs(a2[j]));
+            margin += 1e-13 * (largest / distance) * (1.0 + v1 / distance);
         }
-        // A relative margin far above rounding error keeps the bound a bound in floats.
-        radius += 1e-9 * (1.0 + v1 / distance);
+        radius += margin;
         n = drop_edges_outward(hull, n, SCRATCH - 8);
         // (only a polygon no edge of which can be removed stays larger: not a convex one)
         check_capacity("transfer_region out", n + 3, SCRATCH);
