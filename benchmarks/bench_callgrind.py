@@ -32,6 +32,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from bearing_env.slam.transfer import TRANSFERS
 from bearing_env.train.common.cli_parser import add_json_output, command_parser, doc_summary
 from bearing_env.train.common.cli_values import at_least
 from bearing_env.train.common.doc_tables import markdown_table
@@ -152,7 +153,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     arguments = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(arguments)
     results: dict[str, Any] = {}
-    for transfer in ("conservative", "paper"):
+    for transfer in TRANSFERS:
         counted = count(UPDATE_DRIVER, ENTRY_POINTS["update"], [str(args.movements), transfer])
         per = counted["instructions"] / args.movements
         results[f"update_{transfer}_4"] = {**counted, "count": args.movements, "per_call": per}
@@ -181,8 +182,13 @@ def markdown_callgrind(record: dict[str, Any]) -> str:
     step = counts["step_khepera"]
     sentence = (
         f"{measured_sentence(record['measured'], 'benchmarks/results/bench_callgrind.json')} "
-        f"Instructions per 4-landmark movement: {counts['update_conservative_4']['per_call']:,.0f}"
-        f" conservative, {counts['update_paper_4']['per_call']:,.0f} paper; per Khepera env "
+        "Instructions per 4-landmark movement: "
+        + ", ".join(
+            f"{counts[f'update_{transfer}_4']['per_call']:,.0f} {transfer}"
+            for transfer in TRANSFERS
+            if f"update_{transfer}_4" in counts
+        )
+        + "; per Khepera env "
         f"step (native part, {step['count']} steps): {step['per_call']:,.0f}, of which:"
     )
     names = [(entry["function"].rpartition("::")[2], entry) for entry in step["functions"][1:]]

@@ -50,7 +50,9 @@ def test_the_command_counts_the_update_and_the_step(tmp_path: Path) -> None:
         "bearing-env bench-callgrind --movements 20 --steps 20 --json " + str(out)
     )
     results = record["counts"]
-    assert set(results) == {"update_conservative_4", "update_paper_4", "step_khepera"}
+    assert set(results) == {
+        "update_conservative_4", "update_paper_4", "update_conservative_global_4", "step_khepera"
+    }  # fmt: skip
     for counted in results.values():
         assert counted["per_call"] == counted["instructions"] / counted["count"] > 1000
         names = [f["function"] for f in counted["functions"]]
