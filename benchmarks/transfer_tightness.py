@@ -297,6 +297,9 @@ class Measurement:
     holds_grid: bool  #: every grid point of E is in the region
     holds_reference: bool  #: every vertex of the reference is in the region
     truth_in_e: bool  #: a check of the test: noise within +-epsilon puts the truth in E
+    #: The region as K support values in fixed FL directions (its circumscribed K-gon,
+    #: the other representation a transfer could keep): the K-gon's area, by K.
+    fixed_direction_areas: dict[str, float] = field(default_factory=dict)
 
     @property
     def ratio(self) -> float:
@@ -457,7 +460,32 @@ def measure(movement: Movement, reference: ComplexArray, resolution: int) -> Mea
         holds_grid=region_holds(movement.region, grid.points[inside]),
         holds_reference=region_holds(movement.region, reference),
         truth_in_e=bool(exact_member(truth, movement.target_fr, movement.l1_fr, movement.l2_fr)[0]),
+        fixed_direction_areas={
+            str(k): circumscribed_area(movement.region, k) for k in FIXED_DIRECTIONS
+        },
     )
+
+
+#: The direction counts of the fixed-direction representation measured beside the hull.
+FIXED_DIRECTIONS = (12, 16, 24)
+
+
+def circumscribed_area(region: ComplexArray, directions: int) -> float:
+    """Area of the convex region's circumscribed polygon whose edge normals are
+    ``directions`` fixed directions, evenly spaced: the intersection of the half-planes
+    ``<u_k, w> <= max over the region of <u_k, w>``. Each of them touches the region, so
+    the vertices are the crossings of consecutive lines."""
+    normals = np.exp(2j * np.pi * np.arange(directions) / directions)
+    support = (region[None, :] * np.conj(normals[:, None])).real.max(axis=1)
+    following = np.roll(normals, -1)
+    support_next = np.roll(support, -1)
+    # w = x n_k + y i n_k with x = h_k; <n_{k+1}, w> = h_{k+1} gives y.
+    cos_turn = (following * np.conj(normals)).real
+    sin_turn = (following * np.conj(normals)).imag
+    along = (support_next - support * cos_turn) / sin_turn
+    vertices = normals * (support + 1j * along)
+    x, y = vertices.real, vertices.imag
+    return float(0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
 
 
 def _xy(points: ComplexArray) -> FloatArray:
@@ -520,6 +548,10 @@ def summary(result: TightnessRun) -> dict[str, Any]:
     ratios = np.array([m.ratio for m in found])
     to_reference = np.array([m.region_area / m.reference_area for m in found])
     bounds = np.array([m.grid_error_bound for m in found])
+    exact = np.array([m.exact_area for m in found])
+    fixed = {
+        str(k): np.array([m.fixed_direction_areas[str(k)] for m in found]) for k in FIXED_DIRECTIONS
+    }
     return {
         "regions": len(found),
         "movements_drawn": result.movements_drawn,
@@ -538,6 +570,13 @@ def summary(result: TightnessRun) -> dict[str, Any]:
         "grid_error_bound_median": float(np.median(bounds)),
         "grid_error_bound_p95": float(np.percentile(bounds, 95)),
         "resolution_check_max": max(result.resolution_checks, default=0.0),
+        "fixed_directions": {
+            str(k): {
+                "ratio_median": float(np.median(fixed[str(k)] / exact)),
+                "ratio_p95": float(np.percentile(fixed[str(k)] / exact, 95)),
+            }
+            for k in FIXED_DIRECTIONS
+        },
         "seconds": result.seconds,
     }
 
@@ -550,6 +589,11 @@ def format_summary(figures: dict[str, Any], resolution: int) -> list[str]:
         f"region area / exact area: median {figures['ratio_median']:.3g}, "
         f"95th percentile {figures['ratio_p95']:.3g} "
         f"(min {figures['ratio_min']:.3g}, max {figures['ratio_max']:.3g})",
+        "as support values in fixed directions: "
+        + ", ".join(
+            f"K = {k}: median {entry['ratio_median']:.3g}, 95th percentile {entry['ratio_p95']:.3g}"
+            for k, entry in figures["fixed_directions"].items()
+        ),
         f"region area / reference hull area: median "
         f"{figures['ratio_to_reference_median']:.3g}, "
         f"95th percentile {figures['ratio_to_reference_p95']:.3g}",

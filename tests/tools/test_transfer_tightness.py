@@ -316,3 +316,18 @@ def test_merge_sums_runs_and_refuses_a_repeated_seed() -> None:
     assert merged["misses"] == [{"draw": 4}] and merged["settings"]["seeds"] == [0, 1]
     with pytest.raises(ValueError, match="same seed"):
         tightness.merge_containment([payload(0, 5, []), payload(0, 7, [])])
+
+
+def test_the_circumscribed_polygon_of_fixed_directions_has_the_known_area() -> None:
+    square = np.array([1 + 1j, -1 + 1j, -1 - 1j, 1 - 1j])
+    assert tightness.circumscribed_area(square, 4) == pytest.approx(4.0)
+    # A square turned by 0.3 rad, boxed by the axes' directions.
+    turned = square * np.exp(0.3j)
+    box = 2.0 * (np.cos(0.3) + np.sin(0.3))
+    assert tightness.circumscribed_area(turned, 4) == pytest.approx(box**2)
+    # A fine polygon of the unit circle: the regular K-gon around it, K tan(pi / K).
+    circle = np.exp(2j * np.pi * np.arange(720) / 720)
+    for k in tightness.FIXED_DIRECTIONS:
+        assert tightness.circumscribed_area(circle, k) == pytest.approx(
+            k * np.tan(np.pi / k), rel=1e-4
+        )

@@ -288,6 +288,13 @@ def transfer_tightness(records: Mapping[str, Any]) -> str:
             )
         )
     first = next(iter(records.values()))["settings"]
+    fixed = [
+        f"{record['summary']['fixed_directions'][k]['ratio_median']:.3g}\u00d7 with K = {k} "
+        f"({record['summary']['fixed_directions'][k]['ratio_p95']:.3g}\u00d7)"
+        for record in records.values()
+        if record["settings"]["transfer"] == "conservative"
+        for k in record["summary"].get("fixed_directions", {})
+    ]
     header = (
         "transfer", "samples per edge", "regions", "area \u00f7 exact, median", "95th pct",
         "max", "area \u00f7 dense hull, median", "hold E and the hull",
@@ -296,7 +303,15 @@ def transfer_tightness(records: Mapping[str, Any]) -> str:
         " ".join(sentences)
         + f" Layouts {', '.join(first['layouts'])}; E on a {first['resolution']}\u00d7"
         f"{first['resolution']} grid; the dense hull uses {first['reference_samples_per_edge']}"
-        " samples per edge.\n\n" + markdown_table(header, rows)
+        " samples per edge.\n\n"
+        + markdown_table(header, rows)
+        + (
+            "\n\nThe same `conservative` regions kept as K support values in fixed FL "
+            "directions (each region's circumscribed K-gon) would be, over the exact set, "
+            f"median (95th percentile): {'; '.join(fixed)}."
+            if fixed
+            else ""
+        )
     )
 
 
