@@ -192,6 +192,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     'bearing-env compare --policies greedy oracle lookahead lookahead_oracle': ('parse', ()),
     'bearing-env docs-tables': ('parse', ()),
     'bearing-env generalisation': ('help', ()),
+    'bearing-env suite --episodes 200': ('parse', ()),
     'bearing-env suite --tasks BearingSLAM-FurnishedRoom-v1 --workers 2': ('parse', ()),
     'bearing-env suite --tasks BearingSLAM-Khepera-v1 --workers 2': ('parse', ()),
     "python -m bearing_env.train.studies.generalisation --model ppo_generalist --counts 3 8 12 "
