@@ -46,7 +46,10 @@ def test_the_generalist_plays_an_episode_with_no_env_given() -> None:
     env = policy.make_env()
     record = pretrained_record("ppo_generalist")
     assert env.spec is not None and env.spec.id == record["env_id"]
-    assert env.unwrapped.config == EnvConfig.create(**record["env_kwargs"])  # type: ignore[attr-defined]
+    # Its own id, BearingSLAM-v0, with that version's transfer under the record's kwargs.
+    trained = EnvConfig.create(**{**gym.spec(record["env_id"]).kwargs, **record["env_kwargs"]})
+    assert env.unwrapped.config == trained  # type: ignore[attr-defined]
+    assert trained.transfer == "conservative_global"
     observation, info = env.reset(seed=1_000_000)
     policy.reset(seed=1_000_000)
     moves, done = 0, False

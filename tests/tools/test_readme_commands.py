@@ -193,6 +193,15 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     'bearing-env docs-tables': ('parse', ()),
     'bearing-env generalisation': ('help', ()),
     'bearing-env suite --episodes 200': ('parse', ()),
+    "bearing-env compare --policies random greedy --env bearing_env:BearingSLAM-Khepera-v0 "
+    "--episodes 200": ("parse", ()),
+    "bearing-env compare --policies random greedy --env bearing_env:BearingSLAM-Khepera-v1 "
+    "--episodes 200": ("parse", ()),
+    "bearing-env transfer-tightness --transfer T --json ...": ("help", ()),
+    "bearing-env transfer-tightness --transfer conservative --no-progress --json "
+    "benchmarks/results/transfer_tightness_conservative.json": ("help", ()),
+    "bearing-env transfer-tightness --transfer conservative_global --no-progress --json "
+    "benchmarks/results/transfer_tightness_conservative_global.json": ("help", ()),
     'bearing-env suite --tasks BearingSLAM-FurnishedRoom-v1 --workers 2': ('parse', ()),
     'bearing-env suite --tasks BearingSLAM-Khepera-v1 --workers 2': ('parse', ()),
     "python -m bearing_env.train.studies.generalisation --model ppo_generalist --counts 3 8 12 "
