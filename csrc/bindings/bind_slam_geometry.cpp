@@ -20,6 +20,7 @@
 #include "slam/local_bound.hpp"
 #include "slam/polygons.hpp"
 #include "slam/scratch.hpp"
+#include "slam/update.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -327,36 +328,18 @@ nb::tuple transfer_polygon(nb::handle target_obj, nb::handle a1_obj, nb::handle 
     }
     check_edge_samples(edge_samples, "edge_samples");
     check_room(slam::SCRATCH, out.shape[0], "out");
-    const int64_t n1 = a1.shape[0], n2 = a2.shape[0];
-    const bool conservative = transfer != slam::TRANSFER_PAPER;
-    const slam::FramePlan plan =
-        slam::frame_plan(a1.data, n1, a2.data, n2, conservative, edge_samples);
-    if (plan.status != slam::FRAME_OK) return nb::make_tuple(plan.status, 0);
     // Allocated without zero-filling (every slot used is written first).
     const std::unique_ptr<slam::Buffers> buf(new slam::Buffers);
     slam::FrameChange frame;
-    frame.a1 = a1.data;
-    frame.n1 = n1;
-    frame.a2 = a2.data;
-    frame.n2 = n2;
-    frame.n_pairs = slam::sample_hypotheses(a1.data, n1, a2.data, n2, plan.per_edge, buf->h1,
-                                            buf->inv_d);
-    frame.h1 = buf->h1;
-    frame.inv_d = buf->inv_d;
-    frame.conservative = conservative;
-    if (transfer == slam::TRANSFER_CONSERVATIVE) {
-        slam::plan_sub_squares(a1.data, n1, a2.data, n2, plan.per_edge, buf->sub);
-        frame.local = &buf->sub;
-    }
-    frame.distance = plan.distance;
-    frame.delta1 = plan.delta1;
-    frame.delta2 = plan.delta2;
+    const int64_t status = slam::change_of_frames(a1.data, a1.shape[0], a2.data, a2.shape[0],
+                                                  transfer, edge_samples, *buf, frame);
+    if (status != slam::FRAME_OK) return nb::make_tuple(status, 0);
     slam::Scratch& scratch = buf->scratch;
     const int64_t n = slam::transfer_region(target.data, target.shape[0], frame, scratch.cloud,
                                             scratch.hull, scratch.fresh);
     check_room(n, out.shape[0], "out");
     for (int64_t v = 0; v < n; ++v) out.data[v] = scratch.fresh[v];
-    return nb::make_tuple(plan.status, n);
+    return nb::make_tuple(status, n);
 }
 
 // sigma(z) of every target point and sub-square into out (n_target * m1 * m2, as

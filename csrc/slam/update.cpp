@@ -25,34 +25,10 @@ namespace {
 constexpr double INF = std::numeric_limits<double>::infinity();
 constexpr double NaN = std::numeric_limits<double>::quiet_NaN();
 
-// One movement's frame code and, when it is FRAME_OK, its change of frames (hypotheses
-// sampled into h1 and inv_d) from the FR regions of L1 and L2.
-int64_t frame_of(Buffers& buf, const Params& params, cplx* h1, cplx* inv_d,
-                 FrameChange& frame) {
-    const cplx* a1 = buf.fr[0];
-    const cplx* a2 = buf.fr[1];
-    const int64_t n1 = buf.fr_count[0], n2 = buf.fr_count[1];
-    const bool conservative = params.transfer != TRANSFER_PAPER;
-    const bool local = params.transfer == TRANSFER_CONSERVATIVE;
-    const FramePlan plan = frame_plan(a1, n1, a2, n2, conservative, params.edge_samples);
-    int64_t n_pairs = 0;
-    if (plan.status == FRAME_OK) {
-        n_pairs = sample_hypotheses(a1, n1, a2, n2, plan.per_edge, h1, inv_d);
-        if (local) plan_sub_squares(a1, n1, a2, n2, plan.per_edge, buf.sub);
-    }
-    frame.a1 = a1;
-    frame.n1 = n1;
-    frame.a2 = a2;
-    frame.n2 = n2;
-    frame.h1 = h1;
-    frame.inv_d = inv_d;
-    frame.n_pairs = n_pairs;
-    frame.conservative = conservative;
-    frame.local = local && plan.status == FRAME_OK ? &buf.sub : nullptr;
-    frame.distance = plan.distance;
-    frame.delta1 = plan.delta1;
-    frame.delta2 = plan.delta2;
-    return plan.status;
+// One movement's frame code and change of frames from the FR regions of L1 and L2.
+int64_t frame_of(Buffers& buf, const Params& params, FrameChange& frame) {
+    return change_of_frames(buf.fr[0], buf.fr_count[0], buf.fr[1], buf.fr_count[1],
+                            params.transfer, params.edge_samples, buf, frame);
 }
 
 // Make room in map row's window for a new movement (ageing out the oldest when it is
@@ -136,7 +112,7 @@ void update_row(int64_t i, int64_t row, const double* bearings_start, const doub
         cone_regions(bearings_start, bearings_end, n_landmarks, epsilon, buf));
     if (out.frame_status(i) != FRAME_OK) return;
     FrameChange frame;
-    const int64_t status = frame_of(buf, params, buf.h1, buf.inv_d, frame);
+    const int64_t status = frame_of(buf, params, frame);
     out.frame_status(i) = static_cast<int8_t>(status);
     if (status != FRAME_OK) return;
     int64_t newest = 0;
@@ -218,7 +194,7 @@ int64_t probe_row(int64_t i, int64_t row, const double* bearings_start,
         cone_regions(bearings_start, bearings_end, n_landmarks, PROBE_SHRINK * epsilon, buf);
     if (status != FRAME_OK) return 0;
     FrameChange frame;
-    status = frame_of(buf, params, buf.h1, buf.inv_d, frame);
+    status = frame_of(buf, params, frame);
     if (status != FRAME_OK) return 0;
     int64_t evidence = 0;
     for (int64_t j = 2; j < n_landmarks; ++j) {
@@ -370,6 +346,32 @@ Buffers& thread_buffers() {
 }
 
 }  // namespace
+
+int64_t change_of_frames(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2,
+                         int64_t transfer, int64_t edge_samples, Buffers& buf,
+                         FrameChange& frame) {
+    const bool conservative = transfer != TRANSFER_PAPER;
+    const bool local = transfer == TRANSFER_CONSERVATIVE;
+    const FramePlan plan = frame_plan(a1, n1, a2, n2, conservative, edge_samples);
+    int64_t n_pairs = 0;
+    if (plan.status == FRAME_OK) {
+        n_pairs = sample_hypotheses(a1, n1, a2, n2, plan.per_edge, buf.h1, buf.inv_d);
+        if (local) plan_sub_squares(a1, n1, a2, n2, plan.per_edge, buf.sub);
+    }
+    frame.a1 = a1;
+    frame.n1 = n1;
+    frame.a2 = a2;
+    frame.n2 = n2;
+    frame.h1 = buf.h1;
+    frame.inv_d = buf.inv_d;
+    frame.n_pairs = n_pairs;
+    frame.conservative = conservative;
+    frame.local = local && plan.status == FRAME_OK ? &buf.sub : nullptr;
+    frame.distance = plan.distance;
+    frame.delta1 = plan.delta1;
+    frame.delta2 = plan.delta2;
+    return plan.status;
+}
 
 void update_maps(View2<const double> bearings_start, View2<const double> bearings_end,
                  View1<const int64_t> rows, const Params& params, const MapState& state,

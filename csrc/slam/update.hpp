@@ -8,6 +8,17 @@
 
 namespace bearing::slam {
 
+struct Buffers;      // slam/scratch.hpp
+struct FrameChange;  // slam/frames.hpp
+
+// One movement's frame code (FramePlan's status) and, when it is FRAME_OK, its change of
+// frames from A_L1 = a1[:n1] and A_L2 = a2[:n2] as `transfer` makes it: the hypotheses
+// sampled into buf.h1 and buf.inv_d and, for TRANSFER_CONSERVATIVE, the sub-squares
+// planned into buf.sub. The update and the transfer_polygon binding both use it.
+int64_t change_of_frames(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2,
+                         int64_t transfer, int64_t edge_samples, Buffers& buf,
+                         FrameChange& frame);
+
 // Fuse one movement into each map rows[i] (bearings row i), in place, reporting to out
 // row i. With threads > 1 the rows are split into `threads` contiguous blocks, one per
 // thread, exactly as numba's update_maps_parallel split them; every map is computed by
