@@ -42,10 +42,10 @@ Three transfers are offered:
     figures reproduce. It is larger than the local bound wherever the L1 and L2 regions
     come close somewhere, as ``D`` is their smallest distance.
 
-Both conservative bounds need pieces under a half circle (``delta <= 2 D``). Edges are cut
-finely enough for that, up to :data:`MAX_EDGE_SAMPLES` pieces; a movement whose L1 and L2
-regions are closer still, relative to their size, is refused (``"l1_l2_too_close"``): its
-frame change is too uncertain to be useful.
+Edges are cut into pieces at most twice the distance between the L1 and L2 regions
+(``delta <= 2 D``), up to :data:`MAX_EDGE_SAMPLES` pieces, which keeps both bounds small;
+a movement whose L1 and L2 regions are closer still, relative to their size, is refused
+(``"l1_l2_too_close"``): its frame change is too uncertain to be useful.
 
 The kernels are in :mod:`bearing_env.slam.kernels`; :func:`transfer_vertices` runs one
 movement's transfer for inspection and tests.

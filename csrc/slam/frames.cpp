@@ -216,10 +216,7 @@ int64_t transfer_region(const cplx* target, int64_t n_target, const FrameChange&
             // The samples off their edges move images by up to about
             // 65 u (M / D + 48) (1 + V1 / D), M the largest vertex modulus of A_L1 and A_L2
             // (docs/world_model.md, "Rounding"): covered whatever M / D.
-            double largest = 0.0;
-            for (int64_t j = 0; j < n1; ++j) largest = std::max(largest, abs(a1[j]));
-            for (int64_t j = 0; j < n2; ++j) largest = std::max(largest, abs(a2[j]));
-            margin += 1e-13 * (largest / distance) * (1.0 + v1 / distance);
+            margin += 1e-13 * (frame.local->largest_modulus / distance) * (1.0 + v1 / distance);
         }
         radius += margin;
         n = drop_edges_outward(hull, n, SCRATCH - 8);

@@ -19,8 +19,8 @@ inline double length(cplx d) { return std::sqrt(d.re * d.re + d.im * d.im); }
 
 // Sagitta factor of the arc that 1 / (c - h) traces as h runs along the piece [a, b]
 // (Lemma 1): half its chord |b - a| / (|a - c| |b - c|) times tan(phi / 2), phi the angle
-// the piece subtends at c, tan(phi / 2) = |cross| / (|a - c| |b - c| + dot). Lemma 1 needs
-// phi <= 90 degrees (dot >= 0): else INVALID_FACTOR.
+// the piece subtends at c, tan(phi / 2) = |cross| / (|a - c| |b - c| + dot). Used only
+// for phi <= 90 degrees (dot >= 0), else INVALID_FACTOR (see local_bound.hpp).
 double exact_factor(cplx a, cplx b, cplx c, double piece, double to_a, double to_b) {
     const cplx ca = a - c;
     const cplx cb = b - c;
@@ -43,7 +43,7 @@ inline double to_piece(cplx c, cplx a, cplx b, double piece, double to_a, double
 
 // Bound on the same factor for h2 running along [c, d] seen from any h1 of a piece P1
 // whose distances to c, to d and to [c, d] are at least near_c, near_d and gap (Lemma 2
-// bounds tan(psi / 2) by |d - c| / (2 gap), which needs |d - c| <= 2 gap).
+// bounds tan(psi / 2) by |d - c| / (2 gap)); used only for |d - c| <= 2 gap.
 double moving_factor(double length, double near_c, double near_d, double gap) {
     if (!(gap > 0.0) || !(length <= 2.0 * gap)) return INVALID_FACTOR;
     const double factor = (length * length) / (4.0 * near_c * near_d * gap);
@@ -65,6 +65,10 @@ void plan_sub_squares(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2, in
     out.m2 = boundary_samples(a2, n2, per_edge, out.s2);
     m1 = out.m1;
     m2 = out.m2;
+    double largest = 0.0;
+    for (int64_t j = 0; j < n1; ++j) largest = std::max(largest, abs(a1[j]));
+    for (int64_t j = 0; j < n2; ++j) largest = std::max(largest, abs(a2[j]));
+    out.largest_modulus = largest;
     const cplx* s1 = out.s1;
     const cplx* s2 = out.s2;
     // Sample-to-sample distances and piece lengths, each used by several factors.

@@ -12,11 +12,13 @@
 //     max(|z - a| exact2(a; P2), |z - b| exact2(b; P2)) + max(|z - c|, |z - d|) moving1
 //
 // exact1(P1; c) = |b - a| tan(phi / 2) / (2 |a - c| |b - c|) is the sagitta factor of the
-// arc that 1 / (c - h1) traces as h1 runs along P1 (phi: the angle P1 subtends at c), valid
-// when phi <= 90 degrees; moving2 = |d - c|^2 / (4 dist(c, P1) dist(d, P1) dist(P1, P2))
-// bounds the same factor for h2 along P2 seen from any h1 of P1, valid when
-// |d - c| <= 2 dist(P1, P2). A factor whose condition fails is INVALID_FACTOR, a finite
-// stand-in far above any valid bound, so that the other order (or the global bound) wins.
+// arc that 1 / (c - h1) traces as h1 runs along P1 (phi: the angle P1 subtends at c);
+// moving2 = |d - c|^2 / (4 dist(c, P1) dist(d, P1) dist(P1, P2)) bounds the same factor
+// for h2 along P2 seen from any h1 of P1. The bounds hold at any angle (the page's arc
+// fact), but the kernels use them only where the proof's checked conditions hold, phi <=
+// 90 degrees and |d - c| <= 2 dist(P1, P2), which frame_plan's piece lengths always meet;
+// a factor outside them is INVALID_FACTOR, a finite stand-in far above any valid bound,
+// so that the other order (or the global bound) wins.
 #pragma once
 
 #include <cstdint>
@@ -45,6 +47,8 @@ struct SubSquares {
     // distances they bound order A, hence sigma, over the whole row of sub-squares.
     double row_exact1[MAX_SAMPLES];
     double row_moving2[MAX_SAMPLES];
+    // The largest vertex modulus of A_L1 and A_L2 (M of the rounding margin).
+    double largest_modulus = 0.0;
     SubSquares() {}  // NOLINT: deliberately uninitialised (33 KB); plan_sub_squares fills it
 };
 
