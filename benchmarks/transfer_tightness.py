@@ -794,6 +794,21 @@ def format_containment(figures: dict[str, Any], transfer: str, resolution: int) 
     return lines
 
 
+def run_settings(args: argparse.Namespace, resolution: int, mapping: Mapping) -> dict[str, Any]:
+    """What a run was drawn and measured with, for its JSON."""
+    return {
+        "movements": args.movements,
+        "seed": args.seed,
+        "resolution": resolution,
+        "transfer": mapping.transfer,
+        "edge_samples": mapping.edge_samples,
+        "reference_samples_per_edge": REFERENCE_SAMPLES,
+        "containment_tolerance": CONTAINMENT_TOLERANCE,
+        "layouts": list(LAYOUTS),
+        "epsilon_deg": list(SearchSettings().epsilon_deg),
+    }
+
+
 def main_containment(
     parser: argparse.ArgumentParser, args: argparse.Namespace, arguments: list[str]
 ) -> None:
@@ -822,17 +837,7 @@ def main_containment(
         transfer = mapping.transfer
         payload = {
             "measured": measured,
-            "settings": {
-                "movements": args.movements,
-                "seed": args.seed,
-                "resolution": resolution,
-                "transfer": mapping.transfer,
-                "edge_samples": mapping.edge_samples,
-                "reference_samples_per_edge": REFERENCE_SAMPLES,
-                "containment_tolerance": CONTAINMENT_TOLERANCE,
-                "layouts": list(LAYOUTS),
-                "epsilon_deg": list(SearchSettings().epsilon_deg),
-            },
+            "settings": run_settings(args, resolution, mapping),
             "summary": figures,
             "misses": misses,
         }
@@ -921,17 +926,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     if args.json:
         payload = {
             "measured": measured_here(parser.prog, arguments),
-            "settings": {
-                "movements": args.movements,
-                "seed": args.seed,
-                "resolution": args.resolution,
-                "transfer": mapping.transfer,
-                "edge_samples": mapping.edge_samples,
-                "reference_samples_per_edge": REFERENCE_SAMPLES,
-                "containment_tolerance": CONTAINMENT_TOLERANCE,
-                "layouts": list(LAYOUTS),
-                "epsilon_deg": list(SearchSettings().epsilon_deg),
-            },
+            "settings": run_settings(args, args.resolution, mapping),
             "summary": figures,
             "resolution_checks": result.resolution_checks,
             "regions": [asdict(m) for m in result.measurements],
