@@ -562,9 +562,22 @@ def test_transfer_polygon_of_any_target_and_regions(
     target: ComplexArray, data: st.DataObject
 ) -> None:
     a1, a2 = fr_region(data.draw), fr_region(data.draw)
-    transfer = data.draw(st.one_of(st.sampled_from(TRANSFER_CODES), st.integers(-2, 5)))
-    edge_samples = data.draw(st.one_of(st.integers(-1, 9), st.sampled_from(SPECIAL_INTS)))
-    out = np.zeros(out_length(data.draw, kernels.SCRATCH), dtype=np.complex128)
+    # Mostly valid codes, counts and sizes: the kernels, not only the checks, get most
+    # examples (an empty target or region stands in for the FR regions of L1 and L2 at
+    # fixed points then; their values stay the drawn, possibly corrupt, ones otherwise).
+    valid = data.draw(st.integers(0, 3)) > 0
+    if valid:
+        target = target if target.size else np.array([0.5 + 2.0j])
+        a1 = a1 if a1.size else np.array([2.0 + 1.0j, 2.2 + 1.0j, 2.1 + 1.2j])
+        a2 = a2 if a2.size else np.array([3.0 - 1.0j, 3.2 - 1.0j, 3.1 - 0.8j])
+    transfer = data.draw(st.sampled_from(TRANSFER_CODES) if valid else st.integers(-2, 5))
+    edge_samples = data.draw(
+        st.integers(1, kernels.MAX_EDGE_SAMPLES)
+        if valid
+        else st.one_of(st.integers(-1, 9), st.sampled_from(SPECIAL_INTS))
+    )
+    room = kernels.SCRATCH if valid else out_length(data.draw, kernels.SCRATCH)
+    out = np.zeros(room, dtype=np.complex128)
     returned = result(_core.transfer_polygon, target, a1, a2, transfer, edge_samples, out)
     if returned is not None:
         status, k = returned
