@@ -24,6 +24,12 @@ from bearing_env.benchmarks.bench_timing import (
 )
 from bearing_env.extras import available
 from bearing_env.train.common.files import atomic_write_text
+from bearing_env.train.common.provenance import (
+    short_commit,
+    source_commit,
+    uncommitted_files,
+    uncommitted_text,
+)
 
 #: Relative to the working directory, so an installed package never writes into itself.
 DEFAULT_JSON = Path("outputs") / "bench_env.json"
@@ -192,33 +198,12 @@ def machine_info() -> dict[str, Any]:
         if module in sys.modules:
             info[module] = getattr(sys.modules[module], "__version__", None)
     info["commit"] = source_commit()
+    info["uncommitted"] = uncommitted_files()
     with contextlib.suppress(OSError, AttributeError):
         # Other jobs on the machine move every figure: the 1-minute load average at the
         # time the JSON is written, for the reader of the results.
         info["load_average_1min"] = round(os.getloadavg()[0], 2)
     return info
-
-
-def source_commit() -> str | None:
-    """The git commit of the code measured (its checkout's HEAD, with ``+changes`` when
-    the working tree differs from it), or None outside a git checkout."""
-    import subprocess
-
-    folder = Path(bearing_env.__file__).resolve().parent
-    try:
-        head = subprocess.run(
-            ["git", "rev-parse", "HEAD"], cwd=folder, capture_output=True, text=True, check=True
-        ).stdout.strip()
-        changes = subprocess.run(
-            ["git", "status", "--porcelain", "--untracked-files=no"],
-            cwd=folder,
-            capture_output=True,
-            text=True,
-            check=True,
-        ).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return None
-    return f"{head}+changes" if changes else head
 
 
 def _finite(value: Any) -> Any:
@@ -560,7 +545,7 @@ def markdown_machine(results: dict[str, Any]) -> str:
     machine = results["machine"]
     commit = machine.get("commit")
     code = (
-        f"commit `{commit[:7]}{'+changes' if commit.endswith('+changes') else ''}`"
+        short_commit(commit) + uncommitted_text(machine.get("uncommitted", []))
         if commit
         else f"bearing_env {machine['bearing_env']}"
     )
@@ -584,7 +569,8 @@ def markdown_machine(results: dict[str, Any]) -> str:
             else ""
         )
         + "); file `benchmarks/results/bench_env.json`. "
-        "CartPole-v1's `env.step` measured in the same run: "
+        + (f"{machine['provenance']} " if machine.get("provenance") else "")
+        + "CartPole-v1's `env.step` measured in the same run: "
         + ", ".join(
             f"{ref['steps_per_s']:,.0f}" for ref in results["cartpole_references"]
         )
@@ -608,10 +594,13 @@ def markdown_goals(results: dict[str, Any]) -> str:
 
 
 def markdown_env_table(results: dict[str, Any]) -> str:
-    """Every env, vector env, world-model and PPO figure of the results file."""
+    """Every env, vector env and world-model figure of the results file. The PPO rows
+    stay out: PPO on the batched env has one home on a page, the throughput table's row
+    (:func:`markdown_throughput`), and its ratio to ``SubprocVecEnv`` is goal d's."""
     rows = [
         (section, case, steps, share, relative)
         for section, case, steps, share, _, _, relative in table_rows(results)
+        if section != "ppo"
     ]
     return _markdown(("section", "case", "steps/s", "% of CartPole-v1", "relative"), rows)
 

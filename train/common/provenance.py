@@ -6,7 +6,10 @@ A results file that ``bearing-env docs-tables`` writes a table from carries a
 
 A record of figures measured before their command wrote results files has the same keys,
 filled in from the page that showed them and the commit that published them, and a
-``"transcribed"`` line that says so.
+``"transcribed"`` line that says so. A record whose run named no commit that exists (a
+dirty tree's ``+changes``, before the records listed ``uncommitted`` files) takes its
+commit and date from git history, the commit that added the file's figures, and a
+``"provenance"`` line that says so.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ import contextlib
 import datetime
 import os
 import platform
+import re
 import shlex
 import subprocess
 import sys
@@ -23,22 +27,33 @@ from pathlib import Path
 from typing import Any
 
 
-def source_commit() -> str | None:
-    """The git commit of the code measured (the checkout's HEAD, with ``+changes`` when
-    its tracked files differ from it), or None outside a git checkout."""
+def _git(*arguments: str) -> str:
     folder = Path(__file__).resolve().parent
+    return subprocess.run(
+        ["git", *arguments], cwd=folder, capture_output=True, text=True, check=True
+    ).stdout
 
-    def git(*arguments: str) -> str:
-        return subprocess.run(
-            ["git", *arguments], cwd=folder, capture_output=True, text=True, check=True
-        ).stdout.strip()
 
+def source_commit() -> str | None:
+    """The git commit of the code measured: the checkout's HEAD, always a commit that
+    exists (never ``+changes``: :func:`uncommitted_files` says whether the tracked files
+    differed from it), or None outside a git checkout."""
     try:
-        head = git("rev-parse", "HEAD")
-        changes = git("status", "--porcelain", "--untracked-files=no")
+        return _git("rev-parse", "HEAD").strip()
     except (OSError, subprocess.CalledProcessError):
         return None
-    return f"{head}+changes" if changes else head
+
+
+def uncommitted_files() -> list[str]:
+    """The tracked files of the checkout that differ from its HEAD, sorted (empty for a
+    clean tree, or outside a git checkout): a measurement's record lists them beside its
+    commit, so the commit it names is one that exists."""
+    try:
+        lines = _git("status", "--porcelain", "--untracked-files=no").splitlines()
+    except (OSError, subprocess.CalledProcessError):
+        return []
+    # "XY path" or "XY old -> new": the path the tree holds now.
+    return sorted({line[3:].rpartition(" -> ")[2].strip('"') for line in lines if line.strip()})
 
 
 def machine_line() -> str:
@@ -53,33 +68,60 @@ def machine_line() -> str:
     return line + ")"
 
 
-def measured_here(program: str, argv: Sequence[str]) -> dict[str, Any]:
-    """The ``"measured"`` record of a run of ``program`` (``"bearing-env observability"``)
-    with the arguments ``argv``, made now on this machine."""
+def measured_record(command: str) -> dict[str, Any]:
+    """The ``"measured"`` record of ``command`` (the whole command line), run now on this
+    machine: the command, the commit (HEAD), the tracked files that differed from it
+    (``uncommitted``, empty for a clean tree), the date and the machine."""
     return {
-        "command": " ".join([program, shlex.join(argv)]).strip(),
+        "command": command,
         "commit": source_commit(),
+        "uncommitted": uncommitted_files(),
         "date": datetime.datetime.now(datetime.timezone.utc).date().isoformat(),
         "machine": machine_line(),
     }
 
 
+def measured_here(program: str, argv: Sequence[str]) -> dict[str, Any]:
+    """The ``"measured"`` record (:func:`measured_record`) of a run of ``program``
+    (``"bearing-env observability"``) with the arguments ``argv``, made now on this
+    machine."""
+    return measured_record(" ".join([program, shlex.join(argv)]).strip())
+
+
 def short_commit(commit: str | None) -> str:
-    """A commit as the pages cite it: 7 hex digits, ``+changes`` kept."""
+    """A commit as the pages cite it: ``commit `abc1234``` (7 hex digits). ValueError for
+    anything but a commit's hex name (a dirty tree's ``+changes`` is no commit: the
+    record lists its ``uncommitted`` files instead)."""
     if not commit:
         return "an unknown commit"
-    head, plus, changes = commit.partition("+")
-    return f"commit `{head[:7]}{plus}{changes}`"
+    if not re.fullmatch(r"[0-9a-f]{7,40}", commit):
+        raise ValueError(
+            f"not a commit: {commit!r} (record the clean commit and its uncommitted files)"
+        )
+    return f"commit `{commit[:7]}`"
+
+
+def uncommitted_text(files: Sequence[str]) -> str:
+    """How a caption names a run's uncommitted files: empty for a clean tree."""
+    if not files:
+        return ""
+    shown = ", ".join(f"`{name}`" for name in files[:3])
+    more = f" and {len(files) - 3} more" if len(files) > 3 else ""
+    return f" with uncommitted changes to {shown}{more}"
 
 
 def measured_sentence(measured: Mapping[str, Any], results_file: str) -> str:
-    """One sentence for a table's caption: the command, date, commit, machine and file
-    (and, for transcribed figures, where they were transcribed from)."""
+    """One sentence for a table's caption: the command, date, commit (and the tracked
+    files that differed from it), machine and file (and, for figures whose record was
+    filled in afterwards, where from)."""
     sentence = (
         f"Measured by `{measured['command']}` on {measured['date']}, "
-        f"{short_commit(measured.get('commit'))}, on a {measured['machine']}; "
+        f"{short_commit(measured.get('commit'))}"
+        f"{uncommitted_text(measured.get('uncommitted', []))}, on a {measured['machine']}; "
         f"file `{results_file}`."
     )
     if measured.get("transcribed"):
         sentence += f" {measured['transcribed']}"
+    if measured.get("provenance"):
+        sentence += f" {measured['provenance']}"
     return sentence
