@@ -28,6 +28,7 @@ MODULE_EXTRAS: dict[str, str] = {
     "tensorboard": "train",
     "yaml": "train",
     "rl_zoo3": "train",
+    "rliable": "train",
     "ray": "ray",
     "sphinx": "docs",
     "myst_parser": "docs",

@@ -64,7 +64,7 @@ import argparse
 import contextlib
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -243,6 +243,20 @@ def _add_statistics_options(group: argparse._ArgumentGroup) -> None:
     )
 
 
+def task_of(env_id: str, kwargs: Mapping[str, Any]) -> tuple[bool, object] | None:
+    """What makes two tasks the same: the action kind and the resolved settings of
+    ``env_id`` (in its current version) with ``kwargs``, ``max_moves`` aside; None when
+    they do not make an env (the comparison says what is wrong when it makes one)."""
+    import gymnasium as gym
+
+    settings = {key: value for key, value in kwargs.items() if key != "max_moves"}
+    task = ModelTask(current_id(env_id.rpartition(":")[2]), settings)
+    try:
+        return task.discrete, task.config
+    except (ValueError, TypeError, gym.error.Error):
+        return None
+
+
 def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
     """Specs of the shipped models trained on this env's task: the same action kind and the
     same resolved settings (the id's registered kwargs, then the env kwargs), so a model
@@ -254,17 +268,7 @@ def matching_pretrained(env_id: str, env_kwargs: dict[str, Any]) -> list[str]:
     sides: a model trained on ``BearingSLAM-v0`` with ``scenario="khepera"`` matches
     ``BearingSLAM-Khepera-v1``.
     """
-    import gymnasium as gym
-
     from bearing_env.agents import pretrained_names, pretrained_record
-
-    def task_of(env_id: str, kwargs: dict[str, Any]) -> tuple[bool, object] | None:
-        settings = {key: value for key, value in kwargs.items() if key != "max_moves"}
-        task = ModelTask(current_id(env_id.rpartition(":")[2]), settings)
-        try:
-            return task.discrete, task.config
-        except (ValueError, TypeError, gym.error.Error):
-            return None  # the comparison says what is wrong when it makes the env
 
     wanted = task_of(env_id, env_kwargs)
     if wanted is None:
@@ -374,14 +378,13 @@ _PROCESS_ONLY_FLAGS = ("--resume", "--overwrite", "--no-progress")
 _PROCESS_ONLY_OPTIONS = ("--stop-after", "--executor", "--ray-address")
 
 
-def reproducing_command(
+def result_arguments(
     argv: Sequence[str],
-    prog: str = "bearing-env compare",
     process_flags: Sequence[str] = _PROCESS_ONLY_FLAGS,
     process_options: Sequence[str] = _PROCESS_ONLY_OPTIONS,
-) -> str:
-    """``prog ...`` with the arguments that determine the results: ``argv`` less the
-    ``process_flags`` and the ``process_options`` with their values."""
+) -> list[str]:
+    """The arguments that determine the results: ``argv`` less the ``process_flags`` and
+    the ``process_options`` with their values."""
     kept: list[str] = []
     skip_value = False
     for arg in argv:
@@ -393,7 +396,18 @@ def reproducing_command(
             skip_value = True
         elif not arg.startswith(tuple(f"{option}=" for option in process_options)):
             kept.append(arg)
-    return " ".join([prog, *kept])
+    return kept
+
+
+def reproducing_command(
+    argv: Sequence[str],
+    prog: str = "bearing-env compare",
+    process_flags: Sequence[str] = _PROCESS_ONLY_FLAGS,
+    process_options: Sequence[str] = _PROCESS_ONLY_OPTIONS,
+) -> str:
+    """``prog ...`` with the arguments that determine the results
+    (:func:`result_arguments`)."""
+    return " ".join([prog, *result_arguments(argv, process_flags, process_options)])
 
 
 def main(argv: Sequence[str] | None = None) -> None:

@@ -45,7 +45,7 @@ def _stat_rng(bootstrap_seed: int, label: str, metric: str, move: int) -> np.ran
     return np.random.default_rng([bootstrap_seed, key, move])
 
 
-def _series_matrix(
+def series_matrix(
     records: Sequence[Mapping[str, Any]], key: str, length: int
 ) -> NDArray[np.float64]:
     """(episodes, length) values per move; None -> NaN; carried forward after the end."""
@@ -107,8 +107,8 @@ def summarise_policy(
     records = sorted(records, key=lambda r: r["seed"])
     max_moves = max(int(r["max_moves"]) for r in records)
     length = max_moves + 1
-    areas = _series_matrix(records, "area", length)
-    errors = _series_matrix(records, "error", length)
+    areas = series_matrix(records, "area", length)
+    errors = series_matrix(records, "error", length)
     resamples = config.bootstrap
 
     area_after = {

@@ -98,6 +98,20 @@ def _add_experiment_options(group: argparse._ArgumentGroup) -> None:
         "so before it starts",
     )
     add("--seed", type=SEED, default=0, help="seed of the run (default %(default)s)")
+    add(
+        "--seeds",
+        type=SEED,
+        nargs="+",
+        metavar="SEED",
+        help="train one run per seed, each in --output/seed<SEED> (default: one run, --seed)",
+    )
+    add(
+        "--workers",
+        type=COUNT,
+        default=1,
+        help="with --seeds: seeds trained at once, each in its own process (at most one per "
+        "core pays off)",
+    )
     add("--n-envs", type=COUNT, help="parallel envs (default the YAML's n_envs)")
     add(
         "--vec-env",
@@ -187,8 +201,10 @@ def _add_process_options(group: argparse._ArgumentGroup) -> None:
     )
 
 
-def default_output(algo: str, env_id: str, seed: int) -> Path:
-    return DEFAULT_RUNS_DIR / f"{algo}_{hyperparams_key(env_id)}_seed{seed}"
+def default_output(algo: str, env_id: str, seed: int | None) -> Path:
+    """``runs/<algo>_<env>_seed<seed>``, or ``runs/<algo>_<env>`` for several seeds."""
+    stem = f"{algo}_{hyperparams_key(env_id)}"
+    return DEFAULT_RUNS_DIR / (stem if seed is None else f"{stem}_seed{seed}")
 
 
 def settings_from_args(args: argparse.Namespace) -> TrainSettings:
@@ -229,8 +245,7 @@ def init_model_path(spec: str | None, option: str = "--init-from") -> Path | Non
         name = spec.removeprefix(PRETRAINED_PREFIX)
         if name not in pretrained_names():
             raise ValueError(
-                f"{option}: no pretrained model named {name!r}; available: "
-                f"{pretrained_names()}"
+                f"{option}: no pretrained model named {name!r}; available: {pretrained_names()}"
             )
         return PRETRAINED_DIR / f"{name}.zip"
     return Path(spec)
@@ -254,6 +269,11 @@ def main(argv: Sequence[str] | None = None) -> None:
     args = parser.parse_args(sys.argv[1:] if argv is None else list(argv))
     if args.export_only and args.export is None:
         parser.error("--export-only needs --export DIR/NAME")
+    if args.seeds is not None:
+        _train_seeds(parser, args, sys.argv[1:] if argv is None else list(argv))
+        return
+    if args.workers != 1:
+        parser.error("--workers needs --seeds")
     with _clear_errors(args):
         settings = settings_from_args(args)
         if args.export_only:
@@ -273,6 +293,29 @@ def main(argv: Sequence[str] | None = None) -> None:
     if args.export is not None:
         with _clear_errors(args):
             _print_export(export_run(settings.output, args.export))
+
+
+def _train_seeds(
+    parser: argparse.ArgumentParser, args: argparse.Namespace, argv: list[str]
+) -> None:
+    """``--seeds``: one run per seed (:mod:`bearing_env.train.sb3.multi_seed`)."""
+    from bearing_env.train.sb3.multi_seed import train_seeds
+
+    if any(argument.split("=", 1)[0] == "--seed" for argument in argv):
+        parser.error("--seed and --seeds exclude each other")
+    if args.export is not None:
+        parser.error(
+            "--export takes one run: export a seed with --export-only --output DIR/seed<S>"
+        )
+    env_id = registered_env_id(args.env or default_env_id(args.algo, args.conf_file))
+    output = args.output or default_output(args.algo, env_id, None)
+    try:
+        status = train_seeds(
+            argv, output, args.seeds, args.workers, args.resume, not args.no_progress
+        )
+    except (FileExistsError, ValueError) as error:
+        parser.error(str(error))
+    raise SystemExit(status)
 
 
 @contextlib.contextmanager
