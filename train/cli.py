@@ -1,37 +1,8 @@
-"""The ``bearing-env`` command line.
+"""The ``bearing-env`` command line: explore, compare, train and evaluate exploration
+policies for bearing-only SLAM, and the maintainers' tools.
 
-    bearing-env demo [...]        the random polygonal demo in the Khepera scenario (make demo)
-    bearing-env bench [...]       env, vector env, throughput and PPO steps/s against
-                                  CartPole-v1, as tables and JSON (benchmarks/bench_env.py,
-                                  make bench)
-    bearing-env bench-slam [...]  world-model update() throughput against CartPole-v1
-                                  (benchmarks/bench_slam.py; also ``bearing-env bench --slam``)
-    bearing-env bench-callgrind [...]  instructions per map update and per env step,
-                                  counted by valgrind (benchmarks/bench_callgrind.py)
-    bearing-env region-search [...]  a seeded search for regions that break the world
-                                  model's promises (benchmarks/region_search.py)
-    bearing-env soak [...]        the envs over random configurations, checking the
-                                  conservative guarantee at every step (benchmarks/soak.py)
-    bearing-env compare [...]     exploration policies on the same evaluation episodes
-    bearing-env suite [...]       the baselines on every registered task, with the task
-                                  cards in docs/tasks/ (compare once per task)
-    bearing-env figures [...]     the paper's Figs. 7, 10 and 11 in simulation
-    bearing-env robust-eval [...]  the robust fusion against the strict one under outliers
-                                  and an underestimated noise bound
-    bearing-env observability [...]  which movements can map a layout with a task's sensor,
-                                  whatever the policy (train/studies/observability.py)
-    bearing-env generalisation [...]  a policy trained on random layouts, across landmark
-                                  counts (train/studies/generalisation.py)
-    bearing-env play [...]        move the robot by hand in a pygame window (the render extra)
-    bearing-env train [...]       PPO/SAC/DQN with stable-baselines3 (shipped rl-zoo3 files)
-    bearing-env distill [...]     DAgger from a planner (LookaheadOracle) into an SB3 model
-                                  (train/sb3/distill.py)
-    bearing-env hyperparams ALGO  the path of a shipped rl-zoo3 hyperparameter file
-    bearing-env docs-tables [...]  the docs' tables of measured figures, from the results
-                                  files in the repo (train/common/doc_tables.py)
-    bearing-env rllib [...]       PPO with RLlib, locally or on a Ray cluster (train/ray/rllib.py)
-    bearing-env sweep [...]       a Ray Tune grid of RLlib PPO runs (train/ray/sweep.py)
-
+The commands, each with its module and one line of help, are :data:`COMMAND_GROUPS`;
+``bearing-env --help`` prints them by group, in the order a newcomer meets them.
 ``bearing-env --version`` prints the package's version; ``bearing-env`` alone prints the
 usage and exits with status 2. Each subcommand forwards its remaining arguments to the
 module that implements it, so ``bearing-env demo --help`` shows that module's options,
@@ -45,106 +16,140 @@ as an argparse usage error (status 2) whose one error line names the option and 
 
 from __future__ import annotations
 
+import argparse
 import importlib
 import sys
 
 from bearing_env import __version__
-from bearing_env.train.common.cli_parser import command_parser, doc_summary
+from bearing_env.train.common.cli_parser import doc_summary, plain_text
 from bearing_env.train.common.errors import exit_on_missing_extra, exit_quietly_on_broken_pipe
 
-SUBCOMMANDS: dict[str, tuple[str, str]] = {
-    "demo": (
-        "bearing_env.train.studies.demo",
-        "random polygonal exploration in the Khepera scenario",
-    ),
-    "bench": (
-        "bearing_env.benchmarks.bench_env",
-        "env, vector env, throughput and PPO steps/s vs CartPole-v1",
-    ),
-    "bench-slam": (
-        "bearing_env.benchmarks.bench_slam",
-        "world-model update() throughput vs CartPole-v1",
-    ),
-    "bench-callgrind": (
-        "bearing_env.benchmarks.bench_callgrind",
-        "instructions per map update and per env step, counted by valgrind (load-independent)",
-    ),
-    "region-search": (
-        "bearing_env.benchmarks.region_search",
-        "a seeded search for world-model regions that are not simple, convex or conservative",
-    ),
-    "transfer-tightness": (
-        "bearing_env.benchmarks.transfer_tightness",
-        "single-movement regions against the exact transferred sets they bound (area, containment)",
-    ),
-    "soak": (
-        "bearing_env.benchmarks.soak",
-        "a soak of the envs over random configurations, checking containment every step",
-    ),
-    "train": (
-        "bearing_env.train.sb3.train_cli",
-        "train PPO/SAC/DQN agents with stable-baselines3 (rl-zoo3 hyperparameter files)",
-    ),
-    "distill": (
-        "bearing_env.train.sb3.distill",
-        "DAgger: train a model's actor on a planner's actions at the states it visits",
-    ),
-    "docs-tables": (
-        "bearing_env.train.common.doc_tables",
-        "write the docs' tables of measured figures from the results files in the repo",
-    ),
-    "hyperparams": (
-        "bearing_env.train.sb3.conf_files",
-        "print the path of a shipped rl-zoo3 hyperparameter file (for --conf-file)",
-    ),
-    "compare": (
-        "bearing_env.train.compare.cli",
-        "compare exploration policies on fixed evaluation episodes",
-    ),
-    "suite": (
-        "bearing_env.train.compare.suite",
-        "run the baselines (random, parallax, greedy, lookahead, matching shipped models) "
-        "on every registered task, 50 episodes each by default, and write the task cards",
-    ),
-    "rllib": (
-        "bearing_env.train.ray.rllib",
-        "train PPO with RLlib on this machine or a Ray cluster (the ray extra)",
-    ),
-    "sweep": (
-        "bearing_env.train.ray.sweep",
-        "a Ray Tune grid of RLlib PPO runs over hyperparameters or env kwargs",
-    ),
-    "figures": (
-        "bearing_env.train.studies.figures",
-        "reproduce the paper's Figs. 7, 10 and 11 in simulation",
-    ),
-    "robust-eval": (
-        "bearing_env.train.studies.robust_eval",
-        "the robust fusion against the strict one: containment, area and step time",
-    ),
-    "observability": (
-        "bearing_env.train.studies.observability",
-        "which movements can map a layout at all with a task's sensor, whatever the policy",
-    ),
-    "generalisation": (
-        "bearing_env.train.studies.generalisation",
-        "a shipped policy trained on random layouts, across landmark counts",
-    ),
-    "play": (
-        "bearing_env.train.studies.play",
-        "move the robot by hand in a pygame window (keys or mouse clicks)",
-    ),
+#: The commands by group, in the order a newcomer meets them: what to run first, the
+#: studies and scale-out, then the maintainers' tools. Each: (module, one line of help).
+COMMAND_GROUPS: dict[str, dict[str, tuple[str, str]]] = {
+    "Start here": {
+        "demo": (
+            "bearing_env.train.studies.demo",
+            "the paper's random polygonal exploration in the Khepera arena",
+        ),
+        "play": (
+            "bearing_env.train.studies.play",
+            "move the robot by hand in a pygame window",
+        ),
+        "compare": (
+            "bearing_env.train.compare.cli",
+            "exploration policies on the same evaluation episodes",
+        ),
+        "train": (
+            "bearing_env.train.sb3.train_cli",
+            "train PPO/SAC/DQN with stable-baselines3, one seed or several",
+        ),
+        "curves": (
+            "bearing_env.train.sb3.curves",
+            "learning curves of one run or several seeds, with CI bands",
+        ),
+        "evaluate": (
+            "bearing_env.train.compare.evaluate",
+            "your trained model against the task's baselines, over seeds",
+        ),
+        "figures": (
+            "bearing_env.train.studies.figures",
+            "the paper's Figs. 7, 10 and 11 in simulation",
+        ),
+    },
+    "Studies and scale-out": {
+        "suite": (
+            "bearing_env.train.compare.suite",
+            "the baselines on every registered task, and the task cards",
+        ),
+        "hyperparams": (
+            "bearing_env.train.sb3.conf_files",
+            "the path of a shipped rl-zoo3 hyperparameter file",
+        ),
+        "distill": (
+            "bearing_env.train.sb3.distill",
+            "DAgger: a model's actor trained on a planner's actions",
+        ),
+        "rllib": (
+            "bearing_env.train.ray.rllib",
+            "PPO with RLlib, on this machine or a Ray cluster",
+        ),
+        "sweep": (
+            "bearing_env.train.ray.sweep",
+            "a Ray Tune grid of RLlib PPO runs",
+        ),
+        "observability": (
+            "bearing_env.train.studies.observability",
+            "which movements can map a layout at all, whatever the policy",
+        ),
+        "generalisation": (
+            "bearing_env.train.studies.generalisation",
+            "a shipped random-layout policy across landmark counts",
+        ),
+        "robust-eval": (
+            "bearing_env.train.studies.robust_eval",
+            "the robust fusion against the strict one under outliers",
+        ),
+    },
+    "Maintainers' tools": {
+        "bench": (
+            "bearing_env.benchmarks.bench_env",
+            "env, vector env and PPO speed against CartPole-v1",
+        ),
+        "bench-slam": (
+            "bearing_env.benchmarks.bench_slam",
+            "world-model update() speed against CartPole-v1",
+        ),
+        "bench-callgrind": (
+            "bearing_env.benchmarks.bench_callgrind",
+            "instructions per map update and env step (valgrind)",
+        ),
+        "region-search": (
+            "bearing_env.benchmarks.region_search",
+            "a seeded search for regions that break the model's promises",
+        ),
+        "transfer-tightness": (
+            "bearing_env.benchmarks.transfer_tightness",
+            "transferred regions against the exact sets they bound",
+        ),
+        "soak": (
+            "bearing_env.benchmarks.soak",
+            "the envs over random configurations, containment every step",
+        ),
+        "docs-tables": (
+            "bearing_env.train.common.doc_tables",
+            "the docs' tables of measured figures, from the results files",
+        ),
+    },
 }
+
+#: Every command: (module, one line of help).
+SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    name: entry for group in COMMAND_GROUPS.values() for name, entry in group.items()
+}
+
+
+def commands_help() -> str:
+    """The commands, one line each, under their groups' headings."""
+    width = max(len(name) for name in SUBCOMMANDS) + 2
+    lines = []
+    for heading, commands in COMMAND_GROUPS.items():
+        lines += ["", f"{heading}:"]
+        lines += [f"  {name:<{width}}{text}" for name, (_, text) in commands.items()]
+    return "\n".join(lines[1:])
 
 
 def main(argv: list[str] | None = None) -> None:
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = command_parser("bearing-env", doc_summary(__doc__))
+    parser = argparse.ArgumentParser(
+        prog="bearing-env",
+        description=plain_text(doc_summary(__doc__)),
+        epilog=f"{commands_help()}\n\n'bearing-env COMMAND --help' shows a command's options.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument(
-        "command",
-        choices=sorted(SUBCOMMANDS),
-        help="; ".join(f"{name}: {text}" for name, (_, text) in SUBCOMMANDS.items()),
+        "command", choices=list(SUBCOMMANDS), metavar="COMMAND", help="one of the commands below"
     )
     if argv[:1] in (["-h"], ["--help"]):
         parser.print_help()

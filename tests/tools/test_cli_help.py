@@ -102,7 +102,7 @@ def test_bare_bearing_env_prints_the_usage_and_exits_2(
         cli.main([])
     assert stopped.value.code == 2
     err = capsys.readouterr().err
-    assert err.startswith("usage: bearing-env") and "required: command" in err
+    assert err.startswith("usage: bearing-env") and "required: COMMAND" in err
 
 
 def test_generalisation_is_a_subcommand() -> None:
@@ -125,3 +125,29 @@ def test_the_formatter_adds_a_default_only_where_the_help_has_none() -> None:
 def test_doc_summary_is_the_first_paragraph_on_one_line() -> None:
     assert doc_summary("First line\nwraps here.\n\nMore.") == "First line wraps here."
     assert doc_summary(None) == ""
+
+
+def test_top_level_help_groups_the_commands_users_first(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(sys, "argv", ["bearing-env"])
+    cli.main(["--help"])
+    lines = capsys.readouterr().out.splitlines()
+    headings = [line for line in lines if line.endswith(":") and not line.startswith(" ")]
+    assert headings[-3:] == ["Start here:", "Studies and scale-out:", "Maintainers' tools:"]
+    listed = [line.split()[0] for line in lines if line.startswith("  ") and len(line.split()) > 1]
+    order = [name for name in listed if name in cli.SUBCOMMANDS]
+    assert order == list(cli.SUBCOMMANDS), "each command once, in its group's order"
+    users = {"train", "evaluate", "compare", "play", "demo", "figures", "curves"}
+    assert set(order[: len(users)]) == users, "the user's commands come first"
+    for name in (
+        "bench",
+        "bench-callgrind",
+        "region-search",
+        "transfer-tightness",
+        "soak",
+        "docs-tables",
+    ):
+        assert name in cli.COMMAND_GROUPS["Maintainers' tools"]
+    for line in lines:
+        assert len(line) <= 100 or not line.startswith("  "), f"one short line each: {line!r}"
