@@ -115,6 +115,10 @@ class Task:
         settings: the ``gym.make`` keyword arguments that define it (read-only), those of
             its version (:data:`VERSIONS`) included.
         description: one line for tables.
+        purpose: what the task is for, and its place against the paper (Markdown, a
+            few sentences; the card's "Description").
+        challenge: what makes the task hard, and whether it can be solved at all
+            (Markdown; the card's "Description").
     """
 
     id: str
@@ -122,6 +126,8 @@ class Task:
     # Hashed by the rest (a mapping has no hash); compared all the same.
     settings: Mapping[str, Any] = field(hash=False)
     description: str = ""
+    purpose: str = ""
+    challenge: str = ""
     #: What each version changed, one line each, oldest first (the cards' "Version
     #: history").
     history: tuple[str, ...] = HISTORY
@@ -161,6 +167,8 @@ class Task:
             base_id=versioned_id(BASE_NAMES[self.action_kind], version),
             settings={**self.settings, **_missing(VERSIONS[version], self.settings)},
             description=self.description,
+            purpose=self.purpose,
+            challenge=self.challenge,
             history=tuple(line for line in self.history if _line_version(line) <= version),
         )
 
@@ -183,13 +191,46 @@ def _line_version(line: str) -> int:
     return int(line.partition(":")[0].removeprefix("v"))
 
 
+#: The paper every task builds on, as the cards cite it.
+PAPER = (
+    "H. Huang, F. Maire and N. Keeratipranon, *Uncertainty Analysis of a Landmark "
+    "Initialization Method for Simultaneous Localization and Mapping*, Australasian "
+    "Conference on Robotics and Automation (ACRA), Sydney, 2005"
+)
+
+_KHEPERA_PURPOSE = (
+    "The arena of the paper's real-robot experiment (Huang, Maire & Keeratipranon, "
+    "ACRA 2005): a Khepera robot with a panoramic camera on a 1.05 x 0.68 m field with "
+    "four landmarks, L1 and L2 20 cm apart. The paper moved its robot along random "
+    "polygonal trajectories and showed that the uncertainty regions of L3 and L4 shrink "
+    "as it moves; this task asks which moves shrink them fastest, the paper's own "
+    "setting turned into an exploration problem."
+)
+_KHEPERA_CHALLENGE = (
+    "A region shrinks only where the bearing cones of a movement cross at a wide angle, "
+    "so a good move depends on where the robot believes it is and where the regions are "
+    "long; with moves of 5 to 30 cm and a bearing error of ±2°, short or radial moves "
+    "map little. Success asks both regions to fall below 0.05 FL units² within 20 moves, "
+    "which the planners reach only in some episodes. The robot never sees ground truth: "
+    "it plans on its own map."
+)
+
+
 def _khepera(kind: str) -> Task:
     actions = "continuous turn and move length" if kind == "continuous" else "a grid of moves"
+    grid = (
+        ""
+        if kind == "continuous"
+        else " The discrete id offers a grid of turns and lengths instead, for agents "
+        "(DQN and the like) that need a finite action set."
+    )
     return Task(
         id=versioned_id(f"{BASE_NAMES[kind]}-Khepera"),
         base_id=BASE_IDS[kind],
         settings={"scenario": "khepera"},
         description=f"the paper's Khepera arena (4 fixed landmarks), {actions}",
+        purpose=_KHEPERA_PURPOSE + grid,
+        challenge=_KHEPERA_CHALLENGE,
     )
 
 
@@ -199,7 +240,47 @@ def _random(n_landmarks: int) -> Task:
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "random", "n_landmarks": n_landmarks},
         description=f"a new random layout of {n_landmarks} landmarks every episode, Khepera field",
+        purpose="The paper's sensor and world model on layouts it did not study: a new "
+        f"layout of {n_landmarks} landmarks every episode on the Khepera field, so that a "
+        "policy must generalise over layouts instead of learning one arena's moves.",
+        challenge=f"Every episode places L1, L2 and the {n_landmarks - 2} landmarks to map "
+        "anew, so no fixed sequence of moves works; "
+        + (
+            "with two landmarks to map the task is close to the Khepera one."
+            if n_landmarks <= 4
+            else f"with {n_landmarks - 2} landmarks to map within 20 moves, one move "
+            "cannot serve them all, and the policy must choose which regions to shrink "
+            "first (the observation has a slot per landmark, up to `max_landmarks`)."
+        ),
     )
+
+
+#: The environment page's section on what a limited sensor can map at all (from a card).
+_OBSERVABILITY = (
+    "[what a forward camera can map at all]"
+    "(../environment.md#what-a-forward-camera-can-map-at-all)"
+)
+
+#: What makes each camera task hard (the cards' "Description").
+_CAMERA_CHALLENGE: dict[int, str] = {
+    90: "**This task cannot be solved in practice: every baseline ends at the cap.** A "
+    "movement maps a landmark only when the camera sees L1, L2 and that landmark at both "
+    "ends, with enough parallax. A forward camera turns with the move, so every landmark "
+    "it sees, L1 and L2 (20 cm apart) included, lies within 45° of the line of motion, "
+    "where a move gives the least parallax: the few movements that update L3 or L4 at "
+    "all give regions far wider than `area_cap`. From an empty map no "
+    "single movement in this arena maps both within the cap, and the omniscient two-move "
+    "planner of `bearing-env observability` (measured on the `-v0` id) ended every "
+    "episode with both at the cap "
+    f"({_OBSERVABILITY}). "
+    "The task is kept as a reference for a sensor that cannot map this layout: an agent "
+    "that scores below the cap here has found something the baselines have not.",
+    180: "A movement maps a landmark only when the camera sees L1, L2 and that landmark "
+    "at both ends, with enough parallax; with half the view, few movements do "
+    f"({_OBSERVABILITY}). "
+    "Before it has a map the robot must look around and keep L1 and L2 in view; the "
+    "planners do better than random here but stay far from the panoramic camera's areas.",
+}
 
 
 def _camera(degrees: int) -> Task:
@@ -209,6 +290,11 @@ def _camera(degrees: int) -> Task:
         settings={"scenario": "khepera", "field_of_view_deg": degrees},
         description=f"Khepera arena, a forward camera of {degrees} deg: landmarks outside it "
         "are missed (`bearing-env observability` shows what it can map at all)",
+        purpose="The paper's robot has a panoramic camera; most robots have a forward "
+        f"one. This task keeps the Khepera arena and gives the robot a camera of {degrees}° "
+        "about its heading (the move's direction), so a reading misses every landmark "
+        "outside it, and the world model learns nothing from a movement that misses L1 or L2.",
+        challenge=_CAMERA_CHALLENGE[degrees],
     )
 
 
@@ -224,12 +310,27 @@ TASKS: tuple[Task, ...] = (
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "khepera", "noise": OUTLIER_NOISE, "fusion": "relaxed"},
         description="Khepera arena, 5% of bearings replaced by random angles, relaxed fusion",
+        purpose="The paper assumes every bearing is within ±ε of the truth. Here 5% of "
+        "the bearings are outliers, replaced by a uniformly random angle, as a "
+        "misdetection would give, and the map uses the relaxed fusion, which may leave "
+        "out up to `max_outliers` contradicting regions per landmark over its last 8 "
+        "movements ([the world model](../world_model.md#robust-fusion-fusionrelaxed)).",
+        challenge="An outlier gives a region that may not hold the landmark, and the "
+        "strict intersection would then lose the truth or come out empty; the relaxed "
+        "fusion holds the truth in most regions but not in all, so the regions are "
+        "larger than on the clean task and `landmark_contains_truth` can be false.",
     ),
     Task(
         id=versioned_id("BearingSLAM-Khepera-Missed"),
         base_id=BASE_IDS["continuous"],
         settings={"scenario": "khepera", "noise": MISSED_NOISE, "fusion": "relaxed"},
         description="Khepera arena, each landmark missed in 20% of readings, relaxed fusion",
+        purpose="The paper's camera sees every landmark in every reading. Here each "
+        "landmark is missed in 20% of the readings (its bearing is NaN for the world "
+        "model), as a detector that fails now and then would, with the relaxed fusion.",
+        challenge="A movement maps a landmark only when both readings see it, and maps "
+        "nothing when either misses L1 or L2, so about half the movements are lost "
+        "or partial; the policy cannot know in advance which ones.",
     ),
     _camera(90),
     _camera(180),
@@ -239,6 +340,17 @@ TASKS: tuple[Task, ...] = (
         settings={"scenario": "furnished_room"},
         description="a furnished room of 2 x 1.5 m (5 landmarks): furniture blocks moves "
         "and hides landmarks",
+        purpose="The paper's arena is empty. This one is a room of 2 x 1.5 m with five "
+        "landmarks and four pieces of furniture (a table, a sofa, a shelf and an "
+        "armchair, the `obstacles` setting) that stop moves and block the line of sight, "
+        "as a real room would; the camera is the paper's panoramic one.",
+        challenge="A landmark behind furniture is missed, a move into it stops short, and "
+        "the robot is not told where the furniture is: it learns that from where its "
+        "moves were blocked. From many starts no single movement maps anything "
+        f"({_OBSERVABILITY}), "
+        "so a policy must first move to where L1, L2 and the other landmarks are in sight; "
+        "the map-based planners plan on a map they do not have yet, while a trained "
+        "policy can learn where to go (the baselines below).",
     ),
 )
 
@@ -258,6 +370,11 @@ def _random_table(observation: str) -> Task:
         },
         description=f"a new random layout of 3 to 16 landmarks every episode, the "
         f'`"{observation}"` observation (a landmark table, for set and attention policies)',
+        purpose="The training task of the shipped generalist models: a policy for any "
+        "landmark count from 3 to 16, on a landmark table that set and attention "
+        "policies read.",
+        challenge="The landmark count changes every episode, so a policy must work on a "
+        "table of variable length.",
     )
 
 

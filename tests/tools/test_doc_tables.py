@@ -215,3 +215,59 @@ def test_no_other_table_of_figures_is_hand_written() -> None:
     )
     assert unexpected == []
     assert len(found) <= len(HAND_WRITTEN_TABLES)
+
+
+def test_the_cards_are_rendered_from_their_results_files_without_an_episode(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``bearing-env docs-tables`` is the cards' render-only path: after a change of the
+    card writer (or of a task's text) it rewrites every card from its results file, and
+    runs no episode."""
+    from bearing_env.train.compare import runner
+
+    def no_episode(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a card was rendered by running an episode")
+
+    monkeypatch.setattr(runner, "run_episode", no_episode)
+    monkeypatch.setattr(runner, "run_task", no_episode)
+    root = copy_of_the_docs(tmp_path)
+    cards = sorted((root / "docs" / "tasks").glob("BearingSLAM*.md"))
+    published = {card: card.read_text(encoding="utf-8") for card in cards}
+    for card in cards:
+        card.write_text("# an old card\n", encoding="utf-8")
+    doc_tables.main(["--root", str(root)])
+    assert {card: card.read_text(encoding="utf-8") for card in cards} == published
+
+
+def test_every_card_results_file_names_its_commit_date_and_machine() -> None:
+    """The cards' results files carry a ``measured`` record, and the card quotes it."""
+    import json
+
+    from bearing_env.train.common.provenance import measured_sentence
+
+    files = sorted((ROOT / "docs" / "tasks" / "results").glob("*.json"))
+    assert len(files) == 10
+    for path in files:
+        measured = json.loads(path.read_text(encoding="utf-8"))["measured"]
+        assert {"command", "commit", "date", "machine"} <= measured.keys(), path.name
+        card = ROOT / "docs" / "tasks" / f"{path.stem}.md"
+        sentence = measured_sentence(measured, f"docs/tasks/results/{path.name}")
+        assert sentence in card.read_text(encoding="utf-8"), path.name
+
+
+def test_no_results_file_or_page_names_a_dirty_tree() -> None:
+    """A commit in a results file is a commit's hex name, never ``+changes``: a run on a
+    dirty tree records the clean commit and its ``uncommitted`` files."""
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
+    pages = [page for page in pages if page.name != "notes.md"]  # history may tell of it
+    results = [
+        *sorted((ROOT / "benchmarks" / "results").glob("*.json")),
+        *sorted((ROOT / "docs").rglob("*.json")),
+        *sorted((ROOT / "agents" / "pretrained").glob("*.json")),
+    ]
+    dirty = [
+        str(path.relative_to(ROOT))
+        for path in [*pages, *results]
+        if "+changes" in path.read_text(encoding="utf-8")
+    ]
+    assert dirty == []

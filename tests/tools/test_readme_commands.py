@@ -158,14 +158,22 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     ),
     "bearing-env observability --env BearingSLAM-Khepera-v0 --fov 360 180 90 "
     "--oracle-episodes 20": ("parse", ()),
-    "bearing-env observability --env BearingSLAM-Khepera-v0 --fov 360 180 90 --plot "
+    "bearing-env observability --env BearingSLAM-Khepera-v1 --fov 360 180 90 --plot "
     "docs/figures/observability_khepera.png --json docs/figures/observability_khepera.json": (
         "parse",
         (),
     ),
-    "bearing-env observability --env BearingSLAM-FurnishedRoom-v0 --fov 360 180 90 --plot "
+    "bearing-env observability --env BearingSLAM-FurnishedRoom-v1 --fov 360 180 90 --plot "
     "docs/figures/observability_furnished_room.png --json "
     "docs/figures/observability_furnished_room.json": ("parse", ()),
+    # The same, as the measured sentence of the table quotes them.
+    "bearing-env observability --env BearingSLAM-Khepera-v1 --fov 360 180 90 --plot "
+    "docs/figures/observability_khepera.png --json docs/figures/observability_khepera.json "
+    "--no-progress": ("parse", ()),
+    "bearing-env observability --env BearingSLAM-FurnishedRoom-v1 --fov 360 180 90 --plot "
+    "docs/figures/observability_furnished_room.png --json "
+    "docs/figures/observability_furnished_room.json --no-progress": ("parse", ()),
+    "bearing-env suite": ("parse", ()),
     "bearing-env robust-eval --episodes 200 --json docs/figures/robust_eval.json": ("parse", ()),
     "bearing-env compare --episodes 200 --executor ray": ("parse", ()),
     "bearing-env compare --episodes 2000 --executor ray --ray-address auto "

@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -20,6 +21,7 @@ import numpy as np
 from bearing_env.tasks import Task
 from bearing_env.train.common.errors import available
 from bearing_env.train.common.files import atomic_path, atomic_write_text
+from bearing_env.train.common.provenance import measured_record, measured_sentence
 from bearing_env.train.compare.comparison import CompareResult
 from bearing_env.train.compare.config import CompareConfig
 from bearing_env.train.compare.report import (
@@ -36,6 +38,8 @@ INDEX_NAME = "index.md"
 RESULTS_DIR = "results"
 #: The environment page, relative to the cards.
 ENV_PAGE = "../environment.md"
+#: The world model page, relative to the cards.
+WORLD_MODEL_PAGE = "../world_model.md"
 #: The heading of the index's overview table (:func:`overview_markdown`).
 OVERVIEW_HEADING = "## Baselines at a glance"
 #: Moves of the greedy policy before the card's frame is rendered.
@@ -63,8 +67,35 @@ def _number(value: float) -> str:
     return f"{value:g}"
 
 
+def _field_of_view(degrees: float) -> str:
+    if degrees >= 360:
+        return "360°: the paper's panoramic camera"
+    return (
+        f"{_number(degrees)}° about the heading (the move's direction): a landmark outside "
+        "it is missed"
+    )
+
+
+def _obstacles(obstacles: Sequence[Sequence[Sequence[float]]]) -> str:
+    """The obstacles in a few words: none, or each polygon (a box by its extent)."""
+    if not obstacles:
+        return "none"
+    shapes = []
+    for polygon in obstacles:
+        xs = sorted({float(x) for x, _ in polygon})
+        ys = sorted({float(y) for _, y in polygon})
+        if len(polygon) == 4 and len(xs) == 2 and len(ys) == 2:
+            shapes.append(
+                f"x {_number(xs[0])} to {_number(xs[1])}, y {_number(ys[0])} to {_number(ys[1])}"
+            )
+        else:
+            shapes.append(f"a polygon of {len(polygon)} vertices")
+    return f"{len(obstacles)} polygons that block moves and sight, in metres: " + "; ".join(shapes)
+
+
 def settings_rows(config: Any, task: Task) -> list[list[str]]:
-    """The settings a score depends on, resolved (``EnvConfig``), as table rows."""
+    """Every setting of the task, resolved (``EnvConfig``), as table rows: those that
+    define the task (its registered settings) first, then the rest at their values."""
     noise = config.noise
     if noise.kind == "uniform":
         bound = "ε" if noise.bound_deg is None else f"{_number(noise.bound_deg)}°"
@@ -82,42 +113,134 @@ def settings_rows(config: Any, task: Task) -> list[list[str]]:
         count = f"{lo}" if lo == hi else f"{lo} to {hi}"
         layout = f"a new random layout of {count} landmarks every episode"
     rows = [
-        ["registered settings", f"`{task.settings_text()}` on `{task.base_id}`"],
-        ["scenario", f"`{config.scenario}`: {layout}"],
-        ["arena", f"{_number(config.arena.width)} x {_number(config.arena.height)} m"],
+        ["layout (`scenario`, `n_landmarks`)", f"`{config.scenario}`: {layout}"],
+        ["arena (`arena`)", f"{_number(config.arena.width)} x {_number(config.arena.height)} m"],
         ["bearing error bound ε (`epsilon_deg`)", f"{_number(config.epsilon_deg)}°"],
         ["true sensor noise (`noise`)", sensor],
+        ["field of view (`field_of_view_deg`)", _field_of_view(config.field_of_view_deg)],
+        [
+            "range (`max_range`)",
+            "unlimited" if np.isinf(config.max_range) else f"{_number(config.max_range)} m",
+        ],
+        ["obstacles (`obstacles`)", _obstacles(config.obstacles)],
         ["outliers (`noise.outlier_rate`)", f"{100 * noise.outlier_rate:g}% of bearings"],
         ["detection (`noise.detection_rate`)", f"{100 * noise.detection_rate:g}% of readings"],
-        ["fusion", f"`{config.fusion}`"],
+        ["`fusion`", f"`{config.fusion}`"],
     ]
     if config.fusion == "relaxed":
         rows.append(["`max_outliers`", str(config.max_outliers)])
     rows += [
-        ["transfer", f"`{config.transfer}`"],
-        ["on inconsistency", f"`{config.on_inconsistency}`"],
-        ["move length", f"{_number(config.move_length[0])} to {_number(config.move_length[1])} m"],
+        ["`transfer`", f"`{config.transfer}`"],
+        ["`on_inconsistency`", f"`{config.on_inconsistency}`"],
+        [
+            "`move_length`",
+            f"{_number(config.move_length[0])} to {_number(config.move_length[1])} m",
+        ],
         ["`max_moves`", str(config.max_moves)],
+        ["reward (`reward`)", f"`{config.reward}`"],
+        [
+            "costs (`path_cost`, `move_cost`)",
+            f"{_number(config.path_cost)} per metre, {_number(config.move_cost)} per move",
+        ],
         ["`target_area`", f"{_number(config.target_area)} FL units²"],
         ["`area_cap`", f"{_number(config.area_cap)} FL units²"],
-        ["observation", f"`{config.observation}`, `max_landmarks` = {config.max_landmarks}"],
+        ["`observation`, `max_landmarks`", f"`{config.observation}`, {config.max_landmarks} slots"],
     ]
     if task.action_kind == "discrete":
-        rows.append(["action grid", f"{config.n_turns} turns x {config.n_move_lengths} lengths"])
-    return rows
+        rows.append(
+            [
+                "action grid (`n_turns`, `n_move_lengths`)",
+                f"{config.n_turns} turns x {config.n_move_lengths} lengths",
+            ]
+        )
+    return [[_registered(label, task), value] for label, value in rows]
+
+
+def _registered(label: str, task: Task) -> str:
+    """A settings row's label, in bold with "(registered)" when it holds one of the
+    settings the task's id registers."""
+    if any(re.search(f"`{re.escape(key)}[`.]", label) for key in task.settings):
+        return f"**{label}** (registered)"
+    return label
 
 
 def space_text(space: Any) -> str:
-    """A space in a few words: ``Box((63,), float32)``, ``Discrete(24)``, ``Dict(...)``
-    (a Box's bounds are in the env's docstring, not repeated here)."""
+    """A space in a few words: ``Box(-1.0, 1.0, (2,), float32)`` for a Box with one
+    bound for every column, ``Box((63,), float32)`` otherwise (:func:`bounds_text` gives
+    those bounds), ``Discrete(24)``, ``Dict(...)``."""
     from gymnasium import spaces
 
     if isinstance(space, spaces.Box):
+        low, high = np.unique(space.low), np.unique(space.high)
+        if low.size == 1 and high.size == 1:
+            return f"Box({float(low[0])}, {float(high[0])}, {space.shape}, {space.dtype})"
         return f"Box({space.shape}, {space.dtype})"
     if isinstance(space, spaces.Dict):
         items = ", ".join(f"{key}: {space_text(sub)}" for key, sub in space.spaces.items())
         return f"Dict({items})"
     return str(space)
+
+
+def _bound(value: float) -> str:
+    """A Box bound as the card shows it: 4 significant digits (a bound is the float32
+    just outside the value it stands for), 0 for a subnormal."""
+    return "0" if abs(value) < 1e-30 else f"{float(value):.4g}"
+
+
+def column_names(config: Any, key: str | None = None) -> list[str]:
+    """The name of each column of the flat observation (``key`` None) or of a Dict
+    observation's ``"robot"`` or ``"landmarks"`` Box, as the env lays them out."""
+    from bearing_env.envs.observations import (
+        BEARING_FEATURES,
+        ENTITY_FEATURES,
+        LANDMARK_FEATURES,
+        ROBOT_FEATURES,
+        SHAPE_ENTITY_FEATURES,
+    )
+
+    m = config.max_landmarks
+    if key == "robot":
+        return list(ROBOT_FEATURES)
+    if key == "landmarks":
+        columns = ENTITY_FEATURES if config.observation == "entities" else SHAPE_ENTITY_FEATURES
+        return list(columns) * m
+    return [
+        *ROBOT_FEATURES,
+        *(list(LANDMARK_FEATURES) * (m - 2)),
+        *(list(BEARING_FEATURES) * m),
+    ]
+
+
+def bounds_text(space: Any, config: Any) -> str:
+    """A Box's bounds by column, grouped: ``[-50, 50]`` robot_x, robot_y, x, y; ...
+    (a Dict's per key); empty for a Box with one bound for every column."""
+    from gymnasium import spaces
+
+    if isinstance(space, spaces.Dict):
+        parts = [
+            f"`{key}` {text}"
+            for key, sub in space.spaces.items()
+            if (text := _box_bounds(sub, column_names(config, key)))
+        ]
+        return "; ".join(parts)
+    if isinstance(space, spaces.Box):
+        return _box_bounds(space, column_names(config))
+    return ""
+
+
+def _box_bounds(space: Any, names: Sequence[str]) -> str:
+    if np.unique(space.low).size == 1 and np.unique(space.high).size == 1:
+        return ""
+    if len(names) != space.low.size:
+        names = [f"column {i}" for i in range(space.low.size)]
+    groups: dict[tuple[str, str], list[str]] = {}
+    for name, low, high in zip(names, space.low.ravel(), space.high.ravel(), strict=True):
+        columns = groups.setdefault((_bound(low), _bound(high)), [])
+        if name not in columns:
+            columns.append(name)
+    return "; ".join(
+        f"[{low}, {high}]: {', '.join(columns)}" for (low, high), columns in groups.items()
+    )
 
 
 def observation_text(config: Any, space: Any) -> str:
@@ -241,35 +364,106 @@ def return_text(config: Any) -> str:
     return text
 
 
-INFO_KEYS = (
-    "landmark_area", "landmark_error", "landmark_contains_truth", "total_area",
-    "robot_error", "frame_changed", "inconsistent", "path_length", "rewards", "robot_map",
-)  # fmt: skip
+def info_keys(env: Any, seed: int) -> list[str]:
+    """The keys of the info a reset of ``env`` gives (a step gives the same), in the
+    order the env writes them: what the card's Info section lists."""
+    _, info = env.reset(seed=seed)
+    return list(info)
 
 
-def info_text(config: Any) -> str:
-    keys = list(INFO_KEYS)
-    if config.sensor_info:
-        keys += ["seen", "blocked"]
-    if not config.robot_map_info:
-        keys.remove("robot_map")
+def info_text(keys: Sequence[str]) -> str:
     return (
         ", ".join(f"`{key}`" for key in keys)
-        + ". `robot_map` is the robot's own map; the others are ground truth, for evaluation. "
-        f"Their meanings are in [the environment's info table]({ENV_PAGE}#info)."
+        + ": the same keys from `reset` and `step`. `robot_map` is the robot's own map and "
+        "`outliers` its fusion's count of left-out regions; the others are ground truth, "
+        "for evaluation. Their meanings are in "
+        f"[the environment's info table]({ENV_PAGE}#info)."
     )
 
 
 def summary_box(task: Task, config: Any, observation_space: Any, action_space: Any) -> str:
-    """The card's top table, as Gymnasium's env pages have it."""
+    """The card's top table, as Gymnasium's env pages have it, with the Box bounds."""
+    observation = f"`{space_text(observation_space)}`"
+    bounds = bounds_text(observation_space, config)
+    if bounds:
+        observation += f", bounds by column: {bounds}"
     rows = [
         ["Action space", f"`{space_text(action_space)}`"],
-        ["Observation space", f"`{space_text(observation_space)}`"],
+        ["Observation space", observation],
         ["Episode cap", f"`max_moves` = {config.max_moves} moves"],
         ["Success", f"every region of L3, L4, ... ≤ {_number(config.target_area)} FL units²"],
+        ["Registered settings", f"`{task.settings_text()}` on `{task.base_id}`"],
         ["Import", f'`gym.make("bearing_env:{task.id}")`'],
     ]
     return markdown_table(rows[0], rows[1:])
+
+
+def description_section(task: Task) -> list[str]:
+    """The card's Description: the one-line summary, what the task is for and what makes
+    it hard (from :mod:`bearing_env.tasks`, their one home), the paper, how to make it."""
+    from bearing_env.tasks import PAPER
+
+    return [
+        "## Description",
+        "",
+        f"{task.description[0].upper()}{task.description[1:]}.",
+        "",
+        task.purpose,
+        "",
+        task.challenge,
+        "",
+        "The world model is the polygon SLAM of the paper below, with a conservative "
+        f"transfer ([the world model]({WORLD_MODEL_PAGE}#two-transfers)); "
+        "the agent chooses the moves and is rewarded for shrinking the regions.",
+        "",
+        f"Reference: {PAPER}.",
+        "",
+        "```python",
+        "import gymnasium as gym",
+        "",
+        f'env = gym.make("bearing_env:{task.id}")',
+        f'envs = gym.make_vec("bearing_env:{task.id}", num_envs=8)  # the batched vector env',
+        "```",
+        "",
+    ]
+
+
+def arguments_section(task: Task) -> list[str]:
+    """The card's Arguments: what ``gym.make(ID, **kwargs)`` may override, and how."""
+    from bearing_env.tasks import VERSIONS, versioned_id
+
+    defining = ", ".join(f"`{key}`" for key in task.settings)
+    older = [versioned_id(task.name, v) for v in VERSIONS if v != task.version]
+    return [
+        "## Arguments",
+        "",
+        f'`gym.make("bearing_env:{task.id}", **kwargs)` (and `gym.make_vec`) takes every '
+        f"keyword of its base env `{task.base_id}` ([the environment's settings table]"
+        f'({ENV_PAGE}#settings)) and `render_mode` (`"human"` or `"rgb_array"`). The id '
+        f"registers {defining} (the Registered settings above) as its kwargs: a keyword "
+        "given to `gym.make` replaces the registered one of that name, and every other "
+        "setting keeps the value in the Settings table. For example:",
+        "",
+        "```python",
+        f'env = gym.make("bearing_env:{task.id}", max_moves=40, render_mode="rgb_array")',
+        "```",
+        "",
+        f"The scores below hold for the id as registered. Changing {defining} makes "
+        "another task; changing any other setting (the episode cap, the noise, the "
+        "transfer, ...) changes the scores too, so a result under overrides names them. "
+        + (
+            f"`{', '.join(older)}` "
+            + ("is" if len(older) == 1 else "are")
+            + " the same task in "
+            + ("an older version" if len(older) == 1 else "older versions")
+            + " (the Version history), registered so that scores published under "
+            + ("it" if len(older) == 1 else "them")
+            + " reproduce."
+            if older
+            else ""
+        ),
+        "",
+    ]
 
 
 def version_history(task: Task) -> list[str]:
@@ -326,33 +520,28 @@ def task_card(
     task: Task,
     config: CompareConfig,
     summary: Mapping[str, Any],
-    command: str | None,
+    measured: Mapping[str, Any] | None,
     frame: bool,
     plot: bool,
 ) -> str:
-    """The Markdown of a task's card."""
+    """The Markdown of a task's card; ``measured`` is its results file's record of the
+    run (:func:`~bearing_env.train.common.provenance.measured_record`), or None."""
     from bearing_env.envs.config import EnvConfig
 
     resolved = EnvConfig.create(**{**task.kwargs(), **config.env_kwargs})
     env = make_env(config.env_id, config.env_kwargs)
     with contextlib.closing(env):
         observation_space, action_space = env.observation_space, env.action_space
+        keys = info_keys(env, config.seeds[0])
     seeds = config.seeds
     parts = [
         f"# {task.id}",
         "",
         summary_box(task, resolved, observation_space, action_space),
         "",
-        f"{task.description[0].upper()}{task.description[1:]}.",
-        "",
-        "```python",
-        "import gymnasium as gym",
-        "",
-        f'env = gym.make("bearing_env:{task.id}")',
-        f'envs = gym.make_vec("bearing_env:{task.id}", num_envs=8)  # the batched vector env',
-        "```",
-        "",
-        *task_sections(task, resolved, observation_space, action_space),
+        *description_section(task),
+        *task_sections(task, resolved, observation_space, action_space, keys),
+        *arguments_section(task),
         *baselines_section(task, config, summary),
     ]
     if plot:
@@ -366,14 +555,10 @@ def task_card(
             "latest bearing cones (±ε), the robot and its path.",
             "",
         ]
-    if command:
+    if measured:
         parts += [
-            "Measured with the command below; `bearing-env docs-tables` writes this card from "
-            f"its results file, `{RESULTS_DIR}/{task.id}.json`:",
-            "",
-            "```bash",
-            command,
-            "```",
+            measured_sentence(measured, f"docs/tasks/{RESULTS_DIR}/{task.id}.json")
+            + " `bearing-env docs-tables` writes this card from that file.",
             "",
         ]
     parts += ["## Version history", "", *version_history(task), ""]
@@ -381,10 +566,10 @@ def task_card(
 
 
 def task_sections(
-    task: Task, resolved: Any, observation_space: Any, action_space: Any
+    task: Task, resolved: Any, observation_space: Any, action_space: Any, keys: Sequence[str]
 ) -> list[str]:
     """The card's sections on what the agent faces: observation, action, reward,
-    starting state, episode end, info and settings."""
+    starting state, episode end, info (``keys``) and settings."""
     return [
         "## Observation",
         "",
@@ -410,13 +595,16 @@ def task_sections(
         "",
         "## Info",
         "",
-        info_text(resolved),
+        info_text(keys),
         "",
         "## Settings",
         "",
+        "Every setting of the task as its id makes it: in bold, the settings the id "
+        "registers; the others at the env's defaults.",
+        "",
         markdown_table(["setting", "value"], settings_rows(resolved, task)),
         "",
-        f"Every setting is described in [the environment's settings table]({ENV_PAGE}#settings).",
+        f"Each setting is described in [the environment's settings table]({ENV_PAGE}#settings).",
         "",
     ]
 
@@ -505,10 +693,11 @@ def write_task_card(
     if plot:
         copy_file(plot_source, docs / area_plot_name(task))
     frame = render_frame(config, config.seeds[0], docs / frame_name(task))
-    results = {"task": task.id, "command": command, "summary": result.summary}
+    measured = measured_record(command) if command else None
+    results = {"task": task.id, "measured": measured, "summary": result.summary}
     atomic_write_text(results_path(docs, task), json.dumps(results, indent=1) + "\n")
     path = docs / card_name(task)
-    atomic_write_text(path, task_card(task, config, result.summary, command, frame, plot))
+    atomic_write_text(path, task_card(task, config, result.summary, measured, frame, plot))
     return path
 
 
@@ -544,7 +733,7 @@ def published_cards(docs: Path) -> dict[Path, str]:
         summary = data["summary"]
         frame = (docs / frame_name(task)).is_file()
         plot = (docs / area_plot_name(task)).is_file()
-        text = task_card(task, config_of(summary), summary, data["command"], frame, plot)
+        text = task_card(task, config_of(summary), summary, data.get("measured"), frame, plot)
         cards[docs / card_name(task)] = text
     if cards:
         cards[docs / INDEX_NAME] = index_page(TASKS, docs)
@@ -558,9 +747,7 @@ def markdown_medians(data: Mapping[str, Any]) -> str:
     config = config_of(summary)
     header, rows = area_median_rows(summary, config)
     wanted = [i for i, name in enumerate(header) if name in ("policy", "after 10", "after 20")]
-    rates = {
-        stats.get("containment_rate") for stats in summary["policies"].values()
-    } - {None}
+    rates = {stats.get("containment_rate") for stats in summary["policies"].values()} - {None}
     containment = (
         f"\n\nContainment (the final region holds the true landmark): "
         f"{100 * rates.pop():.1f}% for every policy."
@@ -709,6 +896,7 @@ def index_page(tasks: Sequence[Task], docs: Path) -> str:
         ),
         "",
     ]
+    parts += registered_ids_section()
     if overview:
         parts += [OVERVIEW_HEADING, "", overview_markdown(overview), ""]
     # The docs site lists the cards under this page (a hidden toctree: the table links them).
@@ -718,6 +906,67 @@ def index_page(tasks: Sequence[Task], docs: Path) -> str:
     if cards:
         parts += ["```{toctree}", ":hidden:", "", *cards, "```", ""]
     return "\n".join(parts)
+
+
+#: The heading of the index's list of every registered id (:func:`registered_ids_section`).
+REGISTERED_IDS_HEADING = "## Every registered id"
+
+
+def registered_ids() -> list[tuple[str, str, str]]:
+    """Every id ``import bearing_env`` registers, as (id, what it is, its kwargs), from
+    :mod:`bearing_env.tasks`: the base ids, the tasks and the training tasks, each in
+    every version, the current version first."""
+    from bearing_env.registration import ENV_IDS
+    from bearing_env.tasks import (
+        BASE_ID_KINDS,
+        REGISTERED_TASKS_BY_ID,
+        TASKS,
+        VERSIONS,
+        split_id,
+    )
+
+    carded = {task.name for task in TASKS}
+    rows: list[tuple[int, int, str, str, str]] = []
+    for env_id in ENV_IDS:
+        version = split_id(env_id)[1]
+        kwargs = ", ".join(f"{k}={json.dumps(v)}" for k, v in VERSIONS[version].items())
+        rows.append((-version, 0, env_id, f"base id, {BASE_ID_KINDS[env_id]} actions", kwargs))
+    for task in REGISTERED_TASKS_BY_ID.values():
+        kind = "task" if task.name in carded else "training task"
+        rows.append(
+            (
+                -task.version,
+                1 if kind == "task" else 2,
+                task.id,
+                f"{kind} on `{task.base_id}`",
+                task.settings_text(),
+            )
+        )
+    rows.sort(key=lambda row: row[:2])
+    return [(env_id, what, kwargs) for _, _, env_id, what, kwargs in rows]
+
+
+def registered_ids_section() -> list[str]:
+    """The index's list of every registered id, with their count."""
+    from bearing_env.tasks import BASE_ID_KINDS, TASKS, TRAINING_TASKS, VERSIONS
+
+    ids = registered_ids()
+    per_version = len(BASE_ID_KINDS) // len(VERSIONS)
+    return [
+        REGISTERED_IDS_HEADING,
+        "",
+        f"`import bearing_env` registers {len(ids)} ids with Gymnasium: {per_version} base "
+        f"ids, {len(TASKS)} tasks and {len(TRAINING_TASKS)} training tasks, each in "
+        f"{len(VERSIONS)} versions ({', '.join(f'`-v{v}`' for v in VERSIONS)}). An older "
+        "version registers the settings its version kept (its kwargs below), so that "
+        "scores published under it reproduce; Gymnasium warns that it is out of date.",
+        "",
+        markdown_table(
+            ["id", "what", "registered kwargs"],
+            [[f"`{i}`", what, f"`{kw}`" if kw else "-"] for i, what, kw in ids],
+        ),
+        "",
+    ]
 
 
 def write_index(tasks: Sequence[Task], docs: Path) -> Path:
