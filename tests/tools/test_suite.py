@@ -76,6 +76,12 @@ def test_quick_suite_on_two_tasks_writes_the_cards_and_the_index(
         mean_rows = [line for line in card.splitlines() if line.startswith("| random_polygonal")]
         assert re.search(r"\| [\d.e+-]+ \[[\d.e+-]+, [\d.e+-]+\] \|", mean_rows[0])
         assert "bearing-env suite --quick --tasks" in card and "--no-progress" not in card
+        # The results file records the run: its command, commit, uncommitted files, date
+        # and machine, and the card quotes them.
+        measured = json.loads((docs / "results" / f"{task_id}.json").read_text())["measured"]
+        assert {"command", "commit", "uncommitted", "date", "machine"} <= measured.keys()
+        assert "+" not in (measured["commit"] or "")
+        assert f"Measured by `{measured['command']}` on {measured['date']}" in card
         for target in links(card):
             assert (docs / target).stat().st_size > 0, target
         assert f"{task_id}_area.png" in links(card) and f"{task_id}_frame.png" in links(card)
