@@ -241,3 +241,23 @@ def test_every_card_lists_the_info_keys_its_id_gives() -> None:
     assert len(cards) == 10
     for card in cards:
         assert card_info_keys(card) == emitted_info_keys(card.stem), card.name
+
+
+def test_every_card_has_a_settings_row_for_each_setting_its_id_registers() -> None:
+    """The field of view of the camera tasks, the obstacles' scenario, the noise of the
+    sensor tasks, ...: each registered keyword has its row, in bold, marked registered."""
+    from bearing_env.tasks import TASKS
+
+    for task in TASKS:
+        section = _section((DOCS / "tasks" / f"{task.id}.md").read_text(encoding="utf-8"),
+                           "## Settings")  # fmt: skip
+        rows = [line for line in section.splitlines() if line.startswith("| **")]
+        for key in task.settings:
+            assert any(re.search(f"`{key}[`.]", row) and "(registered)" in row for row in rows), (
+                task.id,
+                key,
+            )
+    camera = (DOCS / "tasks" / "BearingSLAM-Khepera-Camera90-v1.md").read_text(encoding="utf-8")
+    assert "| **field of view (`field_of_view_deg`)** (registered) | 90°" in camera
+    room = (DOCS / "tasks" / "BearingSLAM-FurnishedRoom-v1.md").read_text(encoding="utf-8")
+    assert "| obstacles (`obstacles`) | 4 polygons" in room

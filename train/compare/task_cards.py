@@ -129,6 +129,12 @@ def settings_rows(config: Any, task: Task) -> list[list[str]]:
     ]
     if config.fusion == "relaxed":
         rows.append(["`max_outliers`", str(config.max_outliers)])
+    if config.fusion == "robust":
+        rows += [
+            ["`risk`", _number(config.risk)],
+            ["`robust_set`", f"`{config.robust_set}`"],
+            ["`noise_bound`", f"`{config.noise_bound}`"],
+        ]
     rows += [
         ["`transfer`", f"`{config.transfer}`"],
         ["`on_inconsistency`", f"`{config.on_inconsistency}`"],
@@ -145,6 +151,11 @@ def settings_rows(config: Any, task: Task) -> list[list[str]]:
         ["`target_area`", f"{_number(config.target_area)} FL units²"],
         ["`area_cap`", f"{_number(config.area_cap)} FL units²"],
         ["`observation`, `max_landmarks`", f"`{config.observation}`, {config.max_landmarks} slots"],
+        [
+            "info (`robot_map_info`, `sensor_info`)",
+            f"`robot_map` {'on' if config.robot_map_info else 'off'}, "
+            f"`seen` and `blocked` {'on' if config.sensor_info else 'off'}",
+        ],
     ]
     if task.action_kind == "discrete":
         rows.append(
