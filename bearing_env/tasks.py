@@ -346,7 +346,8 @@ TASKS: tuple[Task, ...] = (
         "as a real room would; the camera is the paper's panoramic one.",
         challenge="A landmark behind furniture is missed, a move into it stops short, and "
         "the robot is not told where the furniture is: it learns that from where its "
-        "moves were blocked. From many starts no single movement maps anything "
+        "moves were blocked. From many starts no single movement maps any landmark within "
+        "`area_cap` "
         f"({_OBSERVABILITY}), "
         "so a policy must first move to where L1, L2 and the other landmarks are in sight; "
         "the map-based planners plan on a map they do not have yet, while a trained "
