@@ -61,6 +61,18 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "make lint": ("make", ()),
     "make native": ("make", ()),
     "bearing-env train": ("parse", ("--algo", "ppo")),
+    "bearing-env train --algo ppo --env BearingSLAM-Khepera-v1 --seeds 0 1 2 --workers 2 "
+    "--eval-freq 250000 --output runs/ppo_khepera": ("parse", ()),
+    "bearing-env curves": ("help", ()),
+    "bearing-env evaluate": ("help", ()),
+    "bearing-env curves runs/ppo_khepera --out outputs/ppo_khepera_curves.png": ("parse", ()),
+    "bearing-env evaluate runs/ppo_khepera --workers 2 --out outputs/evaluate_ppo_khepera": (
+        "parse",
+        (),
+    ),
+    "bearing-env train --algo ppo --env BearingSLAM-Khepera-v1 --seeds 0 1 --timesteps 8192 "
+    "--eval-freq 4096 --output runs/quick": ("parse", ()),
+    "bearing-env evaluate runs/quick --episodes 20 --out outputs/evaluate_quick": ("parse", ()),
     "bearing-env figures": ("parse", ()),
     "bearing-env demo": ("run", ("--episodes", "1", "--moves", "3")),
     "bearing-env compare": ("parse", ()),
@@ -322,6 +334,12 @@ def _parse(argv: list[str]) -> None:
         from bearing_env.train.sb3 import train_cli
 
         train_cli.settings_from_args(train_cli.build_parser().parse_args(arguments))
+    elif command in ("evaluate", "curves"):
+        from bearing_env.train.compare import evaluate
+        from bearing_env.train.sb3 import curves
+
+        module = evaluate if command == "evaluate" else curves
+        module.build_parser().parse_args(arguments)
     elif command == "distill":
         from bearing_env.train.sb3 import distill
 
@@ -367,7 +385,9 @@ def documented_options(argv: list[str]) -> set[str]:
 def command_extra(command: str) -> str | None:
     """The extra a README command needs to run or parse: training (and rl-zoo3's trainer)
     needs ``train``, Ray's own command line ``ray``."""
-    if command.startswith(("bearing-env train", "bearing-env distill", "python -m rl_zoo3")):
+    if command.startswith(
+        ("bearing-env train", "bearing-env distill", "bearing-env evaluate", "python -m rl_zoo3")
+    ):
         return "train"
     if command.startswith("ray "):
         return "ray"
