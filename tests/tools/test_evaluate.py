@@ -122,6 +122,12 @@ def evaluation(seeds_folder: Path, tmp_path_factory: pytest.TempPathFactory) -> 
     return out
 
 
+def model_runs(results: dict[str, object]) -> list[str]:
+    model = results["model"]
+    assert isinstance(model, dict)
+    return list(model["runs"])
+
+
 def test_evaluate_writes_the_json_the_table_and_both_plots(evaluation: Path) -> None:
     results = json.loads((evaluation / "evaluation.json").read_text())
     assert set(results["measured"]) >= {"command", "commit", "date", "machine"}
@@ -140,6 +146,13 @@ def test_evaluate_writes_the_json_the_table_and_both_plots(evaluation: Path) -> 
         for move in ("10", "20"):
             entry = results["probability_of_improvement"][baseline][move]
             assert entry["ci_low"] <= entry["value"] <= entry["ci_high"]
+    runs_iqm = {
+        r: results["policies"][r]["area_after"]["10"]["iqm"]["value"] for r in model_runs(results)
+    }
+    closest = min(
+        runs_iqm, key=lambda r: abs(runs_iqm[r] - model["area_after"]["10"]["iqm"]["value"])
+    )
+    assert results["model"]["representative_run"] == closest
     iqm = model["area_after"]["10"]["iqm"]
     assert iqm["ci_low"] <= iqm["value"] <= iqm["ci_high"]
     table = (evaluation / "evaluation.md").read_text()

@@ -355,6 +355,18 @@ def transfer_fused_area(summaries: Mapping[str, Any]) -> str:
     )
 
 
+#: ``bearing-env evaluate``'s results for the shipped Khepera model's training seeds.
+KHEPERA_SEEDS = "docs/compare/results/seeds_ppo_khepera.json"
+
+
+def khepera_seeds(results: Mapping[str, Any]) -> str:
+    """The shipped Khepera model's training seeds against the baselines
+    (``bearing-env evaluate``'s tables, without the page heading)."""
+    from bearing_env.train.compare.evaluation_report import evaluation_markdown
+
+    return evaluation_markdown(results, KHEPERA_SEEDS, heading=False)
+
+
 def _blocks() -> dict[str, Block]:
     from bearing_env.train.compare import task_cards
     from bearing_env.train.studies import figures, observability, robust_eval
@@ -387,6 +399,7 @@ def _blocks() -> dict[str, Block]:
             "benchmarks/results/transfer_tightness_*.json", transfer_tightness
         ),
         "transfer-fused-area": Block("docs/compare/results/transfer_*.json", transfer_fused_area),
+        "khepera-seeds": Block(KHEPERA_SEEDS, khepera_seeds),
     }
 
 

@@ -106,6 +106,10 @@ def evaluation_results(
         }
         for baseline in baselines
     }
+    aggregate_iqm = curves[model][headline].value
+    representative = min(
+        labels, key=lambda label: abs(curves[label][headline].value - aggregate_iqm)
+    )
     return {
         "task": config.env_id.rpartition(":")[2],
         "env_kwargs": config.env_kwargs,
@@ -122,7 +126,8 @@ def evaluation_results(
             "resamples": resamples,
             "seed": seed,
         },
-        "model": {"name": model, "runs": list(labels)},
+        # The run to ship as "the" model: its IQM is the closest to the IQM over the runs.
+        "model": {"name": model, "runs": list(labels), "representative_run": representative},
         "baselines": baselines,
         "moves": moves,
         "headline_moves": headline,
@@ -165,16 +170,20 @@ def _cell(entry: Mapping[str, Any], digits: int = 3) -> str:
     )
 
 
-def evaluation_markdown(results: Mapping[str, Any], measured: Mapping[str, Any]) -> str:
-    """``evaluation.md``: the aggregate table, the per-run table, and what they rest on."""
+def evaluation_markdown(
+    results: Mapping[str, Any], source: str = "evaluation.json", heading: bool = True
+) -> str:
+    """``evaluation.md`` from ``evaluation.json``'s content: the aggregate table, the
+    per-run table, and what they rest on, citing the results file as ``source``; without
+    the page heading for a docs block (``bearing-env docs-tables``)."""
+    measured = results["measured"]
     model = results["model"]["name"]
     runs = results["model"]["runs"]
     policies = results["policies"]
     head = str(results["headline_moves"])
     final = str(results["moves"][-1])
-    lines = [
-        f"# {model} on {results['task']}",
-        "",
+    lines = [f"# {model} on {results['task']}", ""] if heading else []
+    lines += [
         f"{len(runs)} run(s) of `{model}` (training seeds) and each baseline (one run) on the "
         f"same {results['episodes']} evaluation episodes (seeds {results['episode_seeds'][0]}"
         f"..{results['episode_seeds'][1]}). Score: {results['score']}. IQM: "
@@ -210,7 +219,13 @@ def evaluation_markdown(results: Mapping[str, Any], measured: Mapping[str, Any])
             f"| {run} | {_cell(at_head['iqm'])} | {at_head['median']:.3g} | "
             f"{at_head['worst5_mean']:.3g} | {_cell(at_final['iqm'])} |"
         )
-    lines += ["", measured_sentence(measured, "evaluation.json"), ""]
+    lines += [
+        "",
+        f"The run closest to the IQM over the runs after {head} moves: "
+        f"`{results['model']['representative_run']}`.",
+        "",
+        measured_sentence(measured, source),
+    ]
     return "\n".join(lines)
 
 
@@ -289,9 +304,9 @@ def write_evaluation(
     """Write every file of an evaluation into ``out``; the paths written."""
     results = evaluation_results(records, config, model, labels, resamples, seed)
     results["model"]["paths"] = [str(path) for path in paths]
-    measured = measured_here("bearing-env evaluate", argv)
+    results["measured"] = measured_here("bearing-env evaluate", argv)
     out.mkdir(parents=True, exist_ok=True)
     json_path, markdown_path = out / "evaluation.json", out / "evaluation.md"
-    write_json_atomically(json_path, {"measured": measured, **results})
-    atomic_write_text(markdown_path, evaluation_markdown(results, measured))
+    write_json_atomically(json_path, results)
+    atomic_write_text(markdown_path, evaluation_markdown(results) + "\n")
     return [json_path, markdown_path, *plot_evaluation(results, out)]
