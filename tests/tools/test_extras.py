@@ -106,6 +106,16 @@ def test_train_names_the_one_missing_package(tmp_path: Path, missing: str) -> No
     assert TRAIN in line
 
 
+@pytest.mark.parametrize("blocked", [PLAIN_INSTALL_LACKS, ("rliable",)])
+def test_evaluate_without_the_train_extra_says_to_install_it(
+    tmp_path: Path, blocked: tuple[str, ...]
+) -> None:
+    result = plain_cli(["evaluate", "model.zip", "--out", "out"], tmp_path, blocked=blocked)
+    line = error_line(result, "bearing-env evaluate")
+    assert TRAIN in line and ("'rliable'" in line or blocked != ("rliable",))
+    assert not (tmp_path / "out").exists()
+
+
 def test_figures_without_matplotlib_says_to_install_the_train_extra(tmp_path: Path) -> None:
     result = plain_cli(["figures", "--out", str(tmp_path / "figs")], tmp_path)
     line = error_line(result, "bearing-env figures")

@@ -21,7 +21,6 @@ from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.stats
 from numpy.typing import NDArray
 
 #: Bootstrap resamples of the intervals (rliable's own default is 50,000; 2,000 keeps an
@@ -85,6 +84,7 @@ def iqm_intervals(
     ``get_interval_estimates``: percentile intervals, runs and episodes resampled), for
     scores of shape ``(runs, episodes, moves)``: one :class:`Interval` per move, from one
     bootstrap that resamples the same (run, episode) pairs at every move."""
+    import scipy.stats  # with rliable, in the train extra
     from rliable import library
 
     def iqm_per_move(x: NDArray[np.float64]) -> NDArray[np.float64]:
