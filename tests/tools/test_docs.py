@@ -207,6 +207,7 @@ def emitted_info_keys(env_id: str, **kwargs: object) -> set[str]:
     env = gym.make(f"bearing_env:{env_id}", **kwargs)
     try:
         _, reset_info = env.reset(seed=0)
+        env.action_space.seed(0)
         _, _, _, _, step_info = env.step(env.action_space.sample())
     finally:
         env.close()
