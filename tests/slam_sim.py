@@ -6,10 +6,17 @@ straight over ``length``, read. Bearings are CCW from the direction of motion.
 
 Noise is given in *normalised* form: arrays ``u`` in [-1, 1] that are scaled by a bound,
 so the same draw can be replayed with different bounds (the paper's Fig. 11 setup).
+
+Angles and unit vectors come from the C library's scalar ``atan2``, ``cos`` and ``sin``
+(:func:`angle_of`, :func:`unit`), the functions the native core calls too, never from
+NumPy's: NumPy picks its transcendental loops by the processor's features (AVX-512 or
+not), and those round differently in the last bit on different machines, so seeded inputs
+and the golden hashes taken over them would differ from machine to machine.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,6 +27,19 @@ TWO_PI = 2.0 * np.pi
 def wrap(angle):
     """Wrap to [-pi, pi)."""
     return (np.asarray(angle, dtype=float) + np.pi) % TWO_PI - np.pi
+
+
+def angle_of(z):
+    """The argument of complex ``z`` (elementwise), by the C library's ``atan2``."""
+    z = np.asarray(z, dtype=complex)
+    return np.vectorize(math.atan2, otypes=[float])(z.imag, z.real)
+
+
+def unit(angle):
+    """``exp(i angle)`` (elementwise), by the C library's ``cos`` and ``sin``."""
+    return np.vectorize(lambda a: complex(math.cos(a), math.sin(a)), otypes=[complex])(
+        np.asarray(angle, dtype=float)
+    )
 
 
 def to_complex(xy) -> np.ndarray:
@@ -34,7 +54,7 @@ def to_xy(z) -> np.ndarray:
 
 def true_bearings(landmarks: np.ndarray, position: complex, heading: float) -> np.ndarray:
     """Exact bearings of complex ``landmarks`` from ``position``, robot facing ``heading``."""
-    return wrap(np.angle(landmarks - position) - heading)
+    return wrap(angle_of(landmarks - position) - heading)
 
 
 def fl(points, l1: complex, l2: complex) -> np.ndarray:
@@ -61,7 +81,7 @@ class Episode:
         out = []
         pos = self.start
         for heading, length in self.moves:
-            end = pos + length * np.exp(1j * heading)
+            end = pos + length * unit(heading)
             out.append((pos, end, heading))
             pos = end
         return out
@@ -86,7 +106,7 @@ class Episode:
 
     def transformed(self, scale: float, angle: float, shift: complex) -> Episode:
         """The same episode in a world moved by the similarity z -> a z + shift."""
-        a = scale * np.exp(1j * angle)
+        a = scale * unit(angle)
         return Episode(
             landmarks=a * self.landmarks + shift,
             start=a * self.start + shift,
@@ -134,7 +154,7 @@ def random_episode(
     while len(moves) < n_moves:
         heading = rng.uniform(-np.pi, np.pi)
         length = rng.uniform(*length_range)
-        end = pos + length * np.exp(1j * heading)
+        end = pos + length * unit(heading)
         if ok(end):
             moves.append((heading, length))
             pos = end
@@ -175,15 +195,15 @@ def cone_region_vertices(b_start: float, b_end: float, eps: float, tol: float = 
         return None
     apex = (0.0 + 0j, 1.0 + 0j)
     dirs = (
-        [np.exp(1j * (b_start - eps)), np.exp(1j * (b_start + eps))],
-        [np.exp(1j * (b_end - eps)), np.exp(1j * (b_end + eps))],
+        [unit(b_start - eps), unit(b_start + eps)],
+        [unit(b_end - eps), unit(b_end + eps)],
     )
 
     def in_cone(z: complex, j: int, b: float) -> bool:
         d = z - apex[j]
         if abs(d) <= tol:
             return True
-        return abs(float(wrap(np.angle(d) - b))) <= eps + tol
+        return abs(float(wrap(angle_of(d) - b))) <= eps + tol
 
     cands = [0.0 + 0j, 1.0 + 0j]
     for r in dirs[0]:
