@@ -218,3 +218,44 @@ def test_models_resolve_from_a_parent_a_glob_and_a_zip(seeds_folder: Path, stric
     assert evaluate.run_labels("m", single) == ["m/run0"]
     with pytest.raises(evaluate.ModelError, match="given twice"):
         evaluate.resolve_models([str(seeds_folder / "seed0"), str(seeds_folder / "seed0")])
+
+
+def test_a_card_shows_a_shipped_models_training_seeds(evaluation: Path, tmp_path: Path) -> None:
+    from bearing_env.train.compare.config import CompareConfig
+    from bearing_env.train.compare.task_cards import seeds_path, training_seeds_section
+
+    docs = tmp_path / "docs" / "tasks"
+    config = CompareConfig(
+        policies={"greedy_one_step": "greedy", "ppo_khepera": "pretrained:name='ppo_khepera'"},
+        env_id=f"bearing_env:{TASK}",
+        env_kwargs={},
+    )
+    assert training_seeds_section(docs, config) == [], "no seeds file, no section"
+    seeds_file = seeds_path(docs, "ppo_khepera")
+    seeds_file.parent.mkdir(parents=True)
+    shutil.copy(evaluation / "evaluation.json", seeds_file)
+    text = "\n".join(training_seeds_section(docs, config))
+    results = json.loads(seeds_file.read_text())
+    shipped = results["model"]["representative_run"]
+    assert text.startswith("## Training seeds") and "one of 2 training seeds" in text
+    assert "| ppo_tiny, 2 seeds | 2 x 3 |" in text and f"| {shipped} (shipped) | 1 x 3 |" in text
+    for baseline in ("random_polygonal", "greedy_one_step"):
+        improvement = results["probability_of_improvement"][baseline]["10"]["value"]
+        assert f"| {baseline} | 1 x 3 |" in text and f"| {improvement:.2g} [" in text
+    assert "bearing-env evaluate" in text and "seeds_ppo_khepera.json" in text
+
+
+def test_the_version_history_names_a_shipped_model_left_on_an_older_version() -> None:
+    from bearing_env.agents import pretrained_record
+    from bearing_env.tasks import TASKS_BY_ID
+    from bearing_env.train.compare.config import CompareConfig
+    from bearing_env.train.compare.task_cards import version_history
+
+    task = TASKS_BY_ID["BearingSLAM-FurnishedRoom-v1"]
+    spec = {"ppo_furnished_room": "pretrained:name='ppo_furnished_room'"}
+    config = CompareConfig(policies=spec, env_id=f"bearing_env:{task.id}", env_kwargs={})
+    lines = version_history(task, config)
+    trained_on = pretrained_record("ppo_furnished_room")["env_id"]
+    stays = [line for line in lines if "`ppo_furnished_room` stays" in line]
+    assert (len(stays) == 1) == (trained_on != task.id), lines
+    assert version_history(task) == [f"- {entry}" for entry in task.history]

@@ -170,6 +170,34 @@ def _cell(entry: Mapping[str, Any], digits: int = 3) -> str:
     )
 
 
+def seeds_markdown(results: Mapping[str, Any]) -> str:
+    """A task card's summary of a shipped model's training seeds: the IQM over the seeds,
+    the representative (shipped) seed alone, and the baselines, with the probability
+    that the model beats each."""
+    model = results["model"]["name"]
+    runs = results["model"]["runs"]
+    shipped = results["model"]["representative_run"]
+    policies = results["policies"]
+    head, final = str(results["headline_moves"]), str(results["moves"][-1])
+    header = (
+        f"| policy | runs x episodes | IQM after {head} [95% CI] | IQM after {final} "
+        f"[95% CI] | P({model} better) after {head} [95% CI] |"
+    )
+    lines = [header, "|---|---|---|---|---|"]
+    rows = [(f"{model}, {len(runs)} seeds", model), (f"{shipped} (shipped)", shipped)]
+    rows += [(baseline, baseline) for baseline in results["baselines"]]
+    for name, group in rows:
+        figures = policies[group]
+        improvement = results["probability_of_improvement"].get(group)
+        lines.append(
+            f"| {name} | {figures['runs']} x {figures['episodes']} | "
+            f"{_cell(figures['area_after'][head]['iqm'])} | "
+            f"{_cell(figures['area_after'][final]['iqm'])} | "
+            f"{_cell(improvement[head], 2) if improvement else '-'} |"
+        )
+    return "\n".join(lines)
+
+
 def evaluation_markdown(
     results: Mapping[str, Any], source: str = "evaluation.json", heading: bool = True
 ) -> str:

@@ -477,8 +477,71 @@ def arguments_section(task: Task) -> list[str]:
     ]
 
 
-def version_history(task: Task) -> list[str]:
-    return [f"- {entry}" for entry in task.history]
+def version_history(task: Task, config: CompareConfig | None = None) -> list[str]:
+    """The task's versions, then a line for each shipped model on the card that was
+    trained on another version of the task and not retrained on this one."""
+    from bearing_env.tasks import split_id
+
+    lines = [f"- {entry}" for entry in task.history]
+    for label, record in shipped_records(config).items() if config else ():
+        env_id = str(record.get("env_id", "")).rpartition(":")[2]
+        with contextlib.suppress(ValueError):
+            version = split_id(env_id)[1]
+            if version != task.version:
+                lines.append(
+                    f"- `{label}` stays the model trained on `{env_id}`: it was not retrained "
+                    f"on v{task.version}, and its rows above run it on `{task.id}`."
+                )
+    return lines
+
+
+def shipped_records(config: CompareConfig) -> dict[str, dict[str, Any]]:
+    """The records of the card's shipped models (its ``pretrained:NAME`` policies), by
+    label."""
+    from bearing_env.agents import pretrained_record
+    from bearing_env.agents.registry import parse_policy_spec
+
+    records = {}
+    for label, spec in config.policies.items():
+        parsed = parse_policy_spec(spec)
+        if parsed.kind == "pretrained":
+            records[label] = pretrained_record(str(parsed.options["name"]))
+    return records
+
+
+def seeds_path(docs: Path, model: str) -> Path:
+    """``bearing-env evaluate``'s results over a shipped model's training seeds."""
+    return docs.parent / "compare" / "results" / f"seeds_{model}.json"
+
+
+def training_seeds_section(docs: Path, config: CompareConfig) -> list[str]:
+    """For each shipped model with a seeds file (:func:`seeds_path`): the IQM over its
+    training seeds beside the shipped seed's own figure and the baselines'."""
+    from bearing_env.train.compare.evaluation_report import seeds_markdown
+
+    lines: list[str] = []
+    for label in shipped_records(config):
+        path = seeds_path(docs, label)
+        if not path.is_file():
+            continue
+        results = json.loads(path.read_text(encoding="utf-8"))
+        runs = results["model"]["runs"]
+        lines += [
+            "## Training seeds",
+            "",
+            f"`{label}` is one of {len(runs)} training seeds of the same recipe: the one whose "
+            "IQM is the closest to the IQM over the seeds. Over the seeds, on the same "
+            f"{results['episodes']} evaluation episodes (`bearing-env evaluate`: IQM of the "
+            "total area with stratified bootstrap 95% CIs over episodes and seeds, and the "
+            "probability of a smaller area than each baseline on an episode; "
+            "[evaluating a trained model](../evaluation.md)):",
+            "",
+            seeds_markdown(results),
+            "",
+            measured_sentence(results["measured"], f"docs/compare/results/{path.name}"),
+            "",
+        ]
+    return lines
 
 
 def termination_text(config: Any) -> str:
@@ -534,6 +597,7 @@ def task_card(
     measured: Mapping[str, Any] | None,
     frame: bool,
     plot: bool,
+    docs: Path | None = None,
 ) -> str:
     """The Markdown of a task's card; ``measured`` is its results file's record of the
     run (:func:`~bearing_env.train.common.provenance.measured_record`), or None."""
@@ -554,6 +618,7 @@ def task_card(
         *task_sections(task, resolved, observation_space, action_space, keys),
         *arguments_section(task),
         *baselines_section(task, config, summary),
+        *(training_seeds_section(docs, config) if docs is not None else []),
     ]
     if plot:
         parts += [f"![total area versus moves, {task.id}]({area_plot_name(task)})", ""]
@@ -572,7 +637,7 @@ def task_card(
             + " `bearing-env docs-tables` writes this card from that file.",
             "",
         ]
-    parts += ["## Version history", "", *version_history(task), ""]
+    parts += ["## Version history", "", *version_history(task, config), ""]
     return "\n".join(parts)
 
 
@@ -624,16 +689,10 @@ def shipped_models_text(task: Task, config: CompareConfig) -> str:
     """`` Shipped models: `NAME` was trained on `ID` with `k=v, ...`.`` for the
     ``pretrained:NAME`` policies of a comparison (from their records), saying when that
     id is another version of the task's; empty without such a policy."""
-    from bearing_env.agents import pretrained_record
-    from bearing_env.agents.registry import parse_policy_spec
     from bearing_env.tasks import split_id
 
     parts = []
-    for label, spec in config.policies.items():
-        parsed = parse_policy_spec(spec)
-        if parsed.kind != "pretrained":
-            continue
-        record = pretrained_record(str(parsed.options["name"]))
+    for label, record in shipped_records(config).items():
         env_id = str(record.get("env_id", "")).rpartition(":")[2]
         kwargs = ", ".join(
             f"{key}={json.dumps(value)}" for key, value in record.get("env_kwargs", {}).items()
@@ -708,7 +767,7 @@ def write_task_card(
     results = {"task": task.id, "measured": measured, "summary": result.summary}
     atomic_write_text(results_path(docs, task), json.dumps(results, indent=1) + "\n")
     path = docs / card_name(task)
-    atomic_write_text(path, task_card(task, config, result.summary, measured, frame, plot))
+    atomic_write_text(path, task_card(task, config, result.summary, measured, frame, plot, docs))
     return path
 
 
@@ -744,7 +803,7 @@ def published_cards(docs: Path) -> dict[Path, str]:
         summary = data["summary"]
         frame = (docs / frame_name(task)).is_file()
         plot = (docs / area_plot_name(task)).is_file()
-        text = task_card(task, config_of(summary), summary, data.get("measured"), frame, plot)
+        text = task_card(task, config_of(summary), summary, data.get("measured"), frame, plot, docs)
         cards[docs / card_name(task)] = text
     if cards:
         cards[docs / INDEX_NAME] = index_page(TASKS, docs)
