@@ -179,7 +179,7 @@ def test_an_exported_model_reads_the_record_beside_it(tmp_path: Path) -> None:
     shutil.copy(PRETRAINED_DIR / "ppo_khepera.zip", model)
     model.with_suffix(".json").write_text(json.dumps(pretrained_record("ppo_khepera")))
     policy = SB3Policy(None, model, vecnormalize=None)
-    assert policy.task == ModelTask("BearingSLAM-v0", {"scenario": "khepera"}, "mine", "mine.json")
+    assert policy.task == ModelTask("BearingSLAM-Khepera-v1", {}, "mine", "mine.json")
     env = policy.make_env()
     with pytest.raises(TaskMismatchError, match=r"^model 'mine' .* scenario 'khepera' \(env"):
         SB3Policy(gym.make("BearingSLAM-v1"), model)

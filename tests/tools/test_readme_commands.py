@@ -126,8 +126,6 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "n_landmarks=6 --out outputs/compare_random6": ("parse", ()),
     "bearing-env train --algo ppo --env BearingSLAM-Khepera-v1 --seed 0 --eval-freq 250000 "
     "--output runs/ppo_khepera": ("parse", ()),
-    "bearing-env train --algo ppo --output runs/ppo_khepera --export "
-    "agents/pretrained/ppo_khepera --export-only": ("parse", ()),
     "bearing-env train --algo ppo --env BearingSLAM-v0 --env-kwargs scenario=random "
     '"n_landmarks=(4,8)" max_landmarks=10 --hyperparams n_envs=8 batch_size=256 gamma=0.99 '
     "--timesteps 400000 --seed 1 --output runs/ppo_random": ("parse", ()),
@@ -161,8 +159,13 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--iterations 4 --episodes 50 --output runs/distill_khepera": ("parse", ()),
     "bearing-env train --algo ppo --env BearingSLAM-FurnishedRoom-v0 --seed 0 --eval-freq 250000 "
     "--output runs/ppo_furnished_room": ("parse", ()),
-    "bearing-env train --algo ppo --env BearingSLAM-v0 --env-kwargs scenario=khepera --seed 0 "
-    "--eval-freq 250000 --output runs/ppo_khepera": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAM-Khepera-v1 --seeds 0 1 2 --workers 2 "
+    "--timesteps 5000000 --eval-freq 250000 --output runs/ppo_khepera": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAM-Khepera-v1 --output runs/ppo_khepera/seed0 "
+    "--export agents/pretrained/ppo_khepera --export-only": ("parse", ()),
+    "bearing-env evaluate runs/ppo_khepera --out outputs/evaluate_ppo_khepera": ("parse", ()),
+    "bearing-env curves runs/ppo_khepera --out docs/figures/ppo_khepera_curves.png --json "
+    "docs/figures/ppo_khepera_curves.json": ("parse", ()),
     "bearing-env train --algo ppo --env BearingSLAM-FurnishedRoom-v0 --output "
     "runs/ppo_furnished_room --export agents/pretrained/ppo_furnished_room --export-only": (
         "parse",
