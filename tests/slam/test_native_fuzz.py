@@ -33,6 +33,7 @@ from __future__ import annotations
 import ast
 import dataclasses
 import functools
+import importlib.resources
 import math
 import re
 from collections import Counter
@@ -63,7 +64,9 @@ ComplexArray = NDArray[np.complex128]
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
-STUB = Path(__file__).resolve().parents[2] / "bearing_env" / "_core.pyi"
+#: The stub as installed with the package (the source tree is absent when the installed
+#: package's tests run, e.g. from the sdist).
+STUB = importlib.resources.files("bearing_env") / "_core.pyi"
 
 
 class Draw(Protocol):
