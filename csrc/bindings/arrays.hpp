@@ -10,8 +10,8 @@
 #include <string>
 #include <type_traits>
 
-#include "core/complex.hpp"
-#include "core/views.hpp"
+#include <bearing_core/core/complex.hpp>
+#include <bearing_core/core/views.hpp>
 
 namespace bearing::bindings {
 

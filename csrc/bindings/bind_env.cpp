@@ -18,11 +18,11 @@
 
 #include "bindings/arrays.hpp"
 #include "bindings/env_args.hpp"
-#include "core/errors.hpp"
-#include "env/kernels.hpp"
-#include "env/planning.hpp"
-#include "env/robot_map.hpp"
-#include "env/types.hpp"
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/env/kernels.hpp>
+#include <bearing_core/env/planning.hpp>
+#include <bearing_core/env/robot_map.hpp>
+#include <bearing_core/env/types.hpp>
 
 namespace nb = nanobind;
 using namespace nb::literals;

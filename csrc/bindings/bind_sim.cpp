@@ -9,8 +9,8 @@
 
 #include "bindings/arrays.hpp"
 #include "bindings/sim_args.hpp"
-#include "sim/sensing.hpp"
-#include "sim/world.hpp"
+#include <bearing_core/sim/sensing.hpp>
+#include <bearing_core/sim/world.hpp>
 
 namespace nb = nanobind;
 using namespace nb::literals;

@@ -1,4 +1,4 @@
-// Bindings of the polygon and frame kernels (csrc/slam/polygons.hpp, frames.hpp), for tests
+// Bindings of the polygon and frame kernels (csrc/include/bearing_core/slam/polygons.hpp, frames.hpp), for tests
 // and one-off geometry: the same Python signatures and return conventions as the numba
 // kernels of bearing_env.slam.kernels (complex128 arrays in, `out` arrays written in
 // place, the same return tuples), so that the package can re-export either.
@@ -15,12 +15,12 @@
 #include <string>
 
 #include "bindings/arrays.hpp"
-#include "slam/common.hpp"
-#include "slam/frames.hpp"
-#include "slam/local_bound.hpp"
-#include "slam/polygons.hpp"
-#include "slam/scratch.hpp"
-#include "slam/update.hpp"
+#include <bearing_core/slam/common.hpp>
+#include <bearing_core/slam/frames.hpp>
+#include <bearing_core/slam/local_bound.hpp>
+#include <bearing_core/slam/polygons.hpp>
+#include <bearing_core/slam/scratch.hpp>
+#include <bearing_core/slam/update.hpp>
 
 namespace nb = nanobind;
 using namespace nb::literals;

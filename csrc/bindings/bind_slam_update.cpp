@@ -1,4 +1,4 @@
-// Bindings of the batched map update (csrc/slam/update.hpp): MapState, Params,
+// Bindings of the batched map update (csrc/include/bearing_core/slam/update.hpp): MapState, Params,
 // update_maps, the batch helpers (check_indices, none_infinite, contains_points),
 // binomial_q, and the constants the Python side reads.
 #include <nanobind/nanobind.h>
@@ -14,12 +14,12 @@
 #include <vector>
 
 #include "bindings/arrays.hpp"
-#include "core/errors.hpp"
-#include "slam/fusion.hpp"
-#include "slam/robust.hpp"
-#include "slam/scratch.hpp"
-#include "slam/state.hpp"
-#include "slam/update.hpp"
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/slam/fusion.hpp>
+#include <bearing_core/slam/robust.hpp>
+#include <bearing_core/slam/scratch.hpp>
+#include <bearing_core/slam/state.hpp>
+#include <bearing_core/slam/update.hpp>
 
 namespace nb = nanobind;
 using namespace nb::literals;

@@ -12,9 +12,9 @@
 
 #include "bindings/arrays.hpp"
 #include "bindings/sim_args.hpp"
-#include "env/types.hpp"
-#include "slam/scratch.hpp"
-#include "slam/state.hpp"
+#include <bearing_core/env/types.hpp>
+#include <bearing_core/slam/scratch.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::bindings {
 

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "bindings/arrays.hpp"
-#include "sim/sensing.hpp"
+#include <bearing_core/sim/sensing.hpp>
 
 namespace bearing::bindings {
 

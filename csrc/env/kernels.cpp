@@ -1,17 +1,17 @@
 // bearing_env/envs/kernels.py's kernels (see kernels.hpp).
-#include "env/kernels.hpp"
+#include <bearing_core/env/kernels.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/errors.hpp"
-#include "core/pymath.hpp"
-#include "env/robot_map.hpp"
-#include "sim/sensing.hpp"
-#include "sim/world.hpp"
-#include "slam/polygons.hpp"
-#include "slam/update.hpp"
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/core/pymath.hpp>
+#include <bearing_core/env/robot_map.hpp>
+#include <bearing_core/sim/sensing.hpp>
+#include <bearing_core/sim/world.hpp>
+#include <bearing_core/slam/polygons.hpp>
+#include <bearing_core/slam/update.hpp>
 
 namespace bearing::env {
 

@@ -1,5 +1,5 @@
 // bearing_env/envs/robot_map.py's kernels (see robot_map.hpp).
-#include "env/robot_map.hpp"
+#include <bearing_core/env/robot_map.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -1,11 +1,11 @@
 // bearing_env/sensing.py's kernels (see sensing.hpp).
-#include "sim/sensing.hpp"
+#include <bearing_core/sim/sensing.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/pymath.hpp"
+#include <bearing_core/core/pymath.hpp>
 
 namespace bearing::sim {
 

@@ -1,11 +1,11 @@
 // bearing_env/world.py's kernels (see world.hpp).
-#include "sim/world.hpp"
+#include <bearing_core/sim/world.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/pymath.hpp"
+#include <bearing_core/core/pymath.hpp>
 
 namespace bearing::sim {
 

@@ -1,15 +1,15 @@
 // Cones in the robot frame FR and the change of frames FR -> FL: a function-for-function
 // port of bearing_env/slam/kernels/frames.py (same operations in the same order).
-#include "slam/frames.hpp"
+#include <bearing_core/slam/frames.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <limits>
 
-#include "core/errors.hpp"
-#include "slam/local_bound.hpp"
-#include "slam/polygons.hpp"
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/slam/local_bound.hpp>
+#include <bearing_core/slam/polygons.hpp>
 
 namespace bearing::slam {
 

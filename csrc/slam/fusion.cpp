@@ -1,11 +1,11 @@
 // bearing_env/slam/kernels/fusion.py in C++ (same branches, same order of operations).
-#include "slam/fusion.hpp"
+#include <bearing_core/slam/fusion.hpp>
 
 #include <array>
 #include <limits>
 
-#include "core/pymath.hpp"
-#include "slam/polygons.hpp"
+#include <bearing_core/core/pymath.hpp>
+#include <bearing_core/slam/polygons.hpp>
 
 namespace bearing::slam {
 

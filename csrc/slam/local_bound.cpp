@@ -1,12 +1,12 @@
 // The conservative transfer's local growth bound (see local_bound.hpp and
 // docs/world_model.md, "The local bound", for the proof each factor follows).
-#include "slam/local_bound.hpp"
+#include <bearing_core/slam/local_bound.hpp>
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/errors.hpp"
-#include "slam/frames.hpp"
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/slam/frames.hpp>
 
 namespace bearing::slam {
 

@@ -2,13 +2,13 @@
 // bearing_env/slam/kernels/polygons.py (same operations in the same order, so the same
 // bits). Temporary arrays the numba kernels allocate are fixed-capacity arrays on the
 // stack here, sized by the documented maxima and guarded by check_capacity.
-#include "slam/polygons.hpp"
+#include <bearing_core/slam/polygons.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/errors.hpp"
+#include <bearing_core/core/errors.hpp>
 
 namespace bearing::slam {
 

@@ -1,12 +1,12 @@
 // bearing_env/slam/kernels/robust.py in C++ (same branches, same order of operations).
-#include "slam/robust.hpp"
+#include <bearing_core/slam/robust.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "slam/fusion.hpp"
-#include "slam/polygons.hpp"
+#include <bearing_core/slam/fusion.hpp>
+#include <bearing_core/slam/polygons.hpp>
 
 namespace bearing::slam {
 

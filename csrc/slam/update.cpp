@@ -1,7 +1,7 @@
 // bearing_env/slam/kernels/update.py in C++: one movement per map for a batch of maps,
 // serial or on kept worker threads over contiguous blocks of rows (same branches, same
 // order of operations as the numba kernels, so the same bits).
-#include "slam/update.hpp"
+#include <bearing_core/slam/update.hpp>
 
 #include <cmath>
 #include <limits>
@@ -9,14 +9,14 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/errors.hpp"
-#include "core/pymath.hpp"
-#include "core/worker_pool.hpp"
-#include "slam/frames.hpp"
-#include "slam/fusion.hpp"
-#include "slam/polygons.hpp"
-#include "slam/robust.hpp"
-#include "slam/scratch.hpp"
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/core/pymath.hpp>
+#include <bearing_core/core/worker_pool.hpp>
+#include <bearing_core/slam/frames.hpp>
+#include <bearing_core/slam/fusion.hpp>
+#include <bearing_core/slam/polygons.hpp>
+#include <bearing_core/slam/robust.hpp>
+#include <bearing_core/slam/scratch.hpp>
 
 namespace bearing::slam {
 

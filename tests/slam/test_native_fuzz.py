@@ -172,7 +172,7 @@ moderate_complexes = st.builds(complex, moderate_floats, moderate_floats)
 hard_ints = st.one_of(st.integers(-3, 12), st.sampled_from(SPECIAL_INTS))
 
 #: Hull inputs beyond this many points raise CapacityError (MAX_HULL_POINTS,
-#: csrc/slam/polygons.hpp).
+#: csrc/include/bearing_core/slam/polygons.hpp).
 MAX_HULL_POINTS = kernels.MAX_CLOUD + kernels.SCRATCH
 
 POLYGON_SHAPES = ("convex", "clockwise", "equal", "collinear", "repeated", "wild")

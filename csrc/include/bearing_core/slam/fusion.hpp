@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <utility>
 
-#include "slam/scratch.hpp"
-#include "slam/state.hpp"
+#include <bearing_core/slam/scratch.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::slam {
 

@@ -9,10 +9,10 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "core/complex.hpp"
-#include "core/errors.hpp"
-#include "slam/local_bound.hpp"
-#include "slam/state.hpp"
+#include <bearing_core/core/complex.hpp>
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/slam/local_bound.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::slam {
 

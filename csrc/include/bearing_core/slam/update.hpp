@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "slam/state.hpp"
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::slam {
 

@@ -5,10 +5,10 @@
 
 #include <cstdint>
 
-#include "core/pymath.hpp"
-#include "slam/frames.hpp"
-#include "slam/scratch.hpp"
-#include "slam/state.hpp"
+#include <bearing_core/core/pymath.hpp>
+#include <bearing_core/slam/frames.hpp>
+#include <bearing_core/slam/scratch.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::slam {
 

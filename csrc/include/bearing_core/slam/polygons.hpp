@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <utility>
 
-#include "slam/common.hpp"
+#include <bearing_core/slam/common.hpp>
 
 namespace bearing::slam {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "env/types.hpp"
+#include <bearing_core/env/types.hpp>
 
 namespace bearing::env {
 

@@ -6,10 +6,10 @@
 
 #include <cstdint>
 
-#include "core/complex.hpp"
-#include "core/views.hpp"
-#include "sim/sensing.hpp"
-#include "slam/state.hpp"
+#include <bearing_core/core/complex.hpp>
+#include <bearing_core/core/views.hpp>
+#include <bearing_core/sim/sensing.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::env {
 

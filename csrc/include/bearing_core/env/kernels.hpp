@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "env/types.hpp"
+#include <bearing_core/env/types.hpp>
 
 namespace bearing::env {
 

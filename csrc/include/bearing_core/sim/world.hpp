@@ -4,8 +4,8 @@
 
 #include <cstdint>
 
-#include "core/views.hpp"
-#include "sim/sensing.hpp"
+#include <bearing_core/core/views.hpp>
+#include <bearing_core/sim/sensing.hpp>
 
 namespace bearing::sim {
 

@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-#include "core/views.hpp"
+#include <bearing_core/core/views.hpp>
 
 namespace bearing::sim {
 
