@@ -328,13 +328,14 @@ nb::tuple transfer_polygon(nb::handle target_obj, nb::handle a1_obj, nb::handle 
     }
     check_edge_samples(edge_samples, "edge_samples");
     check_room(slam::SCRATCH, out.shape[0], "out");
-    // Allocated without zero-filling (every slot used is written first).
-    const std::unique_ptr<slam::Buffers> buf(new slam::Buffers);
+    // The thread's reused buffers (every slot used is written first): a fresh Buffers
+    // would zero its 260 KB on every call.
+    slam::Buffers& buf = slam::thread_buffers();
     slam::FrameChange frame;
     const int64_t status = slam::change_of_frames(a1.data, a1.shape[0], a2.data, a2.shape[0],
-                                                  transfer, edge_samples, *buf, frame);
+                                                  transfer, edge_samples, buf, frame);
     if (status != slam::FRAME_OK) return nb::make_tuple(status, 0);
-    slam::Scratch& scratch = buf->scratch;
+    slam::Scratch& scratch = buf.scratch;
     const int64_t n = slam::transfer_region(target.data, target.shape[0], frame, scratch.cloud,
                                             scratch.hull, scratch.fresh);
     check_room(n, out.shape[0], "out");

@@ -445,11 +445,11 @@ nb::tuple relaxed_region_binding(const PyMapState& s, int64_t row, int64_t j, nb
         check_region_count(s.views.base_counts(row, j), s.views.base_vertices.shape[2],
                            "base_counts");
     }
-    auto scratch = std::make_unique<slam::Scratch>();
-    for (int64_t i = 0; i < k_slots.shape[0]; ++i) scratch->slots[i] = k_slots(i);
+    slam::Scratch& scratch = slam::thread_buffers().scratch;  // reused, not zeroed per call
+    for (int64_t i = 0; i < k_slots.shape[0]; ++i) scratch.slots[i] = k_slots(i);
     auto [n, q] = slam::relaxed_region(s.views, row, j, k_slots.shape[0], use_base, max_outliers,
-                                       *scratch);
-    for (int64_t v = 0; v < n; ++v) o(v) = scratch->acc[v];
+                                       scratch);
+    for (int64_t v = 0; v < n; ++v) o(v) = scratch.acc[v];
     return nb::make_tuple(n, q);
 }
 
@@ -469,9 +469,9 @@ void update_levels_binding(const PyMapState& s, int64_t row, int64_t j, nb::hand
         check_region_count(s.views.level_counts(row, j, k), s.views.level_vertices.shape[3],
                            "level_counts");
     }
-    auto scratch = std::make_unique<slam::Scratch>();
-    for (int64_t v = 0; v < f.shape[0]; ++v) scratch->fresh[v] = f(v);
-    slam::update_levels(s.views, row, j, f.shape[0], *scratch);
+    slam::Scratch& scratch = slam::thread_buffers().scratch;  // reused, not zeroed per call
+    for (int64_t v = 0; v < f.shape[0]; ++v) scratch.fresh[v] = f(v);
+    slam::update_levels(s.views, row, j, f.shape[0], scratch);
 }
 
 }  // namespace

@@ -37,6 +37,10 @@ int64_t binomial_q(int64_t n, double p, double risk, int64_t q_cap) {
     double below = term;                  // P(X <= q)
     int64_t q = 0;
     while (q < q_cap && 1.0 - below >= risk) {
+        // A zero term stays zero (past q = n, or underflowed), so `below` and the test
+        // above no longer change: the loop would run on to q_cap (endless for a huge
+        // q_cap, such as a risk <= 0 never met). Its answer, at once:
+        if (term == 0.0) return q_cap;
         term *= static_cast<double>(n - q) / (static_cast<double>(q) + 1.0) * p / (1.0 - p);
         q += 1;
         below += term;

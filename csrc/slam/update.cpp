@@ -241,10 +241,35 @@ void rebuild_row(int64_t i, int64_t row, int64_t n_landmarks, const Params& para
     throw std::invalid_argument("map " + std::to_string(row) + " has a corrupt state: " + what);
 }
 
-// The counts and positions of map row that the update indexes buffers with (written by
-// the kernels only, but a user can write the arrays): any out of range raises
-// std::invalid_argument (a ValueError in Python) before the map is written.
+// A counter the update adds to: in [0, MAX_COUNTER], so the additions cannot overflow.
+void check_counter(int64_t value, int64_t row, const char* what) {
+    if (value < 0 || value > MAX_COUNTER) corrupt(row, what);
+}
+
+// The counters of map row that the update adds to (check_map).
+void check_counters(const MapState& state, int64_t row, const Params& params) {
+    check_counter(state.n_updates(row), row, "n_updates out of range");
+    check_counter(state.n_frame_changes(row), row, "n_frame_changes out of range");
+    check_counter(state.n_inconsistent(row), row, "n_inconsistent out of range");
+    for (int64_t j = 0; j < state.counts.shape[1]; ++j) {
+        if (params.fusion == FUSION_RELAXED) {
+            check_counter(state.n_dropped(row, j), row, "n_dropped out of range");
+        }
+        if (params.fusion == FUSION_ROBUST) {
+            check_counter(state.n_regions(row, j), row, "n_regions out of range");
+        }
+    }
+    if (params.fusion == FUSION_ROBUST && params.estimate_bound) {
+        check_counter(state.bound_events(row), row, "bound_events out of range");
+    }
+}
+
+// The counts and positions of map row that the update indexes buffers with, and the
+// counters it adds to (written by the kernels only, but a user can write the arrays):
+// any out of range raises std::invalid_argument (a ValueError in Python) before the map
+// is written.
 void check_map(const MapState& state, int64_t row, const Params& params) {
+    check_counters(state, row, params);
     const int64_t m = state.counts.shape[1];
     for (int64_t j = 0; j < m; ++j) {
         const int64_t n = state.counts(row, j);
@@ -337,15 +362,13 @@ void update_rows(int64_t first, int64_t stop, View2<const double> bearings_start
     }
 }
 
-// This thread's buffers: allocated on the thread's first update, then reused (one
-// allocation per thread, none per call on a long-lived thread, none per movement).
+}  // namespace
+
 Buffers& thread_buffers() {
     thread_local std::unique_ptr<Buffers> buffers;
     if (!buffers) buffers = std::make_unique<Buffers>();
     return *buffers;
 }
-
-}  // namespace
 
 int64_t change_of_frames(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2,
                          int64_t transfer, int64_t edge_samples, Buffers& buf,

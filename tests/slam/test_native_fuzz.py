@@ -16,8 +16,9 @@ folder) an out-of-bounds access or undefined behaviour fails it too.
 The map and env states' own integers (region counts, window and history cursors, noise
 and trajectory cursors, counters), which the kernels keep and a user can write, are
 corrupted too: negative, past a region's capacity, absurd. Not with values near int64's
-end: counters that count on from them (movements made, regions fused) would overflow only
-after 2**63 movements.
+end: the env's counters that count on from them would overflow only after 2**63 steps (the
+map update refuses its own counters past ``MAX_COUNTER``, 2**62, rather than overflow
+them: tests/slam/test_slam_map.py).
 
 Bad arguments (wrong dtype, dimensions or shape, a strided view, a read-only output,
 not an array) raise ``TypeError`` or ``ValueError`` naming the argument: the table
@@ -905,8 +906,8 @@ def test_contains_points_of_any_points_and_counts(data: st.DataObject) -> None:
     n=st.one_of(st.integers(-2, 1000), st.sampled_from(SPECIAL_INTS)),
     p=hard_floats,
     risk=st.one_of(st.just(0.05), hard_floats),
-    # q grows to q_cap when the risk is never met (risk <= 0): the loop is linear in q_cap.
-    q_cap=st.integers(-3, 10_000),
+    # q_cap when the risk is never met (risk <= 0), at once however large.
+    q_cap=st.one_of(st.integers(-3, 10_000), st.sampled_from(SPECIAL_INTS)),
 )
 def test_binomial_q_of_any_settings(n: int, p: float, risk: float, q_cap: int) -> None:
     q = result(_core.binomial_q, n, p, risk, q_cap)

@@ -57,6 +57,11 @@ struct Buffers {
     Scratch scratch;
 };
 
+// This thread's buffers: allocated (and zeroed) on the thread's first use, then reused:
+// one allocation per thread, none per call or movement. The update and the single-step
+// kernels' bindings use them, never two at once on one thread.
+Buffers& thread_buffers();
+
 // Copy poly[:n] into a buffer of `capacity` points, raising CapacityError if it does not
 // fit (numba's kernels, unchecked, would have written past the buffer).
 inline void copy_polygon(const cplx* source, int64_t n, cplx* out, int64_t capacity,

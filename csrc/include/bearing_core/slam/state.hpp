@@ -26,6 +26,11 @@ inline constexpr int64_t MAX_WINDOW = 32;
 // GreedyOneStep's 16 candidates level within the machine's noise; 64 envs 1.6x faster).
 // Python reads it as kernels.PARALLEL_MIN_MAPS.
 inline constexpr int64_t PARALLEL_MIN_MAPS = 32;
+// The largest value a map's counters (n_updates, n_inconsistent, ...) may hold when a
+// movement starts: beyond any run (2^62 movements), with room for one movement's
+// increments, so that a corrupt state is refused (std::invalid_argument) instead of
+// overflowing a signed counter.
+inline constexpr int64_t MAX_COUNTER = int64_t{1} << 62;
 
 enum FrStatus : int64_t { FR_BOUNDED = 0, FR_UNBOUNDED = 1, FR_EMPTY = 2, FR_MISSING = 3 };
 enum FrameStatus : int8_t {
