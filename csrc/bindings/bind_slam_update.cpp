@@ -16,6 +16,7 @@
 #include "bindings/arrays.hpp"
 #include <bearing_core/core/errors.hpp>
 #include <bearing_core/slam/fusion.hpp>
+#include <bearing_core/slam/map_batch.hpp>
 #include <bearing_core/slam/robust.hpp>
 #include <bearing_core/slam/scratch.hpp>
 #include <bearing_core/slam/state.hpp>
@@ -31,20 +32,11 @@ using bearing::bindings::value_error;
 using bearing::bindings::view_of;
 namespace slam = bearing::slam;
 
-// The fields of bearing_env.slam.kernels.State, in its order.
+// The fields of bearing_env.slam.kernels.State, in its order (slam/state.hpp's list).
 constexpr const char* STATE_FIELDS[] = {
-    "vertices",        "counts",           "areas",
-    "centroids",       "robot_vertices",   "robot_counts",
-    "robot_area",      "robot_centroid",   "robot_heading",
-    "n_updates",       "n_frame_changes",  "n_inconsistent",
-    "window_vertices", "window_counts",    "window_inlier",
-    "window_rejected", "window_length",    "window_next",
-    "base_vertices",   "base_counts",      "n_dropped",
-    "outliers",        "level_vertices",   "level_counts",
-    "n_regions",       "robot_fixed_at",   "noise_scale",
-    "bound_events",    "probe_vertices",   "probe_counts",
-    "history_frame_bearings", "history_bearings", "history_length",
-    "history_next",
+#define BEARING_CORE_FIELD_NAME(T, D, name) #name,
+    BEARING_CORE_MAP_STATE(BEARING_CORE_FIELD_NAME)
+#undef BEARING_CORE_FIELD_NAME
 };
 constexpr size_t N_FIELDS = sizeof(STATE_FIELDS) / sizeof(STATE_FIELDS[0]);
 static_assert(N_FIELDS == 34, "State has 34 fields");
@@ -189,31 +181,11 @@ void init_map_state(PyMapState* self, nb::handle state) {
     new (self) PyMapState{nb::borrow<nb::object>(state), v, n, m, w, levels, h};
 }
 
-// One update call's settings (bearing_env.slam.kernels.Params), validated.
+// One update call's settings (bearing_env.slam.kernels.Params), validated by the
+// library (slam::validate: std::invalid_argument, a ValueError in Python).
 slam::Params make_params(double epsilon, int64_t transfer, int64_t edge_samples,
                          int64_t on_inconsistency, int64_t fusion, int64_t max_outliers,
                          bool with_robot, double risk, bool likely, bool estimate_bound) {
-    require(std::isfinite(epsilon) && epsilon > 0.0,
-            "epsilon must be a positive finite number of radians, not " + std::to_string(epsilon));
-    require(slam::valid_transfer(transfer),
-            "transfer must be TRANSFER_CONSERVATIVE (0), TRANSFER_PAPER (1) or "
-            "TRANSFER_CONSERVATIVE_GLOBAL (2), not " +
-                std::to_string(transfer));
-    require(edge_samples >= 1 && edge_samples <= slam::MAX_EDGE_SAMPLES,
-            "edge_samples must be in [1, " + std::to_string(slam::MAX_EDGE_SAMPLES) + "], not " +
-                std::to_string(edge_samples));
-    require(on_inconsistency == slam::INCONSISTENCY_RESTART ||
-                on_inconsistency == slam::INCONSISTENCY_KEEP,
-            "on_inconsistency must be INCONSISTENCY_RESTART (0) or INCONSISTENCY_KEEP (1), not " +
-                std::to_string(on_inconsistency));
-    require(fusion == slam::FUSION_INTERSECT || fusion == slam::FUSION_RELAXED ||
-                fusion == slam::FUSION_ROBUST,
-            "fusion must be FUSION_INTERSECT (0), FUSION_RELAXED (1) or FUSION_ROBUST (2), not " +
-                std::to_string(fusion));
-    require(max_outliers >= 0 && max_outliers < slam::MAX_WINDOW,
-            "max_outliers must be in [0, " + std::to_string(slam::MAX_WINDOW) + "), not " +
-                std::to_string(max_outliers));
-    require(std::isfinite(risk), "risk must be a finite number, not " + std::to_string(risk));
     slam::Params p;
     p.epsilon = epsilon;
     p.transfer = transfer;
@@ -225,6 +197,7 @@ slam::Params make_params(double epsilon, int64_t transfer, int64_t edge_samples,
     p.risk = risk;
     p.likely = likely;
     p.estimate_bound = estimate_bound;
+    slam::validate(p);
     return p;
 }
 

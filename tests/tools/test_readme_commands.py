@@ -226,6 +226,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     'cp outputs/compare_lookahead/summary.json docs/compare/results/lookahead.json': ('copy', ()),
     "cmake -S . -B build/cpp -G Ninja -DBEARING_ENV_PYTHON=OFF": ("cpp", ()),
     "cmake --build build/cpp": ("cpp", ()),
+    "ctest --test-dir build/cpp --output-on-failure": ("cpp", ()),
 }
 
 
@@ -409,7 +410,7 @@ def test_readme_command_runs_or_parses(command: str, tmp_path: Path) -> None:
         # them from docs/cpp.md.
         from tests.tools.test_cpp_library import page_commands
 
-        assert command in page_commands("cmake ")
+        assert command in page_commands("cmake ") + page_commands("ctest ")
     elif kind == "zoo":
         from tests.tools.test_zoo_commands import COMMANDS
 

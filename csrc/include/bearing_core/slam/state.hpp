@@ -68,44 +68,59 @@ enum Inconsistency : int64_t { INCONSISTENCY_RESTART = 0, INCONSISTENCY_KEEP = 1
 enum Fusion : int64_t { FUSION_INTERSECT = 0, FUSION_RELAXED = 1, FUSION_ROBUST = 2 };
 
 // A batch's state: the fields of bearing_env.slam.kernels.State, in its order, as views
-// of the batch's numpy arrays (m: mapped landmarks, w: the relaxed window, levels: the
-// robust fusion's levels, h: its history; 0-sized where the fusion does not use them).
+// of the batch's arrays (m: mapped landmarks, w: the relaxed window, levels: the robust
+// fusion's levels, h: its history; 0-sized where the fusion does not use them). The one
+// list of them: X(element type, dimensions, name) per field, in State's order; MapState,
+// for_each_field and the bindings' field names are made from it.
+#define BEARING_CORE_MAP_STATE(X)                                          \
+    X(cplx, 3, vertices)                /* (maps, m, CAPACITY) */          \
+    X(int64_t, 2, counts)               /* (maps, m) */                    \
+    X(double, 2, areas)                 /* (maps, m) */                    \
+    X(cplx, 2, centroids)               /* (maps, m) */                    \
+    X(cplx, 2, robot_vertices)          /* (maps, CAPACITY) */             \
+    X(int64_t, 1, robot_counts)         /* (maps,) */                      \
+    X(double, 1, robot_area)            /* (maps,) */                      \
+    X(cplx, 1, robot_centroid)          /* (maps,) */                      \
+    X(double, 1, robot_heading)         /* (maps,) */                      \
+    X(int64_t, 1, n_updates)            /* (maps,) */                      \
+    X(int64_t, 1, n_frame_changes)      /* (maps,) */                      \
+    X(int64_t, 1, n_inconsistent)       /* (maps,) */                      \
+    X(cplx, 4, window_vertices)         /* (maps, w, m, CAPACITY) */       \
+    X(int64_t, 3, window_counts)        /* (maps, w, m) */                 \
+    X(bool, 3, window_inlier)           /* (maps, w, m) */                 \
+    X(bool, 2, window_rejected)         /* (maps, w) */                    \
+    X(int64_t, 1, window_length)        /* (maps,) */                      \
+    X(int64_t, 1, window_next)          /* (maps,) */                      \
+    X(cplx, 3, base_vertices)           /* (maps, m, CAPACITY or 0) */     \
+    X(int64_t, 2, base_counts)          /* (maps, m) */                    \
+    X(int64_t, 2, n_dropped)            /* (maps, m) */                    \
+    X(int64_t, 2, outliers)             /* (maps, m) */                    \
+    X(cplx, 4, level_vertices)          /* (maps, m, levels, CAPACITY) */  \
+    X(int64_t, 3, level_counts)         /* (maps, m, levels) */            \
+    X(int64_t, 2, n_regions)            /* (maps, m) */                    \
+    X(int64_t, 1, robot_fixed_at)       /* (maps,) */                      \
+    X(double, 1, noise_scale)           /* (maps,) */                      \
+    X(int64_t, 1, bound_events)         /* (maps,) */                      \
+    X(cplx, 3, probe_vertices)          /* (maps, m, CAPACITY or 0) */     \
+    X(int64_t, 2, probe_counts)         /* (maps, m) */                    \
+    X(double, 4, history_frame_bearings) /* (maps, h, 2, 2) */             \
+    X(double, 4, history_bearings)      /* (maps, h, 2, m) */              \
+    X(int64_t, 1, history_length)       /* (maps,) */                      \
+    X(int64_t, 1, history_next)         /* (maps,) */
+
 struct MapState {
-    View3<cplx> vertices;                 // (maps, m, CAPACITY)
-    View2<int64_t> counts;                // (maps, m)
-    View2<double> areas;                  // (maps, m)
-    View2<cplx> centroids;                // (maps, m)
-    View2<cplx> robot_vertices;           // (maps, CAPACITY)
-    View1<int64_t> robot_counts;          // (maps,)
-    View1<double> robot_area;             // (maps,)
-    View1<cplx> robot_centroid;           // (maps,)
-    View1<double> robot_heading;          // (maps,)
-    View1<int64_t> n_updates;             // (maps,)
-    View1<int64_t> n_frame_changes;       // (maps,)
-    View1<int64_t> n_inconsistent;        // (maps,)
-    View4<cplx> window_vertices;          // (maps, w, m, CAPACITY)
-    View3<int64_t> window_counts;         // (maps, w, m)
-    View3<bool> window_inlier;            // (maps, w, m)
-    View2<bool> window_rejected;          // (maps, w)
-    View1<int64_t> window_length;         // (maps,)
-    View1<int64_t> window_next;           // (maps,)
-    View3<cplx> base_vertices;            // (maps, m, CAPACITY or 0)
-    View2<int64_t> base_counts;           // (maps, m)
-    View2<int64_t> n_dropped;             // (maps, m)
-    View2<int64_t> outliers;              // (maps, m)
-    View4<cplx> level_vertices;           // (maps, m, levels, CAPACITY)
-    View3<int64_t> level_counts;          // (maps, m, levels)
-    View2<int64_t> n_regions;             // (maps, m)
-    View1<int64_t> robot_fixed_at;        // (maps,)
-    View1<double> noise_scale;            // (maps,)
-    View1<int64_t> bound_events;          // (maps,)
-    View3<cplx> probe_vertices;           // (maps, m, CAPACITY or 0)
-    View2<int64_t> probe_counts;          // (maps, m)
-    View4<double> history_frame_bearings; // (maps, h, 2, 2)
-    View4<double> history_bearings;       // (maps, h, 2, m)
-    View1<int64_t> history_length;        // (maps,)
-    View1<int64_t> history_next;          // (maps,)
+#define BEARING_CORE_DECLARE_FIELD(T, D, name) View<T, D> name;
+    BEARING_CORE_MAP_STATE(BEARING_CORE_DECLARE_FIELD)
+#undef BEARING_CORE_DECLARE_FIELD
 };
+
+// Call visit(name, view) for every field of `state`, in State's order.
+template <class Visit>
+void for_each_field(const MapState& state, Visit&& visit) {
+#define BEARING_CORE_VISIT_FIELD(T, D, name) visit(#name, state.name);
+    BEARING_CORE_MAP_STATE(BEARING_CORE_VISIT_FIELD)
+#undef BEARING_CORE_VISIT_FIELD
+}
 
 // One update call's settings (bearing_env.slam.kernels.Params, same fields, same order).
 struct Params {
