@@ -1,11 +1,15 @@
-"""The C++ library ``bearing_core`` builds without Python and passes its C++ tests, as
+"""The C++ library ``bearing_core`` builds without Python, passes its C++ tests, installs
+as a CMake package, and its example replays a bearing log as the Python package does, as
 ``docs/cpp.md`` says.
 
-The page's ``cmake`` and ``ctest`` commands are read from it and run as written, with the
-build folder moved into a temporary one (``-DBEARING_ENV_WERROR=ON`` added, as ``make``
-builds): configuring must not look for Python or nanobind, the build gives the library
-and its tests, and ctest runs them (the golden map corpus replayed bit for bit on 256 KB
-thread stacks, the owning types' validation). About 30 s on two cores.
+Every shell command of the page is run as written, in order, with its folders moved into
+a temporary one (``-DBEARING_ENV_WERROR=ON`` added to the library's configure step, as
+``make`` builds): configuring must not look for Python or nanobind; the build gives the
+library and its tests, which ctest runs (the golden map corpus replayed bit for bit on
+256 KB thread stacks, the owning types' validation); the install holds the headers, the
+library and the package; the example project finds it with ``find_package`` and its
+``replay`` prints, bit for bit, the regions ``BatchedPolygonSLAM`` computes from the same
+log (read by ``bearing_env.slam.bearing_log``). About 15-40 s on two cores.
 """
 
 from __future__ import annotations
@@ -19,14 +23,15 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from bearing_env.extras import install_command
+from bearing_env.slam import BatchedPolygonSLAM
+from bearing_env.slam.bearing_log import read_bearing_log
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGE = ROOT / "docs" / "cpp.md"
-#: The build folder the page's commands name; the tests build in a temporary one instead.
-DOCUMENTED_BUILD = "build/cpp"
 #: The venv's own tools first (the dev extra installs cmake and ninja there).
 PATH = os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
 if any(shutil.which(tool, path=PATH) is None for tool in ("cmake", "ninja")):
@@ -34,27 +39,29 @@ if any(shutil.which(tool, path=PATH) is None for tool in ("cmake", "ninja")):
                 allow_module_level=True)  # fmt: skip
 
 
-def page_commands(prefix: str) -> list[str]:
+def page_commands(prefix: str = "") -> list[str]:
     """The page's shell commands (its ``sh`` blocks, ``\\`` continuations joined) that
     start with ``prefix``, in order."""
     commands = []
     for block in re.findall(r"```sh\n(.*?)```", PAGE.read_text(encoding="utf-8"), re.S):
         for command in block.replace("\\\n", " ").splitlines():
             command = " ".join(command.split("#", 1)[0].split())
-            if command.startswith(prefix):
+            if command and command.startswith(prefix):
                 commands.append(command)
     return commands
 
 
-#: The commands that configure, build and test the library alone, as the page gives them.
-BUILD_COMMANDS = [c for c in page_commands("cmake ") + page_commands("ctest ")
-                  if DOCUMENTED_BUILD in c]  # fmt: skip
+#: The page's folders, and the temporary ones the tests use instead.
+FOLDERS = {"build/cpp": "build", "/opt/bearing_core": "prefix", "build/replay": "replay"}
+#: The example program, as the page runs it.
+REPLAY = "build/replay/replay"
 
 
 @dataclass
 class Build:
-    folder: Path
-    log: str
+    folder: Path  # the temporary folder of FOLDERS' folders
+    log: str  # every command's output
+    replay: str  # the replay program's output
 
 
 def run(argv: list[str], cwd: Path = ROOT, timeout: float = 600) -> str:
@@ -64,35 +71,52 @@ def run(argv: list[str], cwd: Path = ROOT, timeout: float = 600) -> str:
     return result.stdout + result.stderr
 
 
+def localised(command: str, base: Path) -> list[str]:
+    """A page command's arguments, its folders moved below ``base``."""
+    argv = []
+    for argument in shlex.split(command):
+        for documented, local in FOLDERS.items():
+            if argument == documented or argument.startswith(documented + "/"):
+                argument = str(base / local) + argument[len(documented) :]
+            elif argument.endswith("=" + documented):
+                argument = argument[: -len(documented)] + str(base / local)
+        argv.append(argument)
+    return argv
+
+
 @pytest.fixture(scope="module")
 def library_build(tmp_path_factory: pytest.TempPathFactory) -> Build:
-    folder = tmp_path_factory.mktemp("cpp") / "build"
-    log = ""
-    for command in BUILD_COMMANDS:
-        argv = [str(folder) if a == DOCUMENTED_BUILD else a for a in shlex.split(command)]
-        if "-S" in argv:  # the configure step: warnings are errors, as make builds
+    base = tmp_path_factory.mktemp("cpp")
+    log = replay = ""
+    for command in page_commands():
+        argv = localised(command, base)
+        if command.startswith("cmake -S . "):  # the library: warnings are errors, as make builds
             argv.append("-DBEARING_ENV_WERROR=ON")
-        if "--build" in argv:
+        if "--build" in argv or argv[0] == "ctest":
             argv += ["--parallel", "2"]
-        if argv[0] == "ctest":
-            argv += ["--parallel", "2"]
-        log += run(argv)
-    return Build(folder, log)
+        output = run(argv)
+        log += output
+        if command.startswith(REPLAY):
+            replay = output
+    return Build(base, log, replay)
 
 
-def test_the_page_configures_without_python_builds_and_tests() -> None:
-    configure, build, test = BUILD_COMMANDS
-    assert "-DBEARING_ENV_PYTHON=OFF" in configure and configure.startswith("cmake -S . -B ")
-    assert build.startswith("cmake --build ")
-    assert test.startswith("ctest --test-dir ")
+def test_the_page_builds_tests_installs_and_runs_the_example() -> None:
+    configure, build, test, install, example, example_build, replay = page_commands()
+    assert configure == "cmake -S . -B build/cpp -G Ninja -DBEARING_ENV_PYTHON=OFF"
+    assert build.startswith("cmake --build build/cpp") and test.startswith("ctest --test-dir")
+    assert install == "cmake --install build/cpp --prefix /opt/bearing_core"
+    assert example.startswith("cmake -S examples/cpp") and "CMAKE_PREFIX_PATH" in example
+    assert example_build.startswith("cmake --build build/replay") and replay.startswith(REPLAY)
 
 
 def test_the_library_builds_without_finding_python_or_nanobind(library_build: Build) -> None:
-    assert (library_build.folder / "libbearing_core.a").is_file()
-    cache = (library_build.folder / "CMakeCache.txt").read_text(encoding="utf-8")
+    folder = library_build.folder / "build"
+    assert (folder / "libbearing_core.a").is_file()
+    cache = (folder / "CMakeCache.txt").read_text(encoding="utf-8")
     assert "BEARING_ENV_PYTHON:BOOL=OFF" in cache
     assert not re.search(r"^(Python_EXECUTABLE|nanobind_DIR)[:=]", cache, re.M)
-    assert "/_core.dir/" not in (library_build.folder / "build.ninja").read_text(encoding="utf-8")
+    assert "/_core.dir/" not in (folder / "build.ninja").read_text(encoding="utf-8")
 
 
 
@@ -107,7 +131,7 @@ def test_the_fp_flags_are_usage_requirements_of_the_library(library_build: Build
     # A consumer's compile line (the C++ tests link bearing_core and set no flags of their
     # own) carries the library's floating-point flags: the inline arithmetic of its
     # headers compiles as the library's own does.
-    ninja = (library_build.folder / "build.ninja").read_text(encoding="utf-8")
+    ninja = (library_build.folder / "build" / "build.ninja").read_text(encoding="utf-8")
     consumer = re.search(r"build tests/cpp/CMakeFiles/test_map_batch\.dir/[^\n]*\n(.*?)\n\n",
                          ninja, re.S)  # fmt: skip
     assert consumer is not None
@@ -115,3 +139,48 @@ def test_the_fp_flags_are_usage_requirements_of_the_library(library_build: Build
     assert flags is not None
     for flag in ("-ffp-contract=off", "-fno-tree-vectorize", "-fno-fast-math"):
         assert flag in flags.group(1).split(), flag
+
+
+def test_the_install_holds_the_headers_the_library_and_the_cmake_package(
+    library_build: Build,
+) -> None:
+    prefix = library_build.folder / "prefix"
+    package = next(prefix.glob("lib*/cmake/bearing_core"))
+    assert {p.name for p in package.iterdir()} >= {
+        "bearing_coreConfig.cmake", "bearing_coreConfigVersion.cmake",
+        "bearing_coreTargets.cmake"}  # fmt: skip
+    assert (prefix / "include/bearing_core/slam/map_batch.hpp").is_file()
+    assert next(prefix.glob("lib*/libbearing_core.a")).is_file()
+    targets = (package / "bearing_coreTargets.cmake").read_text(encoding="utf-8")
+    assert "bearing_core::bearing_core" in targets and "-ffp-contract=off" in targets
+
+
+def _printed_regions(output: str) -> dict[int, list[complex]]:
+    regions: dict[int, list[complex]] = {}
+    for line in output.splitlines():
+        if line.startswith("# landmark "):
+            regions[int(line.split()[2])] = []
+        elif line and not line.startswith("#"):
+            j, x, y = line.split(",")
+            regions[int(j)].append(complex(float(x), float(y)))
+    return regions
+
+
+def test_the_replay_prints_the_regions_python_computes_from_the_same_log(
+    library_build: Build,
+) -> None:
+    (replay,) = page_commands(REPLAY)
+    _, log, epsilon = shlex.split(replay)
+    start, end = read_bearing_log(ROOT / log)
+    assert start.shape == (10, 5) and np.isnan(start).sum() + np.isnan(end).sum() == 2
+    maps = BatchedPolygonSLAM(1, start.shape[1], float(epsilon))
+    for b1, b2 in zip(start, end, strict=True):
+        maps.update(b1[None], b2[None])
+    printed = _printed_regions(library_build.replay)
+    assert sorted(printed) == [2, 3, 4]
+    for j, region in printed.items():
+        assert len(region) >= 3
+        assert region == maps.polygon(0, j - 2).tolist(), j  # bit for bit
+    areas = [float(line.split()[5].rstrip(",")) for line in library_build.replay.splitlines()
+             if line.startswith("# landmark ")]  # fmt: skip
+    assert areas == maps.areas[0].tolist()
