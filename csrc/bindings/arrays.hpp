@@ -19,12 +19,30 @@ namespace nb = nanobind;
 
 template <class T>
 struct dtype_name;
-template <> struct dtype_name<double> { static constexpr const char* value = "float64"; };
-template <> struct dtype_name<float> { static constexpr const char* value = "float32"; };
-template <> struct dtype_name<int64_t> { static constexpr const char* value = "int64"; };
-template <> struct dtype_name<int8_t> { static constexpr const char* value = "int8"; };
-template <> struct dtype_name<bool> { static constexpr const char* value = "bool"; };
-template <> struct dtype_name<cplx> { static constexpr const char* value = "complex128"; };
+template <>
+struct dtype_name<double> {
+    static constexpr const char* value = "float64";
+};
+template <>
+struct dtype_name<float> {
+    static constexpr const char* value = "float32";
+};
+template <>
+struct dtype_name<int64_t> {
+    static constexpr const char* value = "int64";
+};
+template <>
+struct dtype_name<int8_t> {
+    static constexpr const char* value = "int8";
+};
+template <>
+struct dtype_name<bool> {
+    static constexpr const char* value = "bool";
+};
+template <>
+struct dtype_name<cplx> {
+    static constexpr const char* value = "complex128";
+};
 
 template <class T>
 nb::dlpack::dtype dtype_of() {

@@ -1,6 +1,6 @@
-// Bindings of the polygon and frame kernels (csrc/include/bearing_core/slam/polygons.hpp, frames.hpp), for tests
-// and one-off geometry: the same Python signatures and return conventions as the numba
-// kernels of bearing_env.slam.kernels (complex128 arrays in, `out` arrays written in
+// Bindings of the polygon and frame kernels (csrc/include/bearing_core/slam/polygons.hpp,
+// frames.hpp), for tests and one-off geometry: the same Python signatures and return conventions as
+// the numba kernels of bearing_env.slam.kernels (complex128 arrays in, `out` arrays written in
 // place, the same return tuples), so that the package can re-export either.
 //
 // Every array is checked (dtype, dimensions, C-contiguity, writeability), and every count
@@ -14,13 +14,13 @@
 #include <memory>
 #include <string>
 
-#include "bindings/arrays.hpp"
 #include <bearing_core/slam/common.hpp>
 #include <bearing_core/slam/frames.hpp>
 #include <bearing_core/slam/local_bound.hpp>
 #include <bearing_core/slam/polygons.hpp>
 #include <bearing_core/slam/scratch.hpp>
 #include <bearing_core/slam/update.hpp>
+#include "bindings/arrays.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -113,8 +113,7 @@ int64_t convex_hull(nb::handle points_obj, int64_t n_points, nb::handle out_obj)
     return bearing::slam::convex_hull(points.data, n_points, out.data);
 }
 
-int64_t small_convex_hull(nb::handle points_obj, int64_t n_points, nb::handle out_obj,
-                          double tol) {
+int64_t small_convex_hull(nb::handle points_obj, int64_t n_points, nb::handle out_obj, double tol) {
     const In points = input(points_obj, "points");
     const Out out = output(out_obj, "out");
     check_count(n_points, "n_points", points.shape[0], "points");
@@ -218,9 +217,8 @@ nb::tuple frame_plan(nb::handle a1_obj, int64_t n1, nb::handle a2_obj, int64_t n
     const In a2 = input(a2_obj, "a2");
     check_count(n1, "n1", a1.shape[0], "a1", 1);
     check_count(n2, "n2", a2.shape[0], "a2", 1);
-    const bearing::slam::FramePlan plan =
-        bearing::slam::frame_plan(a1.data, n1, a2.data, n2,
-                                  bool_of(conservative, "conservative"), edge_samples);
+    const bearing::slam::FramePlan plan = bearing::slam::frame_plan(
+        a1.data, n1, a2.data, n2, bool_of(conservative, "conservative"), edge_samples);
     return nb::make_tuple(plan.status, plan.per_edge, plan.distance, plan.delta1, plan.delta2);
 }
 
@@ -323,8 +321,10 @@ nb::tuple transfer_polygon(nb::handle target_obj, nb::handle a1_obj, nb::handle 
     const Out out = output(out_obj, "out");
     if (target.shape[0] < 1) value_error("target must hold at least one point");
     if (!slam::valid_transfer(transfer)) {
-        value_error("transfer must be TRANSFER_CONSERVATIVE (0), TRANSFER_PAPER (1) or "
-                    "TRANSFER_CONSERVATIVE_GLOBAL (2), got " + std::to_string(transfer));
+        value_error(
+            "transfer must be TRANSFER_CONSERVATIVE (0), TRANSFER_PAPER (1) or "
+            "TRANSFER_CONSERVATIVE_GLOBAL (2), got " +
+            std::to_string(transfer));
     }
     check_edge_samples(edge_samples, "edge_samples");
     check_room(slam::SCRATCH, out.shape[0], "out");
@@ -374,11 +374,15 @@ void bind_slam_geometry(nb::module_& m) {
     // common.py and numerics.py's scalar helpers.
     m.def(
         "cross",
-        [](nb::handle a, nb::handle b) { return bearing::cross(complex_of(a, "a"), complex_of(b, "b")); },
+        [](nb::handle a, nb::handle b) {
+            return bearing::cross(complex_of(a, "a"), complex_of(b, "b"));
+        },
         "a"_a, "b"_a, "2-D cross product a.x * b.y - a.y * b.x.");
     m.def(
         "dot",
-        [](nb::handle a, nb::handle b) { return bearing::dot(complex_of(a, "a"), complex_of(b, "b")); },
+        [](nb::handle a, nb::handle b) {
+            return bearing::dot(complex_of(a, "a"), complex_of(b, "b"));
+        },
         "a"_a, "b"_a, "2-D dot product.");
     m.def("wrap", &bearing::wrap, "angle"_a, "An angle wrapped to [-pi, pi).");
     m.def("scale_of", &scale_of, "poly"_a, "n"_a,

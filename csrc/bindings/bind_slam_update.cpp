@@ -13,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include "bindings/arrays.hpp"
 #include <bearing_core/core/errors.hpp>
 #include <bearing_core/slam/fusion.hpp>
 #include <bearing_core/slam/map_batch.hpp>
@@ -21,6 +20,7 @@
 #include <bearing_core/slam/scratch.hpp>
 #include <bearing_core/slam/state.hpp>
 #include <bearing_core/slam/update.hpp>
+#include "bindings/arrays.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -47,8 +47,8 @@ struct PyMapState {
     nb::object tuple;
     slam::MapState views;
     int64_t maps = 0;
-    int64_t mapped = 0;   // m: landmarks mapped per map (L1 and L2 excluded)
-    int64_t window = 0;   // w
+    int64_t mapped = 0;  // m: landmarks mapped per map (L1 and L2 excluded)
+    int64_t window = 0;  // w
     int64_t levels = 0;
     int64_t history = 0;  // h
 };
@@ -150,20 +150,27 @@ void init_map_state(PyMapState* self, nb::handle state) {
         axis(first, n, STATE_FIELDS[k], 0);
     }
     const std::pair<const char*, int64_t> landmark_axes[] = {
-        {"areas", v.areas.shape[1]},           {"centroids", v.centroids.shape[1]},
+        {"areas", v.areas.shape[1]},
+        {"centroids", v.centroids.shape[1]},
         {"window_vertices", v.window_vertices.shape[2]},
         {"window_counts", v.window_counts.shape[2]},
-        {"window_inlier", v.window_inlier.shape[2]}, {"base_vertices", v.base_vertices.shape[1]},
-        {"base_counts", v.base_counts.shape[1]}, {"n_dropped", v.n_dropped.shape[1]},
-        {"outliers", v.outliers.shape[1]},     {"level_vertices", v.level_vertices.shape[1]},
-        {"level_counts", v.level_counts.shape[1]}, {"n_regions", v.n_regions.shape[1]},
-        {"probe_vertices", v.probe_vertices.shape[1]}, {"probe_counts", v.probe_counts.shape[1]},
+        {"window_inlier", v.window_inlier.shape[2]},
+        {"base_vertices", v.base_vertices.shape[1]},
+        {"base_counts", v.base_counts.shape[1]},
+        {"n_dropped", v.n_dropped.shape[1]},
+        {"outliers", v.outliers.shape[1]},
+        {"level_vertices", v.level_vertices.shape[1]},
+        {"level_counts", v.level_counts.shape[1]},
+        {"n_regions", v.n_regions.shape[1]},
+        {"probe_vertices", v.probe_vertices.shape[1]},
+        {"probe_counts", v.probe_counts.shape[1]},
         {"history_bearings", v.history_bearings.shape[3]},
     };
     for (const auto& [name, length] : landmark_axes) {
-        require(length == m, std::string("state.") + name + " must have the " +
-                                 std::to_string(m) + " landmarks of state.vertices on its "
-                                 "landmark axis, not " + std::to_string(length));
+        require(length == m, std::string("state.") + name + " must have the " + std::to_string(m) +
+                                 " landmarks of state.vertices on its "
+                                 "landmark axis, not " +
+                                 std::to_string(length));
     }
     axis(v.window_counts.shape[1], w, "window_counts", 1);
     axis(v.window_inlier.shape[1], w, "window_inlier", 1);
@@ -204,19 +211,22 @@ slam::Params make_params(double epsilon, int64_t transfer, int64_t edge_samples,
 // What the fusion in `params` needs of the state's optional arrays.
 void check_state_for(const PyMapState& s, const slam::Params& p) {
     if (p.fusion == slam::FUSION_RELAXED) {
-        require(s.window >= 1, "state has no relaxed window (state.window_vertices axis 1 is "
-                               "0), but params.fusion is FUSION_RELAXED");
+        require(s.window >= 1,
+                "state has no relaxed window (state.window_vertices axis 1 is "
+                "0), but params.fusion is FUSION_RELAXED");
         require(s.views.base_vertices.shape[2] == slam::CAPACITY,
                 "state.base_vertices has no vertex slots, but params.fusion is FUSION_RELAXED");
     }
     if (p.fusion == slam::FUSION_ROBUST) {
-        require(s.levels >= 1, "state has no robust levels (state.level_vertices axis 2 is 0), "
-                               "but params.fusion is FUSION_ROBUST");
+        require(s.levels >= 1,
+                "state has no robust levels (state.level_vertices axis 2 is 0), "
+                "but params.fusion is FUSION_ROBUST");
         if (p.estimate_bound) {
             require(s.views.probe_vertices.shape[2] == slam::CAPACITY,
                     "state.probe_vertices has no vertex slots, but params.estimate_bound is set");
-            require(s.history >= 1, "state has no bearing history (state.history_bearings "
-                                    "axis 1 is 0), but params.estimate_bound is set");
+            require(s.history >= 1,
+                    "state has no bearing history (state.history_bearings "
+                    "axis 1 is 0), but params.estimate_bound is set");
         }
     }
 }
@@ -235,8 +245,9 @@ void update_maps_binding(nb::handle bearings_start, nb::handle bearings_end, nb:
             "bearings_start and bearings_end must have one row per entry of rows (" +
                 std::to_string(n_rows) + ")");
     if (!nb::isinstance<nb::tuple>(out) || nb::len(out) != 3) {
-        bearing::bindings::type_error("out must be a bearing_env.slam.kernels.Outputs tuple "
-                                      "(frame_status, landmark_status, n_bad)");
+        bearing::bindings::type_error(
+            "out must be a bearing_env.slam.kernels.Outputs tuple "
+            "(frame_status, landmark_status, n_bad)");
     }
     slam::Outputs outputs;
     outputs.frame_status = view_of<int8_t, 1>(out[0], "out.frame_status", {n_rows});
@@ -245,8 +256,8 @@ void update_maps_binding(nb::handle bearings_start, nb::handle bearings_end, nb:
     require(outputs.frame_status.shape[0] == n_rows && outputs.landmark_status.shape[0] == n_rows &&
                 outputs.landmark_status.shape[1] == m && outputs.n_bad.shape[0] == n_rows,
             "out's arrays must have one row per entry of rows (" + std::to_string(n_rows) +
-                ") and out.landmark_status one column per mapped landmark (" +
-                std::to_string(m) + ")");
+                ") and out.landmark_status one column per mapped landmark (" + std::to_string(m) +
+                ")");
     require(threads >= 1, "threads must be at least 1, not " + std::to_string(threads));
     check_state_for(state, params);
     for (int64_t i = 0; i < n_rows; ++i) {
@@ -280,17 +291,15 @@ void copy_maps_binding(const PyMapState& from, nb::handle rows, const PyMapState
                 from.views.base_vertices.shape[2] == to.views.base_vertices.shape[2] &&
                 from.views.probe_vertices.shape[2] == to.views.probe_vertices.shape[2],
             "copy_maps needs states of the same landmarks and fusion arrays: from has " +
-                std::to_string(from.mapped) + " mapped landmarks, to " +
-                std::to_string(to.mapped));
+                std::to_string(from.mapped) + " mapped landmarks, to " + std::to_string(to.mapped));
     auto rows_view = view_of<const int64_t, 1>(rows, "rows");
     require(rows_view.shape[0] <= to.maps, "rows has " + std::to_string(rows_view.shape[0]) +
                                                " entries, more than to's " +
                                                std::to_string(to.maps) + " maps");
     for (int64_t i = 0; i < rows_view.shape[0]; ++i) {
         if (rows_view(i) < 0 || rows_view(i) >= from.maps) {
-            value_error("rows must be map indices in [0, " + std::to_string(from.maps) +
-                        "), got " + std::to_string(rows_view(i)) + " at position " +
-                        std::to_string(i));
+            value_error("rows must be map indices in [0, " + std::to_string(from.maps) + "), got " +
+                        std::to_string(rows_view(i)) + " at position " + std::to_string(i));
         }
     }
     slam::copy_maps(from.views, rows_view, to.views);
@@ -399,10 +408,10 @@ nb::tuple relaxed_region_binding(const PyMapState& s, int64_t row, int64_t j, nb
                                  bool use_base, int64_t max_outliers, nb::handle out) {
     auto k_slots = bearing::bindings::view_of<const int64_t, 1>(slots, "slots");
     auto o = bearing::bindings::view_of<cplx, 1>(out, "out");
-    require(0 <= row && row < s.maps, "row must be a map index in [0, " +
-                                          std::to_string(s.maps) + ")");
-    require(0 <= j && j < s.mapped, "j must be a landmark slot in [0, " +
-                                        std::to_string(s.mapped) + ")");
+    require(0 <= row && row < s.maps,
+            "row must be a map index in [0, " + std::to_string(s.maps) + ")");
+    require(0 <= j && j < s.mapped,
+            "j must be a landmark slot in [0, " + std::to_string(s.mapped) + ")");
     require(1 <= k_slots.shape[0] && k_slots.shape[0] <= s.window,
             "slots must hold 1.." + std::to_string(s.window) + " window slots");
     for (int64_t i = 0; i < k_slots.shape[0]; ++i) {
@@ -420,8 +429,8 @@ nb::tuple relaxed_region_binding(const PyMapState& s, int64_t row, int64_t j, nb
     }
     slam::Scratch& scratch = slam::thread_buffers().scratch;  // reused, not zeroed per call
     for (int64_t i = 0; i < k_slots.shape[0]; ++i) scratch.slots[i] = k_slots(i);
-    auto [n, q] = slam::relaxed_region(s.views, row, j, k_slots.shape[0], use_base, max_outliers,
-                                       scratch);
+    auto [n, q] =
+        slam::relaxed_region(s.views, row, j, k_slots.shape[0], use_base, max_outliers, scratch);
     for (int64_t v = 0; v < n; ++v) o(v) = scratch.acc[v];
     return nb::make_tuple(n, q);
 }
@@ -430,10 +439,10 @@ nb::tuple relaxed_region_binding(const PyMapState& s, int64_t row, int64_t j, nb
 // levels of map `row` (bearing_env.slam.geometry.robust_levels' kernel).
 void update_levels_binding(const PyMapState& s, int64_t row, int64_t j, nb::handle fresh) {
     auto f = bearing::bindings::view_of<const cplx, 1>(fresh, "fresh");
-    require(0 <= row && row < s.maps, "row must be a map index in [0, " +
-                                          std::to_string(s.maps) + ")");
-    require(0 <= j && j < s.mapped, "j must be a landmark slot in [0, " +
-                                        std::to_string(s.mapped) + ")");
+    require(0 <= row && row < s.maps,
+            "row must be a map index in [0, " + std::to_string(s.maps) + ")");
+    require(0 <= j && j < s.mapped,
+            "j must be a landmark slot in [0, " + std::to_string(s.mapped) + ")");
     require(s.levels > 0, "the state has no robust levels (fusion must be 'robust')");
     require(3 <= f.shape[0] && f.shape[0] <= slam::CAPACITY,
             "fresh must have 3.." + std::to_string(slam::CAPACITY) + " vertices");
@@ -462,16 +471,17 @@ void bind_slam_update(nb::module_& m) {
         .def_prop_ro("history", [](const PyMapState& s) { return s.history; });
 
     nb::class_<slam::Params>(m, "Params", "One update call's settings, validated.")
-        .def("__init__", [](slam::Params* self, double epsilon, int64_t transfer,
-                           int64_t edge_samples, int64_t on_inconsistency, int64_t fusion,
-                           int64_t max_outliers, bool with_robot, double risk, bool likely,
-                           bool estimate_bound) {
-                 new (self) slam::Params(make_params(epsilon, transfer, edge_samples,
-                                                     on_inconsistency, fusion, max_outliers,
-                                                     with_robot, risk, likely, estimate_bound));
-             },
-             "epsilon"_a, "transfer"_a, "edge_samples"_a, "on_inconsistency"_a, "fusion"_a,
-             "max_outliers"_a, "with_robot"_a, "risk"_a, "likely"_a, "estimate_bound"_a)
+        .def(
+            "__init__",
+            [](slam::Params* self, double epsilon, int64_t transfer, int64_t edge_samples,
+               int64_t on_inconsistency, int64_t fusion, int64_t max_outliers, bool with_robot,
+               double risk, bool likely, bool estimate_bound) {
+                new (self) slam::Params(make_params(epsilon, transfer, edge_samples,
+                                                    on_inconsistency, fusion, max_outliers,
+                                                    with_robot, risk, likely, estimate_bound));
+            },
+            "epsilon"_a, "transfer"_a, "edge_samples"_a, "on_inconsistency"_a, "fusion"_a,
+            "max_outliers"_a, "with_robot"_a, "risk"_a, "likely"_a, "estimate_bound"_a)
         .def_ro("epsilon", &slam::Params::epsilon)
         .def_ro("transfer", &slam::Params::transfer)
         .def_ro("edge_samples", &slam::Params::edge_samples)

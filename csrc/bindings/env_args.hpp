@@ -10,11 +10,11 @@
 #include <type_traits>
 #include <vector>
 
-#include "bindings/arrays.hpp"
-#include "bindings/sim_args.hpp"
 #include <bearing_core/env/types.hpp>
 #include <bearing_core/slam/scratch.hpp>
 #include <bearing_core/slam/state.hpp>
+#include "bindings/arrays.hpp"
+#include "bindings/sim_args.hpp"
 
 namespace bearing::bindings {
 
@@ -26,8 +26,8 @@ template <class T, int D>
 void field_of(nb::handle obj, const char* name, View<T, D>& out, Kept& kept,
               const std::array<int64_t, D>& expect = {}) {
     if (!nb::hasattr(obj, name)) {
-        type_error(std::string("expected an object with the array attribute '") + name +
-                   "', got " + nb::type_name(obj.type()).c_str());
+        type_error(std::string("expected an object with the array attribute '") + name + "', got " +
+                   nb::type_name(obj.type()).c_str());
     }
     nb::object value = obj.attr(name);
     out = view_of<T, D>(value, name, expect);
@@ -106,8 +106,7 @@ inline slam::Params params_of(nb::handle obj) {
     p.estimate_bound = scalar_of<bool>(obj, "estimate_bound");
     // The ranges the native Params checks (the update's buffers are sized by them).
     const bool valid =
-        std::isfinite(p.epsilon) && p.epsilon > 0.0 &&
-        slam::valid_transfer(p.transfer) &&
+        std::isfinite(p.epsilon) && p.epsilon > 0.0 && slam::valid_transfer(p.transfer) &&
         p.edge_samples >= 1 && p.edge_samples <= slam::MAX_EDGE_SAMPLES &&
         (p.on_inconsistency == slam::INCONSISTENCY_RESTART ||
          p.on_inconsistency == slam::INCONSISTENCY_KEEP) &&
@@ -119,16 +118,40 @@ inline slam::Params params_of(nb::handle obj) {
 }
 
 // kernels.State's fields, in order.
-inline constexpr const char* STATE_FIELDS[34] = {
-    "vertices",        "counts",           "areas",          "centroids",
-    "robot_vertices",  "robot_counts",     "robot_area",     "robot_centroid",
-    "robot_heading",   "n_updates",        "n_frame_changes", "n_inconsistent",
-    "window_vertices", "window_counts",    "window_inlier",  "window_rejected",
-    "window_length",   "window_next",      "base_vertices",  "base_counts",
-    "n_dropped",       "outliers",         "level_vertices", "level_counts",
-    "n_regions",       "robot_fixed_at",   "noise_scale",    "bound_events",
-    "probe_vertices",  "probe_counts",     "history_frame_bearings", "history_bearings",
-    "history_length",  "history_next"};
+inline constexpr const char* STATE_FIELDS[34] = {"vertices",
+                                                 "counts",
+                                                 "areas",
+                                                 "centroids",
+                                                 "robot_vertices",
+                                                 "robot_counts",
+                                                 "robot_area",
+                                                 "robot_centroid",
+                                                 "robot_heading",
+                                                 "n_updates",
+                                                 "n_frame_changes",
+                                                 "n_inconsistent",
+                                                 "window_vertices",
+                                                 "window_counts",
+                                                 "window_inlier",
+                                                 "window_rejected",
+                                                 "window_length",
+                                                 "window_next",
+                                                 "base_vertices",
+                                                 "base_counts",
+                                                 "n_dropped",
+                                                 "outliers",
+                                                 "level_vertices",
+                                                 "level_counts",
+                                                 "n_regions",
+                                                 "robot_fixed_at",
+                                                 "noise_scale",
+                                                 "bound_events",
+                                                 "probe_vertices",
+                                                 "probe_counts",
+                                                 "history_frame_bearings",
+                                                 "history_bearings",
+                                                 "history_length",
+                                                 "history_next"};
 
 // Field k of a map state given as a State tuple (by position) or as an object with the
 // arrays as attributes (a BatchedPolygonSLAM), its array kept.
@@ -138,7 +161,8 @@ void state_field(nb::handle obj, bool by_position, size_t k, View<T, D>& out, Ke
     const char* name = STATE_FIELDS[k];
     if (!by_position && !nb::hasattr(obj, name)) {
         type_error(std::string("maps must be a MapState, a bearing_env.slam.kernels.State or "
-                               "an object with its arrays; it has no '") + name + "'");
+                               "an object with its arrays; it has no '") +
+                   name + "'");
     }
     nb::object value = by_position ? nb::borrow(obj[k]) : obj.attr(name);
     const std::string label = std::string("maps.") + name;
@@ -212,18 +236,40 @@ inline slam::MapState map_state_of(nb::handle obj, Kept& kept) {
     get(s.history_length, A1{M});
     get(s.history_next, A1{M});
     // view_of skips axes of expected length 0 (0 = any): spell those out.
-    const std::array<int64_t, 34> firsts{
-        s.vertices.shape[0], s.counts.shape[0], s.areas.shape[0], s.centroids.shape[0],
-        s.robot_vertices.shape[0], s.robot_counts.shape[0], s.robot_area.shape[0],
-        s.robot_centroid.shape[0], s.robot_heading.shape[0], s.n_updates.shape[0],
-        s.n_frame_changes.shape[0], s.n_inconsistent.shape[0], s.window_vertices.shape[0],
-        s.window_counts.shape[0], s.window_inlier.shape[0], s.window_rejected.shape[0],
-        s.window_length.shape[0], s.window_next.shape[0], s.base_vertices.shape[0],
-        s.base_counts.shape[0], s.n_dropped.shape[0], s.outliers.shape[0],
-        s.level_vertices.shape[0], s.level_counts.shape[0], s.n_regions.shape[0],
-        s.robot_fixed_at.shape[0], s.noise_scale.shape[0], s.bound_events.shape[0],
-        s.probe_vertices.shape[0], s.probe_counts.shape[0], s.history_frame_bearings.shape[0],
-        s.history_bearings.shape[0], s.history_length.shape[0], s.history_next.shape[0]};
+    const std::array<int64_t, 34> firsts{s.vertices.shape[0],
+                                         s.counts.shape[0],
+                                         s.areas.shape[0],
+                                         s.centroids.shape[0],
+                                         s.robot_vertices.shape[0],
+                                         s.robot_counts.shape[0],
+                                         s.robot_area.shape[0],
+                                         s.robot_centroid.shape[0],
+                                         s.robot_heading.shape[0],
+                                         s.n_updates.shape[0],
+                                         s.n_frame_changes.shape[0],
+                                         s.n_inconsistent.shape[0],
+                                         s.window_vertices.shape[0],
+                                         s.window_counts.shape[0],
+                                         s.window_inlier.shape[0],
+                                         s.window_rejected.shape[0],
+                                         s.window_length.shape[0],
+                                         s.window_next.shape[0],
+                                         s.base_vertices.shape[0],
+                                         s.base_counts.shape[0],
+                                         s.n_dropped.shape[0],
+                                         s.outliers.shape[0],
+                                         s.level_vertices.shape[0],
+                                         s.level_counts.shape[0],
+                                         s.n_regions.shape[0],
+                                         s.robot_fixed_at.shape[0],
+                                         s.noise_scale.shape[0],
+                                         s.bound_events.shape[0],
+                                         s.probe_vertices.shape[0],
+                                         s.probe_counts.shape[0],
+                                         s.history_frame_bearings.shape[0],
+                                         s.history_bearings.shape[0],
+                                         s.history_length.shape[0],
+                                         s.history_next.shape[0]};
     for (size_t f = 0; f < firsts.size(); ++f) {
         if (firsts[f] != M) {
             value_error(std::string("maps.") + STATE_FIELDS[f] + " has " +
@@ -231,11 +277,11 @@ inline slam::MapState map_state_of(nb::handle obj, Kept& kept) {
         }
     }
     const std::array<int64_t, 15> landmark_axes{
-        s.counts.shape[1], s.areas.shape[1], s.centroids.shape[1], s.window_vertices.shape[2],
-        s.window_counts.shape[2], s.window_inlier.shape[2], s.base_vertices.shape[1],
-        s.base_counts.shape[1], s.n_dropped.shape[1], s.outliers.shape[1],
-        s.level_vertices.shape[1], s.level_counts.shape[1], s.n_regions.shape[1],
-        s.probe_vertices.shape[1], s.history_bearings.shape[3]};
+        s.counts.shape[1],          s.areas.shape[1],          s.centroids.shape[1],
+        s.window_vertices.shape[2], s.window_counts.shape[2],  s.window_inlier.shape[2],
+        s.base_vertices.shape[1],   s.base_counts.shape[1],    s.n_dropped.shape[1],
+        s.outliers.shape[1],        s.level_vertices.shape[1], s.level_counts.shape[1],
+        s.n_regions.shape[1],       s.probe_vertices.shape[1], s.history_bearings.shape[3]};
     for (int64_t length : landmark_axes) {
         if (length != m) {
             value_error("maps' per-landmark arrays must all map the " + std::to_string(m) +
@@ -243,8 +289,7 @@ inline slam::MapState map_state_of(nb::handle obj, Kept& kept) {
         }
     }
     const bool axes_match = s.window_counts.shape[1] == w && s.window_inlier.shape[1] == w &&
-                            s.window_rejected.shape[1] == w &&
-                            s.level_counts.shape[2] == levels &&
+                            s.window_rejected.shape[1] == w && s.level_counts.shape[2] == levels &&
                             s.history_bearings.shape[1] == h;
     if (!axes_match) value_error("maps' window, level or history axes do not match");
     for (const auto& [length, name] : {std::pair{s.base_vertices.shape[2], "base_vertices"},
@@ -272,8 +317,8 @@ inline void check_state_for(const slam::MapState& s, const slam::Params& p) {
         if (s.level_vertices.shape[2] < 1) {
             value_error("params.fusion is FUSION_ROBUST but maps have no robust levels");
         }
-        if (p.estimate_bound && (s.probe_vertices.shape[2] != slam::CAPACITY ||
-                                 s.history_bearings.shape[1] < 1)) {
+        if (p.estimate_bound &&
+            (s.probe_vertices.shape[2] != slam::CAPACITY || s.history_bearings.shape[1] < 1)) {
             value_error("params.estimate_bound is set but maps have no probe or history");
         }
     }

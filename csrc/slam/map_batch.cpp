@@ -50,12 +50,12 @@ void require_transfer(int64_t transfer) {
 }
 
 void require_policy_and_fusion(int64_t on_inconsistency, int64_t fusion) {
-    require_code(on_inconsistency == INCONSISTENCY_RESTART || on_inconsistency == INCONSISTENCY_KEEP,
-                 "on_inconsistency", "INCONSISTENCY_RESTART (0) or INCONSISTENCY_KEEP (1)",
-                 on_inconsistency);
+    require_code(
+        on_inconsistency == INCONSISTENCY_RESTART || on_inconsistency == INCONSISTENCY_KEEP,
+        "on_inconsistency", "INCONSISTENCY_RESTART (0) or INCONSISTENCY_KEEP (1)",
+        on_inconsistency);
     require_code(fusion == FUSION_INTERSECT || fusion == FUSION_RELAXED || fusion == FUSION_ROBUST,
-                 "fusion", "FUSION_INTERSECT (0), FUSION_RELAXED (1) or FUSION_ROBUST (2)",
-                 fusion);
+                 "fusion", "FUSION_INTERSECT (0), FUSION_RELAXED (1) or FUSION_ROBUST (2)", fusion);
 }
 
 void require_edge_samples(int64_t edge_samples) {
@@ -89,9 +89,9 @@ void MapSettings::validate() const {
     require_transfer(transfer);
     require_edge_samples(edge_samples);
     require_policy_and_fusion(on_inconsistency, fusion);
-    require(window >= 1 && window <= MAX_WINDOW, "window must be in [1, " +
-                                                     std::to_string(MAX_WINDOW) + "], not " +
-                                                     std::to_string(window));
+    require(
+        window >= 1 && window <= MAX_WINDOW,
+        "window must be in [1, " + std::to_string(MAX_WINDOW) + "], not " + std::to_string(window));
     require(max_outliers >= 0 && max_outliers < window,
             "max_outliers must be in [0, window = " + std::to_string(window) + "), not " +
                 std::to_string(max_outliers));
@@ -132,7 +132,9 @@ struct MapBatch::Storage {
 };
 
 MapBatch::MapBatch(int64_t num_maps, int64_t n_landmarks, const MapSettings& settings)
-    : num_maps_(num_maps), n_landmarks_(n_landmarks), settings_(settings),
+    : num_maps_(num_maps),
+      n_landmarks_(n_landmarks),
+      settings_(settings),
       storage_(std::make_unique<Storage>()) {
     require(num_maps >= 1 && num_maps <= MAX_MAPS, "num_maps must be in [1, " +
                                                        std::to_string(MAX_MAPS) + "], not " +
@@ -205,9 +207,9 @@ void MapBatch::reset() {
     fill(s.robot_area, INF);
     fill(s.robot_centroid, nan_point);
     fill(s.robot_heading, NAN_VALUE);
-    for (const auto& counter : {s.n_updates, s.n_frame_changes, s.n_inconsistent,
-                                s.window_length, s.window_next, s.robot_fixed_at,
-                                s.bound_events, s.history_length, s.history_next}) {
+    for (const auto& counter :
+         {s.n_updates, s.n_frame_changes, s.n_inconsistent, s.window_length, s.window_next,
+          s.robot_fixed_at, s.bound_events, s.history_length, s.history_next}) {
         fill(counter, int64_t{0});
     }
     for (const auto& per_landmark :
@@ -227,13 +229,13 @@ UpdateResult MapBatch::update(const std::vector<double>& bearings_start,
         {"bearings_start", &bearings_start}, {"bearings_end", &bearings_end}};
     for (const auto& [name, bearings] : inputs) {
         require(static_cast<int64_t>(bearings->size()) == size,
-                std::string(name) + " must hold num_maps x n_landmarks = " +
-                    std::to_string(size) + " bearings, not " + std::to_string(bearings->size()));
+                std::string(name) + " must hold num_maps x n_landmarks = " + std::to_string(size) +
+                    " bearings, not " + std::to_string(bearings->size()));
         for (size_t k = 0; k < bearings->size(); ++k) {
-            require(!std::isinf((*bearings)[k]),
-                    std::string(name) + "[" + std::to_string(k) + "] is " +
-                        describe((*bearings)[k]) + ": bearings must be finite or NaN (a missed "
-                        "reading)");
+            require(!std::isinf((*bearings)[k]), std::string(name) + "[" + std::to_string(k) +
+                                                     "] is " + describe((*bearings)[k]) +
+                                                     ": bearings must be finite or NaN (a missed "
+                                                     "reading)");
         }
     }
     require(threads >= 1, "threads must be at least 1, not " + std::to_string(threads));

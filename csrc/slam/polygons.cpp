@@ -403,7 +403,8 @@ double polygon_distance(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q) 
 
 double longest_edge(const cplx* poly, int64_t n) {
     double longest = 0.0;
-    for (int64_t i = 0; i < n; ++i) longest = std::max(longest, abs(poly[py_mod(i + 1, n)] - poly[i]));
+    for (int64_t i = 0; i < n; ++i)
+        longest = std::max(longest, abs(poly[py_mod(i + 1, n)] - poly[i]));
     return longest;
 }
 
@@ -481,8 +482,8 @@ int64_t drop_edges_outward(cplx* poly, int64_t n, int64_t capacity) {
     return n;
 }
 
-int64_t clip_convex(const cplx* subject, int64_t n_subject, const cplx* clipper,
-                    int64_t n_clipper, cplx* out, cplx* work) {
+int64_t clip_convex(const cplx* subject, int64_t n_subject, const cplx* clipper, int64_t n_clipper,
+                    cplx* out, cplx* work) {
     const auto [size_s, mag_s] = scale_of(subject, n_subject);
     const auto [size_c, mag_c] = scale_of(clipper, n_clipper);
     const double size = std::min(size_s, size_c);

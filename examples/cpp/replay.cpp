@@ -57,7 +57,8 @@ void read_row(const std::string& text, int line, BearingLog& log) {
         log.end.emplace_back();
     }
     const auto expected_movement = static_cast<long>(log.start.size()) - 1;
-    const auto expected_landmark = static_cast<long>(log.start.empty() ? 0 : log.start.back().size());
+    const auto expected_landmark =
+        static_cast<long>(log.start.empty() ? 0 : log.start.back().size());
     if (movement != expected_movement || landmark != expected_landmark) {
         throw std::invalid_argument("line " + std::to_string(line) + ": (movement, landmark) (" +
                                     fields[0] + ", " + fields[1] + ") out of order");
@@ -132,7 +133,8 @@ int main(int argc, char** argv) {
             settings.transfer =
                 code_of(argv[3], {"conservative", "paper", "conservative_global"}, "transfer");
         }
-        if (argc > 4) settings.fusion = code_of(argv[4], {"intersect", "relaxed", "robust"}, "fusion");
+        if (argc > 4)
+            settings.fusion = code_of(argv[4], {"intersect", "relaxed", "robust"}, "fusion");
         slam::MapBatch maps(1, log.landmarks, settings);
         for (size_t move = 0; move < log.start.size(); ++move) {
             maps.update(log.start[move], log.end[move]);

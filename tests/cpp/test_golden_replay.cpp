@@ -100,8 +100,8 @@ template <class T, int D>
 void feed(Sha256& digest, const bearing::View<T, D>& view) {
     using Element = std::remove_const_t<T>;
     constexpr bool is_complex = std::is_same_v<Element, cplx>;
-    const char* dtype = std::is_same_v<Element, bool>     ? "|b1"
-                        : std::is_same_v<Element, int8_t> ? "|i1"
+    const char* dtype = std::is_same_v<Element, bool>      ? "|b1"
+                        : std::is_same_v<Element, int8_t>  ? "|i1"
                         : std::is_same_v<Element, int64_t> ? "<i8"
                                                            : "<f8";
     digest.update(dtype + shape_text(view.shape, is_complex));

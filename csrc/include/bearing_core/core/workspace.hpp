@@ -40,7 +40,8 @@ public:
 
 private:
     void release() {
-        if (data_ != nullptr) std::allocator<T>().deallocate(data_, static_cast<std::size_t>(capacity_));
+        if (data_ != nullptr)
+            std::allocator<T>().deallocate(data_, static_cast<std::size_t>(capacity_));
         data_ = nullptr;
         capacity_ = 0;
     }

@@ -11,9 +11,9 @@
 namespace bearing::slam {
 
 // Capacities (bearing_env/slam/kernels/common.py; the Python constants are read from here).
-inline constexpr int64_t CAPACITY = 128;           // most vertices a map region holds
-inline constexpr int64_t MAX_EDGE_SAMPLES = 8;     // samples per edge, conservative transfer
-inline constexpr int64_t FR_VERTICES = 4;          // a robot-frame region is at most a quadrangle
+inline constexpr int64_t CAPACITY = 128;        // most vertices a map region holds
+inline constexpr int64_t MAX_EDGE_SAMPLES = 8;  // samples per edge, conservative transfer
+inline constexpr int64_t FR_VERTICES = 4;       // a robot-frame region is at most a quadrangle
 inline constexpr int64_t MAX_SAMPLES = FR_VERTICES * MAX_EDGE_SAMPLES;
 inline constexpr int64_t MAX_PAIRS = MAX_SAMPLES * MAX_SAMPLES;
 inline constexpr int64_t SCRATCH = 2 * CAPACITY + 8;
@@ -73,40 +73,40 @@ enum Fusion : int64_t { FUSION_INTERSECT = 0, FUSION_RELAXED = 1, FUSION_ROBUST 
 // list of them: X(element type, dimensions, name) per field, in State's order; MapState,
 // for_each_field and the bindings' field names are made from it.
 #define BEARING_CORE_MAP_STATE(X)                                          \
-    X(cplx, 3, vertices)                /* (maps, m, CAPACITY) */          \
-    X(int64_t, 2, counts)               /* (maps, m) */                    \
-    X(double, 2, areas)                 /* (maps, m) */                    \
-    X(cplx, 2, centroids)               /* (maps, m) */                    \
-    X(cplx, 2, robot_vertices)          /* (maps, CAPACITY) */             \
-    X(int64_t, 1, robot_counts)         /* (maps,) */                      \
-    X(double, 1, robot_area)            /* (maps,) */                      \
-    X(cplx, 1, robot_centroid)          /* (maps,) */                      \
-    X(double, 1, robot_heading)         /* (maps,) */                      \
-    X(int64_t, 1, n_updates)            /* (maps,) */                      \
-    X(int64_t, 1, n_frame_changes)      /* (maps,) */                      \
-    X(int64_t, 1, n_inconsistent)       /* (maps,) */                      \
-    X(cplx, 4, window_vertices)         /* (maps, w, m, CAPACITY) */       \
-    X(int64_t, 3, window_counts)        /* (maps, w, m) */                 \
-    X(bool, 3, window_inlier)           /* (maps, w, m) */                 \
-    X(bool, 2, window_rejected)         /* (maps, w) */                    \
-    X(int64_t, 1, window_length)        /* (maps,) */                      \
-    X(int64_t, 1, window_next)          /* (maps,) */                      \
-    X(cplx, 3, base_vertices)           /* (maps, m, CAPACITY or 0) */     \
-    X(int64_t, 2, base_counts)          /* (maps, m) */                    \
-    X(int64_t, 2, n_dropped)            /* (maps, m) */                    \
-    X(int64_t, 2, outliers)             /* (maps, m) */                    \
-    X(cplx, 4, level_vertices)          /* (maps, m, levels, CAPACITY) */  \
-    X(int64_t, 3, level_counts)         /* (maps, m, levels) */            \
-    X(int64_t, 2, n_regions)            /* (maps, m) */                    \
-    X(int64_t, 1, robot_fixed_at)       /* (maps,) */                      \
-    X(double, 1, noise_scale)           /* (maps,) */                      \
-    X(int64_t, 1, bound_events)         /* (maps,) */                      \
-    X(cplx, 3, probe_vertices)          /* (maps, m, CAPACITY or 0) */     \
-    X(int64_t, 2, probe_counts)         /* (maps, m) */                    \
+    X(cplx, 3, vertices)                 /* (maps, m, CAPACITY) */         \
+    X(int64_t, 2, counts)                /* (maps, m) */                   \
+    X(double, 2, areas)                  /* (maps, m) */                   \
+    X(cplx, 2, centroids)                /* (maps, m) */                   \
+    X(cplx, 2, robot_vertices)           /* (maps, CAPACITY) */            \
+    X(int64_t, 1, robot_counts)          /* (maps,) */                     \
+    X(double, 1, robot_area)             /* (maps,) */                     \
+    X(cplx, 1, robot_centroid)           /* (maps,) */                     \
+    X(double, 1, robot_heading)          /* (maps,) */                     \
+    X(int64_t, 1, n_updates)             /* (maps,) */                     \
+    X(int64_t, 1, n_frame_changes)       /* (maps,) */                     \
+    X(int64_t, 1, n_inconsistent)        /* (maps,) */                     \
+    X(cplx, 4, window_vertices)          /* (maps, w, m, CAPACITY) */      \
+    X(int64_t, 3, window_counts)         /* (maps, w, m) */                \
+    X(bool, 3, window_inlier)            /* (maps, w, m) */                \
+    X(bool, 2, window_rejected)          /* (maps, w) */                   \
+    X(int64_t, 1, window_length)         /* (maps,) */                     \
+    X(int64_t, 1, window_next)           /* (maps,) */                     \
+    X(cplx, 3, base_vertices)            /* (maps, m, CAPACITY or 0) */    \
+    X(int64_t, 2, base_counts)           /* (maps, m) */                   \
+    X(int64_t, 2, n_dropped)             /* (maps, m) */                   \
+    X(int64_t, 2, outliers)              /* (maps, m) */                   \
+    X(cplx, 4, level_vertices)           /* (maps, m, levels, CAPACITY) */ \
+    X(int64_t, 3, level_counts)          /* (maps, m, levels) */           \
+    X(int64_t, 2, n_regions)             /* (maps, m) */                   \
+    X(int64_t, 1, robot_fixed_at)        /* (maps,) */                     \
+    X(double, 1, noise_scale)            /* (maps,) */                     \
+    X(int64_t, 1, bound_events)          /* (maps,) */                     \
+    X(cplx, 3, probe_vertices)           /* (maps, m, CAPACITY or 0) */    \
+    X(int64_t, 2, probe_counts)          /* (maps, m) */                   \
     X(double, 4, history_frame_bearings) /* (maps, h, 2, 2) */             \
-    X(double, 4, history_bearings)      /* (maps, h, 2, m) */              \
-    X(int64_t, 1, history_length)       /* (maps,) */                      \
-    X(int64_t, 1, history_next)         /* (maps,) */
+    X(double, 4, history_bearings)       /* (maps, h, 2, m) */             \
+    X(int64_t, 1, history_length)        /* (maps,) */                     \
+    X(int64_t, 1, history_next)          /* (maps,) */
 
 struct MapState {
 #define BEARING_CORE_DECLARE_FIELD(T, D, name) View<T, D> name;
