@@ -29,6 +29,8 @@ namespace {
 
 using bearing::cplx;
 using bearing::View1;
+using bearing::bindings::extent_of;
+using bearing::bindings::require_apart;
 using bearing::bindings::value_error;
 using bearing::bindings::view_of;
 
@@ -110,6 +112,7 @@ int64_t convex_hull(nb::handle points_obj, int64_t n_points, nb::handle out_obj)
     const Out out = output(out_obj, "out");
     check_count(n_points, "n_points", points.shape[0], "points");
     check_room(n_points + 1, out.shape[0], "out");
+    require_apart({extent_of(points, "points"), extent_of(out, "out")});
     return bearing::slam::convex_hull(points.data, n_points, out.data);
 }
 
@@ -118,6 +121,7 @@ int64_t small_convex_hull(nb::handle points_obj, int64_t n_points, nb::handle ou
     const Out out = output(out_obj, "out");
     check_count(n_points, "n_points", points.shape[0], "points");
     check_room(n_points + 1, out.shape[0], "out");
+    require_apart({extent_of(points, "points"), extent_of(out, "out")});
     return bearing::slam::small_convex_hull(points.data, n_points, out.data, tol);
 }
 
@@ -127,6 +131,7 @@ int64_t small_hull_indices(nb::handle points_obj, int64_t n_points, nb::handle o
     const View1<int64_t> out = view_of<int64_t, 1>(out_obj, "out");
     check_count(n_points, "n_points", points.shape[0], "points");
     check_room(n_points + 1, out.shape[0], "out");
+    require_apart({extent_of(points, "points"), extent_of(out, "out")});
     return bearing::slam::small_hull_indices(points.data, n_points, out.data, tol);
 }
 
@@ -179,6 +184,8 @@ int64_t clip_convex(nb::handle subject_obj, int64_t n_subject, nb::handle clippe
     check_count(n_clipper, "n_clipper", clipper.shape[0], "clipper", 1);
     check_room(bearing::slam::SCRATCH, out.shape[0], "out");
     check_room(bearing::slam::SCRATCH, work.shape[0], "work");
+    require_apart({extent_of(subject, "subject"), extent_of(clipper, "clipper"),
+                   extent_of(out, "out"), extent_of(work, "work")});
     return bearing::slam::clip_convex(subject.data, n_subject, clipper.data, n_clipper, out.data,
                                       work.data);
 }
@@ -189,6 +196,7 @@ int64_t offset_outward(nb::handle poly_obj, int64_t n, double radius, nb::handle
     check_count(n, "n", poly.shape[0], "poly");
     if (n < 1) value_error("offset_outward needs n >= 1");
     check_room(n + 3, out.shape[0], "out");
+    require_apart({extent_of(poly, "poly"), extent_of(out, "out")});
     return bearing::slam::offset_outward(poly.data, n, radius, out.data);
 }
 
@@ -208,6 +216,7 @@ int64_t boundary_samples(nb::handle poly_obj, int64_t n, int64_t per_edge, nb::h
     const Out out = output(out_obj, "out");
     check_count(n, "n", poly.shape[0], "poly");
     check_room(product(n, per_edge), out.shape[0], "out");
+    require_apart({extent_of(poly, "poly"), extent_of(out, "out")});
     return bearing::slam::boundary_samples(poly.data, n, per_edge, out.data);
 }
 
@@ -237,6 +246,8 @@ int64_t sample_hypotheses(nb::handle a1_obj, int64_t n1, nb::handle a2_obj, int6
         check_room(pairs, h1.shape[0], "h1");
         check_room(pairs, inv_d.shape[0], "inv_d");
     }
+    require_apart(
+        {extent_of(a1, "a1"), extent_of(a2, "a2"), extent_of(h1, "h1"), extent_of(inv_d, "inv_d")});
     return bearing::slam::sample_hypotheses(a1.data, n1, a2.data, n2, per_edge, h1.data,
                                             inv_d.data);
 }
@@ -286,6 +297,10 @@ int64_t transfer_region(nb::handle target_obj, int64_t n_target, nb::handle fram
         check_room(k + 1, hull.shape[0], "hull");
         check_room(bearing::slam::SCRATCH, out.shape[0], "out");
     }
+    require_apart({extent_of(target, "target"), extent_of(a1, "frame.a1"),
+                   extent_of(a2, "frame.a2"), extent_of(h1, "frame.h1"),
+                   extent_of(inv_d, "frame.inv_d"), extent_of(cloud, "cloud"),
+                   extent_of(hull, "hull"), extent_of(out, "out")});
     return bearing::slam::transfer_region(target.data, n_target, change, cloud.data, hull.data,
                                           out.data);
 }

@@ -21,6 +21,7 @@
 #include <bearing_core/slam/state.hpp>
 #include <bearing_core/slam/update.hpp>
 #include "bindings/arrays.hpp"
+#include "bindings/state_args.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -32,14 +33,8 @@ using bearing::bindings::value_error;
 using bearing::bindings::view_of;
 namespace slam = bearing::slam;
 
-// The fields of bearing_env.slam.kernels.State, in its order (slam/state.hpp's list).
-constexpr const char* STATE_FIELDS[] = {
-#define BEARING_CORE_FIELD_NAME(T, D, name) #name,
-    BEARING_CORE_MAP_STATE(BEARING_CORE_FIELD_NAME)
-#undef BEARING_CORE_FIELD_NAME
-};
-constexpr size_t N_FIELDS = sizeof(STATE_FIELDS) / sizeof(STATE_FIELDS[0]);
-static_assert(N_FIELDS == 34, "State has 34 fields");
+using bearing::bindings::N_STATE_FIELDS;
+using bearing::bindings::STATE_FIELDS;
 
 // A batch's state as the native update takes it: checked views of the 34 arrays of a
 // bearing_env.slam.kernels.State, and a reference to the tuple (the arrays stay alive).
@@ -53,24 +48,8 @@ struct PyMapState {
     int64_t history = 0;  // h
 };
 
-// The field `name` (index k) of the state tuple, as a view (shape checked against expect).
-template <class T, int D>
-bearing::View<T, D> field(nb::handle state, size_t k, const std::array<int64_t, D>& expect) {
-    const std::string name = std::string("state.") + STATE_FIELDS[k];
-    return view_of<T, D>(state[k], name.c_str(), expect);
-}
-
 void require(bool ok, const std::string& message) {
     if (!ok) value_error(message);
-}
-
-// Vertex axis of a per-landmark polygon array that may be left empty (0) by fusions
-// that do not use it.
-void check_vertex_axis(int64_t length, const char* name, bool may_be_empty) {
-    if (length == slam::CAPACITY || (may_be_empty && length == 0)) return;
-    value_error(std::string("state.") + name + " must have " + std::to_string(slam::CAPACITY) +
-                (may_be_empty ? " (or 0)" : "") + " vertex slots on its last axis, not " +
-                std::to_string(length));
 }
 
 void init_map_state(PyMapState* self, nb::handle state) {
@@ -80,112 +59,29 @@ void init_map_state(PyMapState* self, nb::handle state) {
                                       nb::type_name(state.type()).c_str());
     }
     const size_t size = nb::len(state);
-    if (size != N_FIELDS) {
-        value_error("state must have the " + std::to_string(N_FIELDS) +
+    if (size != N_STATE_FIELDS) {
+        value_error("state must have the " + std::to_string(N_STATE_FIELDS) +
                     " fields of bearing_env.slam.kernels.State, not " + std::to_string(size));
     }
     // Field names, when the tuple has them (a State namedtuple): in State's order.
     if (nb::hasattr(state, "_fields")) {
         nb::tuple names = nb::cast<nb::tuple>(state.attr("_fields"));
-        for (size_t k = 0; k < N_FIELDS; ++k) {
+        for (size_t k = 0; k < N_STATE_FIELDS; ++k) {
             if (nb::cast<std::string>(names[k]) != STATE_FIELDS[k]) {
                 value_error(std::string("state field ") + std::to_string(k) + " must be " +
                             STATE_FIELDS[k] + ", not " + nb::cast<std::string>(names[k]));
             }
         }
     }
-    slam::MapState v;
-    constexpr int64_t any = -1;
-    const int64_t cap = slam::CAPACITY;
-    v.vertices = field<cplx, 3>(state, 0, {any, any, cap});
-    const int64_t n = v.vertices.shape[0], m = v.vertices.shape[1];
-    v.counts = field<int64_t, 2>(state, 1, {n, m});
-    v.areas = field<double, 2>(state, 2, {n, m});
-    v.centroids = field<cplx, 2>(state, 3, {n, m});
-    v.robot_vertices = field<cplx, 2>(state, 4, {n, cap});
-    v.robot_counts = field<int64_t, 1>(state, 5, {n});
-    v.robot_area = field<double, 1>(state, 6, {n});
-    v.robot_centroid = field<cplx, 1>(state, 7, {n});
-    v.robot_heading = field<double, 1>(state, 8, {n});
-    v.n_updates = field<int64_t, 1>(state, 9, {n});
-    v.n_frame_changes = field<int64_t, 1>(state, 10, {n});
-    v.n_inconsistent = field<int64_t, 1>(state, 11, {n});
-    v.window_vertices = field<cplx, 4>(state, 12, {n, any, m, cap});
-    const int64_t w = v.window_vertices.shape[1];
-    v.window_counts = field<int64_t, 3>(state, 13, {n, w, m});
-    v.window_inlier = field<bool, 3>(state, 14, {n, w, m});
-    v.window_rejected = field<bool, 2>(state, 15, {n, w});
-    v.window_length = field<int64_t, 1>(state, 16, {n});
-    v.window_next = field<int64_t, 1>(state, 17, {n});
-    v.base_vertices = field<cplx, 3>(state, 18, {n, m, any});
-    v.base_counts = field<int64_t, 2>(state, 19, {n, m});
-    v.n_dropped = field<int64_t, 2>(state, 20, {n, m});
-    v.outliers = field<int64_t, 2>(state, 21, {n, m});
-    v.level_vertices = field<cplx, 4>(state, 22, {n, m, any, cap});
-    const int64_t levels = v.level_vertices.shape[2];
-    v.level_counts = field<int64_t, 3>(state, 23, {n, m, levels});
-    v.n_regions = field<int64_t, 2>(state, 24, {n, m});
-    v.robot_fixed_at = field<int64_t, 1>(state, 25, {n});
-    v.noise_scale = field<double, 1>(state, 26, {n});
-    v.bound_events = field<int64_t, 1>(state, 27, {n});
-    v.probe_vertices = field<cplx, 3>(state, 28, {n, m, any});
-    v.probe_counts = field<int64_t, 2>(state, 29, {n, m});
-    v.history_frame_bearings = field<double, 4>(state, 30, {n, any, 2, 2});
-    const int64_t h = v.history_frame_bearings.shape[1];
-    v.history_bearings = field<double, 4>(state, 31, {n, h, 2, m});
-    v.history_length = field<int64_t, 1>(state, 32, {n});
-    v.history_next = field<int64_t, 1>(state, 33, {n});
-    // view_of skips axes of expected length 0 (0 = any), so the 0-length cases of the
-    // consistency checks are spelled out here.
-    auto axis = [&](int64_t got, int64_t want, const char* name, int d) {
-        require(got == want, std::string("state.") + name + " has axis " + std::to_string(d) +
-                                 " of length " + std::to_string(got) + ", expected " +
-                                 std::to_string(want));
-    };
-    axis(v.counts.shape[0], n, "counts", 0);
-    axis(v.counts.shape[1], m, "counts", 1);
-    for (size_t k = 1; k < N_FIELDS; ++k) {
-        nb::handle array = state[k];
-        const int64_t first = nb::cast<int64_t>(array.attr("shape")[0]);
-        axis(first, n, STATE_FIELDS[k], 0);
-    }
-    const std::pair<const char*, int64_t> landmark_axes[] = {
-        {"areas", v.areas.shape[1]},
-        {"centroids", v.centroids.shape[1]},
-        {"window_vertices", v.window_vertices.shape[2]},
-        {"window_counts", v.window_counts.shape[2]},
-        {"window_inlier", v.window_inlier.shape[2]},
-        {"base_vertices", v.base_vertices.shape[1]},
-        {"base_counts", v.base_counts.shape[1]},
-        {"n_dropped", v.n_dropped.shape[1]},
-        {"outliers", v.outliers.shape[1]},
-        {"level_vertices", v.level_vertices.shape[1]},
-        {"level_counts", v.level_counts.shape[1]},
-        {"n_regions", v.n_regions.shape[1]},
-        {"probe_vertices", v.probe_vertices.shape[1]},
-        {"probe_counts", v.probe_counts.shape[1]},
-        {"history_bearings", v.history_bearings.shape[3]},
-    };
-    for (const auto& [name, length] : landmark_axes) {
-        require(length == m, std::string("state.") + name + " must have the " + std::to_string(m) +
-                                 " landmarks of state.vertices on its "
-                                 "landmark axis, not " +
-                                 std::to_string(length));
-    }
-    axis(v.window_counts.shape[1], w, "window_counts", 1);
-    axis(v.window_inlier.shape[1], w, "window_inlier", 1);
-    axis(v.window_rejected.shape[1], w, "window_rejected", 1);
-    axis(v.level_counts.shape[2], levels, "level_counts", 2);
-    axis(v.history_bearings.shape[1], h, "history_bearings", 1);
-    check_vertex_axis(v.base_vertices.shape[2], "base_vertices", true);
-    check_vertex_axis(v.probe_vertices.shape[2], "probe_vertices", true);
-    require(w <= slam::MAX_WINDOW, "state.window_vertices has a window of " + std::to_string(w) +
-                                       " movements, more than MAX_WINDOW (" +
-                                       std::to_string(slam::MAX_WINDOW) + ")");
-    require(m + 2 <= slam::MAX_LANDMARKS,
-            "state.vertices has " + std::to_string(m) + " mapped landmarks, more than " +
-                std::to_string(slam::MAX_LANDMARKS - 2) + " (MAX_LANDMARKS - 2)");
-    new (self) PyMapState{nb::borrow<nb::object>(state), v, n, m, w, levels, h};
+    bearing::bindings::Kept kept;  // (the tuple keeps its arrays alive)
+    const auto parsed = bearing::bindings::parse_map_state(state, true, "state", kept);
+    new (self) PyMapState{nb::borrow<nb::object>(state),
+                          parsed.views,
+                          parsed.maps,
+                          parsed.mapped,
+                          parsed.window,
+                          parsed.levels,
+                          parsed.history};
 }
 
 // One update call's settings (bearing_env.slam.kernels.Params), validated by the
@@ -208,29 +104,6 @@ slam::Params make_params(double epsilon, int64_t transfer, int64_t edge_samples,
     return p;
 }
 
-// What the fusion in `params` needs of the state's optional arrays.
-void check_state_for(const PyMapState& s, const slam::Params& p) {
-    if (p.fusion == slam::FUSION_RELAXED) {
-        require(s.window >= 1,
-                "state has no relaxed window (state.window_vertices axis 1 is "
-                "0), but params.fusion is FUSION_RELAXED");
-        require(s.views.base_vertices.shape[2] == slam::CAPACITY,
-                "state.base_vertices has no vertex slots, but params.fusion is FUSION_RELAXED");
-    }
-    if (p.fusion == slam::FUSION_ROBUST) {
-        require(s.levels >= 1,
-                "state has no robust levels (state.level_vertices axis 2 is 0), "
-                "but params.fusion is FUSION_ROBUST");
-        if (p.estimate_bound) {
-            require(s.views.probe_vertices.shape[2] == slam::CAPACITY,
-                    "state.probe_vertices has no vertex slots, but params.estimate_bound is set");
-            require(s.history >= 1,
-                    "state has no bearing history (state.history_bearings "
-                    "axis 1 is 0), but params.estimate_bound is set");
-        }
-    }
-}
-
 void update_maps_binding(nb::handle bearings_start, nb::handle bearings_end, nb::handle rows,
                          const slam::Params& params, const PyMapState& state, nb::handle out,
                          int64_t threads) {
@@ -240,10 +113,6 @@ void update_maps_binding(nb::handle bearings_start, nb::handle bearings_end, nb:
     const int64_t n_rows = rows_view.shape[0];
     auto start = view_of<const double, 2>(bearings_start, "bearings_start", {n_rows, n_landmarks});
     auto end = view_of<const double, 2>(bearings_end, "bearings_end", {n_rows, n_landmarks});
-    // view_of treats an expected 0 as "any": spell out the zero-row case.
-    require(start.shape[0] == n_rows && end.shape[0] == n_rows,
-            "bearings_start and bearings_end must have one row per entry of rows (" +
-                std::to_string(n_rows) + ")");
     if (!nb::isinstance<nb::tuple>(out) || nb::len(out) != 3) {
         bearing::bindings::type_error(
             "out must be a bearing_env.slam.kernels.Outputs tuple "
@@ -259,7 +128,7 @@ void update_maps_binding(nb::handle bearings_start, nb::handle bearings_end, nb:
                 ") and out.landmark_status one column per mapped landmark (" + std::to_string(m) +
                 ")");
     require(threads >= 1, "threads must be at least 1, not " + std::to_string(threads));
-    check_state_for(state, params);
+    bearing::bindings::check_state_for(state.views, params);
     for (int64_t i = 0; i < n_rows; ++i) {
         const int64_t row = rows_view(i);
         if (row < 0 || row >= state.maps) {
@@ -370,12 +239,10 @@ void contains_points_binding(nb::handle vertices, nb::handle counts, nb::handle 
     auto r = view_of<const int64_t, 1>(rows, "rows");
     auto p = view_of<const cplx, 2>(points, "points", {r.shape[0], c.shape[1]});
     auto o = view_of<bool, 2>(out, "out", {p.shape[0], p.shape[1]});
-    require(c.shape[0] == v.shape[0] && c.shape[1] == v.shape[1],
-            "counts must have the shape of vertices' first two axes");
-    require(p.shape[0] == r.shape[0] && p.shape[1] == c.shape[1],
-            "points must have one row per entry of rows and one column per landmark");
-    require(o.shape[0] == p.shape[0] && o.shape[1] == p.shape[1],
-            "out must have the shape of points");
+    bearing::bindings::require_apart(
+        {bearing::bindings::extent_of(v, "vertices"), bearing::bindings::extent_of(c, "counts"),
+         bearing::bindings::extent_of(r, "rows"), bearing::bindings::extent_of(p, "points"),
+         bearing::bindings::extent_of(o, "out")});
     for (int64_t i = 0; i < r.shape[0]; ++i) {
         if (r(i) < 0 || r(i) >= v.shape[0]) {
             value_error("rows must be map indices in [0, " + std::to_string(v.shape[0]) +

@@ -41,10 +41,6 @@ struct MapSettings {
     Params params(bool with_robot) const;
 };
 
-// Throws std::invalid_argument naming the first bad value of one update call's settings
-// (the bindings' Params and MapSettings::params both pass through it).
-void validate(const Params& params);
-
 // What one update did to each map (bearing_env.slam.BatchUpdateResult).
 struct UpdateResult {
     std::vector<int8_t> frame_status;     // (maps,) a FrameStatus

@@ -136,6 +136,10 @@ struct Params {
     bool estimate_bound = false;   // robust fusion: estimate the noise bound
 };
 
+// Throws std::invalid_argument naming the first bad value of one update call's settings
+// (MapSettings::params and the bindings' Params all pass through it; map_batch.cpp).
+void validate(const Params& params);
+
 // What one call did, per bearings row i (bearing_env.slam.kernels.Outputs).
 struct Outputs {
     View1<int8_t> frame_status;     // (rows,)
