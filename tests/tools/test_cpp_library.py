@@ -184,3 +184,18 @@ def test_the_replay_prints_the_regions_python_computes_from_the_same_log(
     areas = [float(line.split()[5].rstrip(",")) for line in library_build.replay.splitlines()
              if line.startswith("# landmark ")]  # fmt: skip
     assert areas == maps.areas[0].tolist()
+
+
+def test_configuring_without_a_compiler_says_so_in_one_sentence(tmp_path: Path) -> None:
+    # An sdist installed where there is no C++ compiler: CMake stops with the project's
+    # own message, not a failed compiler test.
+    result = subprocess.run(
+        ["cmake", "-S", str(ROOT), "-B", str(tmp_path / "build"), "-G", "Ninja",
+         "-DBEARING_ENV_PYTHON=OFF"],
+        capture_output=True, text=True, timeout=120,
+        env={**os.environ, "PATH": PATH, "CXX": str(tmp_path / "no-such-compiler")},
+    )  # fmt: skip
+    assert result.returncode != 0
+    output = " ".join((result.stdout + result.stderr).split())
+    assert "bearing_env needs a C++17 compiler to build from source, and found none" in output
+    assert "is not able to compile a simple test program" not in output
