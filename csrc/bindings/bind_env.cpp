@@ -392,6 +392,13 @@ int64_t decode_with(nb::handle actions, double lo, double hi, nb::handle turns,
 }  // namespace
 
 void bind_env(nb::module_& m) {
+    // The observation's block sizes and the shape block's limit (observations.py checks its
+    // feature names against the blocks, and reads the limit).
+    m.attr("ROBOT_BLOCK") = env::ROBOT_FEATURES;
+    m.attr("LANDMARK_BLOCK") = env::LANDMARK_FEATURES;
+    m.attr("BEARING_BLOCK") = env::BEARING_FEATURES;
+    m.attr("SHAPE_BLOCK") = env::SHAPE_FEATURES;
+    m.attr("ELONGATION_LIMIT") = env::ELONGATION_LIMIT;
     m.attr("STEP_DONE") = static_cast<int64_t>(env::STEP_DONE);
     m.attr("STEP_NEEDS_NOISE") = static_cast<int64_t>(env::STEP_NEEDS_NOISE);
     m.attr("STEP_NEEDS_TRAJECTORY") = static_cast<int64_t>(env::STEP_NEEDS_TRAJECTORY);

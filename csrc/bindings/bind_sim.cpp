@@ -44,6 +44,7 @@ void check_same_shape(const std::array<int64_t, 2>& shape, const std::array<int6
 
 void bind_sim(nb::module_& m) {
     namespace sim = bearing::sim;
+    m.attr("CONTACT_SLACK") = sim::CONTACT_SLACK;  // bearing_env.sensing reads it
 
     // bearing_env/world.py
     m.def(
