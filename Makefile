@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 # of bearing_env (setuptools package-dir), so the view links them in under that name.
 TYPECHECK_VIEW := $(VENV)/typecheck
 
-.PHONY: test test-slow demo docs lint typecheck format format-check bench bench-slam clean native
+.PHONY: test test-slow demo docs lint typecheck format format-check bench bench-slam clean native wheel
 
 # The native core's sources: any change rebuilds the extension before a test or demo runs,
 # so no stale binary is ever tested.
@@ -53,6 +53,16 @@ demo: $(NATIVE)
 docs: $(NATIVE)
 	$(PY) -m sphinx -W --keep-going -q -j auto -b html docs docs/_build/html
 	@echo "docs/_build/html/index.html"
+
+# A wheel of this checkout for this machine, repaired by auditwheel to the manylinux tag
+# its symbols allow (DIST/, default dist/): the wheel PyPI users install without a compiler.
+DIST ?= dist
+wheel: $(STAMP)
+	rm -rf $(DIST)/raw
+	$(PY) -m pip wheel --quiet --no-deps --no-build-isolation -Cbuild-dir=build/wheel \
+		-w $(DIST)/raw .
+	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(PY) -m auditwheel repair -w $(DIST) $(DIST)/raw/*.whl
+	rm -rf $(DIST)/raw
 
 bench: $(NATIVE)
 	$(PY) -m bearing_env.benchmarks.bench_env

@@ -63,6 +63,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "make lint": ("make", ()),
     "make native": ("make", ()),
     "make format": ("make", ()),
+    "make wheel": ("make", ()),
     "bearing-env train": ("parse", ("--algo", "ppo")),
     "bearing-env figures": ("parse", ()),
     "bearing-env demo": ("run", ("--episodes", "1", "--moves", "3")),
