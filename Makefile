@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 # of bearing_env (setuptools package-dir), so the view links them in under that name.
 TYPECHECK_VIEW := $(VENV)/typecheck
 
-.PHONY: test test-slow demo docs lint typecheck bench bench-slam clean native
+.PHONY: test test-slow demo docs lint typecheck format format-check bench bench-slam clean native wheel
 
 # The native core's sources: any change rebuilds the extension before a test or demo runs,
 # so no stale binary is ever tested.
@@ -36,7 +36,7 @@ $(NATIVE): $(STAMP) $(NATIVE_SOURCES)
 native: $(NATIVE)
 
 # Two workers, one per core; a test module stays on one worker (its fixtures run once).
-test: $(NATIVE) lint typecheck
+test: $(NATIVE) lint typecheck format-check
 	SDL_VIDEODRIVER=dummy $(PY) -m pytest -q -m "not slow" -n 2 --dist loadfile
 
 # The tests `make test` leaves out (marked slow): each costs minutes (the sdist's own test
@@ -54,11 +54,29 @@ docs: $(NATIVE)
 	$(PY) -m sphinx -W --keep-going -q -j auto -b html docs docs/_build/html
 	@echo "docs/_build/html/index.html"
 
+# A wheel of this checkout for this machine, repaired by auditwheel to the manylinux tag
+# its symbols allow (DIST/, default dist/): the wheel PyPI users install without a compiler.
+DIST ?= dist
+wheel: $(STAMP)
+	rm -rf $(DIST)/raw
+	$(PY) -m pip wheel --quiet --no-deps --no-build-isolation -Cbuild-dir=build/wheel \
+		-w $(DIST)/raw .
+	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(PY) -m auditwheel repair -w $(DIST) $(DIST)/raw/*.whl
+	rm -rf $(DIST)/raw
+
 bench: $(NATIVE)
 	$(PY) -m bearing_env.benchmarks.bench_env
 
 bench-slam: $(NATIVE)
 	$(PY) -m bearing_env.benchmarks.bench_slam
+
+# The C++ sources' style (.clang-format), with the clang-format pinned in constraints.txt.
+CPP_SOURCES := $(shell find csrc tests/cpp examples/cpp -name '*.cpp' -o -name '*.hpp' 2>/dev/null)
+format-check: $(STAMP)
+	$(VENV)/bin/clang-format --style=file --dry-run --Werror $(CPP_SOURCES)
+
+format: $(STAMP)
+	$(VENV)/bin/clang-format --style=file -i $(CPP_SOURCES)
 
 lint: $(STAMP)
 	$(PY) -m ruff check bearing_env agents train tests benchmarks docs/conf.py

@@ -12,6 +12,12 @@ class CapacityError(RuntimeError):
 # ---- The batched map update (csrc/bindings/bind_slam_update.cpp; keep in step with it) ----
 
 CAPACITY: int
+CONTACT_SLACK: float
+ELONGATION_LIMIT: float
+ROBOT_BLOCK: int
+LANDMARK_BLOCK: int
+BEARING_BLOCK: int
+SHAPE_BLOCK: int
 MAX_EDGE_SAMPLES: int
 FR_VERTICES: int
 MAX_SAMPLES: int

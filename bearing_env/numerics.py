@@ -2,7 +2,7 @@
 (``bearing_env.slam``): this module sits below both, so neither imports the other.
 
 * :func:`wrap`: one angle wrapped to [-pi, pi), native (the same function as the C++
-  kernels use, ``csrc/core/pymath.hpp``);
+  kernels use, ``csrc/include/bearing_core/core/pymath.hpp``);
 * :func:`wrap_angle`: the same for arrays, in numpy.
 """
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from bearing_env import _core
 from bearing_env._core import _cross as _cross
 from bearing_env._core import _disc_entry as _disc_entry
 from bearing_env._core import _edge_entry as _edge_entry
@@ -39,8 +40,8 @@ IntArray = NDArray[np.int64]
 Packed = tuple[FloatArray, IntArray]
 
 #: Rounding slack (metres) of the contact tests: a robot left a hair inside an obstacle's
-#: margin by rounding counts as touching it.
-CONTACT_SLACK = 1e-12
+#: margin by rounding counts as touching it (the native core's value, read from it).
+CONTACT_SLACK: float = _core.CONTACT_SLACK
 
 
 def pack_polygons(polygons: tuple[tuple[tuple[float, float], ...], ...]) -> Packed:

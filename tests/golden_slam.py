@@ -28,6 +28,7 @@ import itertools
 import json
 import sys
 from collections import Counter
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -114,22 +115,25 @@ def _feed(digest: Any, array: np.ndarray) -> None:
     digest.update(array.tobytes())
 
 
-def case_hash(case: Case, seed: int, seen: Counter[str] | None = None) -> str:
-    """The sha256 of a case's whole run (every state and result after every movement);
-    ``seen`` counts the frame and landmark statuses met, and the robust bound's growths."""
-    rng = np.random.default_rng(seed)
-    epsilon = np.deg2rad(case.epsilon_deg)
-    maps = BatchedPolygonSLAM(
-        case.maps, case.n_landmarks, epsilon, transfer=case.transfer,
+def new_maps(case: Case) -> BatchedPolygonSLAM:
+    """The case's batch of empty maps."""
+    return BatchedPolygonSLAM(
+        case.maps, case.n_landmarks, np.deg2rad(case.epsilon_deg), transfer=case.transfer,
         edge_samples=case.edge_samples, on_inconsistency=case.on_inconsistency,
         fusion=case.fusion, robust_set=case.robust_set, noise_bound=case.noise_bound,
     )  # fmt: skip
+
+
+def movements(case: Case, seed: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """The case's bearings, (maps, n_landmarks) at R1 and at R2, movement by movement
+    (drawn from ``seed`` as they are fed, in this order)."""
+    rng = np.random.default_rng(seed)
+    epsilon = np.deg2rad(case.epsilon_deg)
     episodes = [
         random_episode(rng, case.n_landmarks, case.moves, length_range=case.length_range)
         for _ in range(case.maps)
     ]
     readings = [episode.readings(case.noise_factor * epsilon) for episode in episodes]
-    digest = hashlib.sha256()
     for move in range(case.moves):
         b1 = np.array([readings[k][move][0] for k in range(case.maps)])
         b2 = np.array([readings[k][move][1] for k in range(case.maps)])
@@ -137,6 +141,18 @@ def case_hash(case: Case, seed: int, seen: Counter[str] | None = None) -> str:
             outliers = rng.random(bearings.shape) < case.outlier_rate
             bearings[outliers] = wrap(rng.uniform(-np.pi, np.pi, int(outliers.sum())))
             bearings[rng.random(bearings.shape) < case.missing_rate] = np.nan
+        yield b1, b2
+
+
+def run_hash(
+    maps: BatchedPolygonSLAM,
+    moves: Iterable[tuple[np.ndarray, np.ndarray]],
+    seen: Counter[str] | None = None,
+) -> str:
+    """The sha256 of ``maps``' run through ``moves`` (every update's result and every
+    state array after every movement); ``seen`` counts the statuses met."""
+    digest = hashlib.sha256()
+    for b1, b2 in moves:
         result = maps.update(b1, b2)
         if seen is not None:
             seen.update(f"frame {FRAME_STATUSES[c]}" for c in result.frame_status)
@@ -145,17 +161,27 @@ def case_hash(case: Case, seed: int, seen: Counter[str] | None = None) -> str:
             _feed(digest, np.asarray(value))
         for name in maps.state_names:
             _feed(digest, getattr(maps, name))
-    if seen is not None and case.fusion == "robust":
-        seen["robust bound growths"] += int(np.sum(maps.bound_events > 0))
     return digest.hexdigest()
 
 
+def case_hash(case: Case, seed: int, seen: Counter[str] | None = None) -> str:
+    """The sha256 of a case's whole run (every state and result after every movement);
+    ``seen`` counts the frame and landmark statuses met, and the robust bound's growths."""
+    maps = new_maps(case)
+    digest = run_hash(maps, movements(case, seed), seen)
+    if seen is not None and case.fusion == "robust":
+        seen["robust bound growths"] += int(np.sum(maps.bound_events > 0))
+    return digest
+
+
+def seeded_cases(large: bool = False) -> list[tuple[Case, int]]:
+    """The corpus's cases, each with its seed (fixed by the case's place in the list)."""
+    return [(case, 1000 + index) for index, case in enumerate(_cases(large))]
+
+
 def corpus(large: bool = False, seen: Counter[str] | None = None) -> dict[str, str]:
-    """Every case's hash (seeds fixed by the case's place in the list)."""
-    return {
-        case.name: case_hash(case, seed=1000 + index, seen=seen)
-        for index, case in enumerate(_cases(large))
-    }
+    """Every case's hash."""
+    return {case.name: case_hash(case, seed, seen=seen) for case, seed in seeded_cases(large)}
 
 
 def recorded() -> dict[str, dict[str, str]]:

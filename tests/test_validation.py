@@ -78,8 +78,8 @@ def package_functions() -> list[tuple[Path, ast.FunctionDef]]:
 def test_angle_wrapping_and_value_checks_have_one_home_each():
     wraps = [str(p) for p, f in package_functions() if ("wrap" in f.name and "angle" in f.name)
              or f.name == "wrap"]
-    # wrap_angle (numpy) here; the scalar wrap is the native core's (csrc/core/pymath.hpp),
-    # which numerics re-exports.
+    # wrap_angle (numpy) here; the scalar wrap is the native core's
+    # (csrc/include/bearing_core/core/pymath.hpp), which numerics re-exports.
     assert sorted(wraps) == ["bearing_env/numerics.py"]
     from bearing_env import _core, numerics
 

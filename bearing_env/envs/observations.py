@@ -28,6 +28,7 @@ import numpy as np
 from gymnasium import spaces
 from numpy.typing import NDArray
 
+from bearing_env import _core
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig
 
 #: The robot block, first in the flat vector.
@@ -68,8 +69,16 @@ ENTITY_FEATURES: tuple[str, ...] = (
 #: theta in FL as (cos 2 theta, sin 2 theta) (an axis has no sign; (0, 0) when round).
 #: Zeros for a landmark without a region yet (and for L1, L2).
 SHAPE_FEATURES: tuple[str, ...] = ("elongation", "axis_cos2", "axis_sin2")
-#: The elongation's upper bound (an axis ratio of e**10, about 22,000).
-ELONGATION_LIMIT = 10.0
+#: The elongation's upper bound (an axis ratio of e**10, about 22,000; the native core's
+#: value, read from it).
+ELONGATION_LIMIT: float = _core.ELONGATION_LIMIT
+
+# The native step writes blocks of the sizes it was compiled with; the names above are
+# their columns, so the two must agree (a mismatch would shift every observation).
+if (len(ROBOT_FEATURES), len(LANDMARK_FEATURES), len(BEARING_FEATURES), len(SHAPE_FEATURES)) != (
+    _core.ROBOT_BLOCK, _core.LANDMARK_BLOCK, _core.BEARING_BLOCK, _core.SHAPE_BLOCK
+):
+    raise ImportError("the observation's feature names disagree with the native core's blocks")
 #: The landmark table's columns in the ``"shapes"`` kind.
 SHAPE_ENTITY_FEATURES: tuple[str, ...] = ENTITY_FEATURES + SHAPE_FEATURES
 

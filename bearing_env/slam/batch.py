@@ -77,7 +77,8 @@ LANDMARK_CODE = {name: code for code, name in enumerate(LANDMARK_STATUSES)}
 
 #: Batches of at least this many maps are updated on :func:`bearing_env.slam.kernels.threads`
 #: threads (``BEARING_ENV_NUM_THREADS``, else the CPUs the process may use). Below it,
-#: waking a worker costs more than it saves (csrc/slam/state.hpp, which holds the value).
+#: waking a worker costs more than it saves (csrc/include/bearing_core/slam/state.hpp,
+#: which holds the value).
 PARALLEL_MIN_MAPS: int = kernels.PARALLEL_MIN_MAPS
 
 #: How far outside a region a point may lie and still count as inside, relative to the

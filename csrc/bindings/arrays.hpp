@@ -1,17 +1,19 @@
 // Turning Python arguments into checked views: every array the kernels take is checked
-// once here (dtype, dimensions, C-contiguity, writeability, shape), and a bad one raises
-// TypeError or ValueError naming the argument, never a crash.
+// once here (dtype, dimensions, C-contiguity, alignment, writeability, shape, bool bytes),
+// and a bad one raises TypeError or ValueError naming the argument, never a crash.
 #pragma once
 
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 #include <type_traits>
 
-#include "core/complex.hpp"
-#include "core/views.hpp"
+#include <bearing_core/core/complex.hpp>
+#include <bearing_core/core/views.hpp>
 
 namespace bearing::bindings {
 
@@ -19,12 +21,30 @@ namespace nb = nanobind;
 
 template <class T>
 struct dtype_name;
-template <> struct dtype_name<double> { static constexpr const char* value = "float64"; };
-template <> struct dtype_name<float> { static constexpr const char* value = "float32"; };
-template <> struct dtype_name<int64_t> { static constexpr const char* value = "int64"; };
-template <> struct dtype_name<int8_t> { static constexpr const char* value = "int8"; };
-template <> struct dtype_name<bool> { static constexpr const char* value = "bool"; };
-template <> struct dtype_name<cplx> { static constexpr const char* value = "complex128"; };
+template <>
+struct dtype_name<double> {
+    static constexpr const char* value = "float64";
+};
+template <>
+struct dtype_name<float> {
+    static constexpr const char* value = "float32";
+};
+template <>
+struct dtype_name<int64_t> {
+    static constexpr const char* value = "int64";
+};
+template <>
+struct dtype_name<int8_t> {
+    static constexpr const char* value = "int8";
+};
+template <>
+struct dtype_name<bool> {
+    static constexpr const char* value = "bool";
+};
+template <>
+struct dtype_name<cplx> {
+    static constexpr const char* value = "complex128";
+};
 
 template <class T>
 nb::dlpack::dtype dtype_of() {
@@ -42,10 +62,36 @@ nb::dlpack::dtype dtype_of() {
     throw nb::value_error(message.c_str());
 }
 
+// An expected shape's entry for an axis of any length.
+inline constexpr int64_t ANY_LENGTH = -1;
+
+template <int D>
+constexpr std::array<int64_t, D> any_shape() {
+    std::array<int64_t, D> shape{};
+    for (int d = 0; d < D; ++d) shape[d] = ANY_LENGTH;
+    return shape;
+}
+
+// A bool array's bytes are 0 or 1 (numpy writes no other, but a view of other bytes can
+// hold any; the kernels would read such a byte as neither true nor false).
+inline void check_bool_bytes(const bool* data, int64_t size, const char* name) {
+    const auto* bytes = reinterpret_cast<const unsigned char*>(data);
+    for (int64_t k = 0; k < size; ++k) {
+        if (bytes[k] > 1) {
+            value_error(std::string(name) + " holds the byte " + std::to_string(bytes[k]) +
+                        " at flat index " + std::to_string(k) + ", not a bool (0 or 1)");
+        }
+    }
+}
+
 // A view of the numpy array `obj` (argument `name`): dtype T, D dimensions, C-contiguous,
-// and writeable unless T is const. `shape[d] >= 0` entries must match.
+// aligned for T, and writeable unless T is const; a read-only bool array (const bool)
+// holds only 0 and 1 (a state's bool arrays, read and written, are checked by their
+// parser, state_args.hpp). Entries
+// of `expect` other than ANY_LENGTH must match (0 included).
 template <class T, int D>
-View<T, D> view_of(nb::handle obj, const char* name, const std::array<int64_t, D>& expect = {}) {
+View<T, D> view_of(nb::handle obj, const char* name,
+                   const std::array<int64_t, D>& expect = any_shape<D>()) {
     using Element = std::remove_const_t<T>;
     // Read-only arrays are taken too (nb::ro); a view of a non-const T checks writeability
     // below, naming the argument.
@@ -71,7 +117,7 @@ View<T, D> view_of(nb::handle obj, const char* name, const std::array<int64_t, D
             value_error(std::string(name) + " must be C-contiguous");
         }
         expected_stride *= view.shape[d];
-        if (expect[d] > 0 && view.shape[d] != expect[d]) {
+        if (expect[d] != ANY_LENGTH && view.shape[d] != expect[d]) {
             value_error(std::string(name) + " has axis " + std::to_string(d) + " of length " +
                         std::to_string(view.shape[d]) + ", expected " + std::to_string(expect[d]));
         }
@@ -82,7 +128,44 @@ View<T, D> view_of(nb::handle obj, const char* name, const std::array<int64_t, D
         }
     }
     view.data = reinterpret_cast<T*>(const_cast<void*>(static_cast<const void*>(array.data())));
+    if (reinterpret_cast<std::uintptr_t>(view.data) % alignof(Element) != 0) {
+        value_error(std::string(name) + " must be aligned to " + std::to_string(alignof(Element)) +
+                    " bytes (a view at an odd offset of a buffer is not)");
+    }
+    // (An output the kernel only writes may come from np.empty: its bytes are not read.)
+    if constexpr (std::is_same_v<T, const bool>) check_bool_bytes(view.data, view.size(), name);
     return view;
+}
+
+// An array argument's memory, for require_apart.
+struct Extent {
+    const char* name;
+    const void* data;
+    int64_t bytes;
+    bool written;  // the kernel writes it
+};
+
+template <class T, int D>
+Extent extent_of(const View<T, D>& view, const char* name) {
+    return {name, view.data, view.size() * static_cast<int64_t>(sizeof(T)), !std::is_const_v<T>};
+}
+
+// No array a kernel writes shares memory with another of its arguments: the kernels read
+// their inputs while they write their outputs, so an overlap would change the result
+// midway. ValueError naming both.
+inline void require_apart(std::initializer_list<Extent> arrays) {
+    for (const Extent* a = arrays.begin(); a != arrays.end(); ++a) {
+        for (const Extent* b = a + 1; b != arrays.end(); ++b) {
+            if (!(a->written || b->written) || a->bytes == 0 || b->bytes == 0) continue;
+            const auto* a_begin = static_cast<const char*>(a->data);
+            const auto* b_begin = static_cast<const char*>(b->data);
+            if (a_begin < b_begin + b->bytes && b_begin < a_begin + a->bytes) {
+                value_error(std::string(a->name) + " and " + b->name +
+                            " must not share memory (the kernel writes " +
+                            (a->written ? a->name : b->name) + " while it reads the other)");
+            }
+        }
+    }
 }
 
 }  // namespace bearing::bindings

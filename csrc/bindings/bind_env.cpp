@@ -16,13 +16,13 @@
 #include <utility>
 #include <vector>
 
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/env/kernels.hpp>
+#include <bearing_core/env/planning.hpp>
+#include <bearing_core/env/robot_map.hpp>
+#include <bearing_core/env/types.hpp>
 #include "bindings/arrays.hpp"
 #include "bindings/env_args.hpp"
-#include "core/errors.hpp"
-#include "env/kernels.hpp"
-#include "env/planning.hpp"
-#include "env/robot_map.hpp"
-#include "env/types.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -94,15 +94,26 @@ View1<const int64_t> rows_of(nb::handle rows, int64_t num_rows, std::vector<uint
     return r;
 }
 
-constexpr const char* REPORT_FIELDS[16] = {
-    "observations", "rewards",        "terminated",    "truncated",
-    "frame_changed", "inconsistent",  "path_length",   "uncertainty",
-    "path_cost",    "move_cost",      "landmark_area", "landmark_error",
-    "landmark_contains_truth", "total_area", "robot_error", "outliers"};
-constexpr const char* ENCODED_FIELDS[12] = {
-    "vertices",   "counts",        "areas",          "centroids",
-    "robot_vertices", "robot_counts", "robot_area",  "robot_centroid",
-    "robot_heading", "n_updates",  "n_frame_changes", "n_inconsistent"};
+constexpr const char* REPORT_FIELDS[16] = {"observations",
+                                           "rewards",
+                                           "terminated",
+                                           "truncated",
+                                           "frame_changed",
+                                           "inconsistent",
+                                           "path_length",
+                                           "uncertainty",
+                                           "path_cost",
+                                           "move_cost",
+                                           "landmark_area",
+                                           "landmark_error",
+                                           "landmark_contains_truth",
+                                           "total_area",
+                                           "robot_error",
+                                           "outliers"};
+constexpr const char* ENCODED_FIELDS[12] = {"vertices",   "counts",          "areas",
+                                            "centroids",  "robot_vertices",  "robot_counts",
+                                            "robot_area", "robot_centroid",  "robot_heading",
+                                            "n_updates",  "n_frame_changes", "n_inconsistent"};
 
 nb::tuple as_tuple(nb::handle obj, size_t size, const char* name) {
     if (!nb::isinstance<nb::tuple>(obj)) {
@@ -141,16 +152,24 @@ env::Report report_of(nb::handle obj, const env::Inputs& inputs, int64_t rows, K
     r.total_area = view_of<double, 1>(t[13], "report.total_area", {rows});
     r.robot_error = view_of<double, 1>(t[14], "report.robot_error", {rows});
     r.outliers = view_of<int64_t, 2>(t[15], "report.outliers", {rows, m});
-    const std::array<int64_t, 16> firsts{
-        r.observations.shape[0], r.rewards.shape[0], r.terminated.shape[0],
-        r.truncated.shape[0], r.frame_changed.shape[0], r.inconsistent.shape[0],
-        r.path_length.shape[0], r.uncertainty.shape[0], r.path_cost.shape[0],
-        r.move_cost.shape[0], r.landmark_area.shape[0], r.landmark_error.shape[0],
-        r.landmark_contains_truth.shape[0], r.total_area.shape[0], r.robot_error.shape[0],
-        r.outliers.shape[0]};
+    const std::array<int64_t, 16> firsts{r.observations.shape[0],
+                                         r.rewards.shape[0],
+                                         r.terminated.shape[0],
+                                         r.truncated.shape[0],
+                                         r.frame_changed.shape[0],
+                                         r.inconsistent.shape[0],
+                                         r.path_length.shape[0],
+                                         r.uncertainty.shape[0],
+                                         r.path_cost.shape[0],
+                                         r.move_cost.shape[0],
+                                         r.landmark_area.shape[0],
+                                         r.landmark_error.shape[0],
+                                         r.landmark_contains_truth.shape[0],
+                                         r.total_area.shape[0],
+                                         r.robot_error.shape[0],
+                                         r.outliers.shape[0]};
     const std::array<int64_t, 4> seconds{r.landmark_area.shape[1], r.landmark_error.shape[1],
-                                         r.landmark_contains_truth.shape[1],
-                                         r.outliers.shape[1]};
+                                         r.landmark_contains_truth.shape[1], r.outliers.shape[1]};
     for (size_t k = 0; k < firsts.size(); ++k) {
         if (firsts[k] != rows) {
             value_error(std::string("report.") + REPORT_FIELDS[k] + " has " +
@@ -158,7 +177,8 @@ env::Report report_of(nb::handle obj, const env::Inputs& inputs, int64_t rows, K
         }
     }
     for (int64_t second : seconds) {
-        if (second != m) value_error("report's per-landmark arrays must have settings.n - 2 columns");
+        if (second != m)
+            value_error("report's per-landmark arrays must have settings.n - 2 columns");
     }
     for (size_t k = 0; k < 16; ++k) kept.push_back(nb::borrow(t[k]));
     return r;
@@ -189,10 +209,10 @@ env::Encoded encoded_of(nb::handle obj, const slam::MapState& maps, int64_t rows
     e.n_frame_changes = view_of<int64_t, 1>(t[10], "encoded.n_frame_changes", {rows});
     e.n_inconsistent = view_of<int64_t, 1>(t[11], "encoded.n_inconsistent", {rows});
     const std::array<int64_t, 12> firsts{
-        e.vertices.shape[0], e.counts.shape[0], e.areas.shape[0], e.centroids.shape[0],
-        e.robot_vertices.shape[0], e.robot_counts.shape[0], e.robot_area.shape[0],
-        e.robot_centroid.shape[0], e.robot_heading.shape[0], e.n_updates.shape[0],
-        e.n_frame_changes.shape[0], e.n_inconsistent.shape[0]};
+        e.vertices.shape[0],   e.counts.shape[0],          e.areas.shape[0],
+        e.centroids.shape[0],  e.robot_vertices.shape[0],  e.robot_counts.shape[0],
+        e.robot_area.shape[0], e.robot_centroid.shape[0],  e.robot_heading.shape[0],
+        e.n_updates.shape[0],  e.n_frame_changes.shape[0], e.n_inconsistent.shape[0]};
     for (size_t k = 0; k < firsts.size(); ++k) {
         if (firsts[k] != rows) {
             value_error(std::string("encoded.") + ENCODED_FIELDS[k] + " has " +
@@ -332,19 +352,19 @@ nb::tuple new_encoded_arrays(const slam::MapState& maps, int64_t size, int64_t s
     const int64_t capacity = maps.vertices.shape[2];
     const nb::tuple one = nb::make_tuple(size), two = nb::make_tuple(size, slots);
     const double inf = std::numeric_limits<double>::infinity();
-    return nb::make_tuple(
-        zeros(nb::make_tuple(size, slots, capacity), "complex128"), zeros(two, "int64"),
-        full(two, nb::float_(inf), "float64"),
-        full(two, nb::cast(std::complex<double>(inf, inf)), "complex128"),
-        zeros(nb::make_tuple(size, maps.robot_vertices.shape[1]), "complex128"),
-        empty(one, "int64"), empty(one), empty(one, "complex128"), empty(one),
-        empty(one, "int64"), empty(one, "int64"), empty(one, "int64"));
+    return nb::make_tuple(zeros(nb::make_tuple(size, slots, capacity), "complex128"),
+                          zeros(two, "int64"), full(two, nb::float_(inf), "float64"),
+                          full(two, nb::cast(std::complex<double>(inf, inf)), "complex128"),
+                          zeros(nb::make_tuple(size, maps.robot_vertices.shape[1]), "complex128"),
+                          empty(one, "int64"), empty(one), empty(one, "complex128"), empty(one),
+                          empty(one, "int64"), empty(one, "int64"), empty(one, "int64"));
 }
 
 // encode_map into new arrays (robot_map.encode_map).
 nb::tuple encode_map_new(const slam::MapState& maps, View1<const int64_t> rows, int64_t slots) {
     if (slots < maps.counts.shape[1]) {
-        value_error("slots (" + std::to_string(slots) + ") must be at least the mapped landmarks (" +
+        value_error("slots (" + std::to_string(slots) +
+                    ") must be at least the mapped landmarks (" +
                     std::to_string(maps.counts.shape[1]) + ")");
     }
     nb::tuple arrays = new_encoded_arrays(maps, rows.shape[0], slots);
@@ -372,6 +392,13 @@ int64_t decode_with(nb::handle actions, double lo, double hi, nb::handle turns,
 }  // namespace
 
 void bind_env(nb::module_& m) {
+    // The observation's block sizes and the shape block's limit (observations.py checks its
+    // feature names against the blocks, and reads the limit).
+    m.attr("ROBOT_BLOCK") = env::ROBOT_FEATURES;
+    m.attr("LANDMARK_BLOCK") = env::LANDMARK_FEATURES;
+    m.attr("BEARING_BLOCK") = env::BEARING_FEATURES;
+    m.attr("SHAPE_BLOCK") = env::SHAPE_FEATURES;
+    m.attr("ELONGATION_LIMIT") = env::ELONGATION_LIMIT;
     m.attr("STEP_DONE") = static_cast<int64_t>(env::STEP_DONE);
     m.attr("STEP_NEEDS_NOISE") = static_cast<int64_t>(env::STEP_NEEDS_NOISE);
     m.attr("STEP_NEEDS_TRAJECTORY") = static_cast<int64_t>(env::STEP_NEEDS_TRAJECTORY);
@@ -383,8 +410,8 @@ void bind_env(nb::module_& m) {
                           "A group's kernel inputs (kernels.Inputs), made once per group and "
                           "state: its Settings, the map update's Params and MapState, the envs' "
                           "BatchState (its arrays, checked and kept).")
-        .def(nb::init<nb::handle, nb::handle, nb::handle, nb::handle>(), "settings"_a,
-             "params"_a, "maps"_a, "state"_a)
+        .def(nb::init<nb::handle, nb::handle, nb::handle, nb::handle>(), "settings"_a, "params"_a,
+             "maps"_a, "state"_a)
         .def_prop_ro("n", [](const EnvInputs& self) { return self.inputs.settings.n; })
         .def_prop_ro("num_rows", [](const EnvInputs& self) { return self.num_rows; })
         .def_prop_ro("observation_size", [](const EnvInputs& self) {
@@ -420,7 +447,8 @@ void bind_env(nb::module_& m) {
             const env::BatchState& state = inputs.inputs.state;
             for (int64_t i = 0; i < size; ++i) {
                 if (state.noise_used[r[i]] < 0 || state.trajectory_length[r[i]] < 0) {
-                    value_error("the state's noise_used and trajectory_length must not be negative");
+                    value_error(
+                        "the state's noise_used and trajectory_length must not be negative");
                 }
             }
             const env::Encoded* encoded = with_map ? &outputs.encoded : nullptr;
@@ -589,9 +617,11 @@ void bind_env(nb::module_& m) {
             const slam::MapState s = maps_of(maps, kept);
             auto r = rows_of(rows, s.counts.shape[0], nullptr);
             const int64_t size = r.shape[0], window = s.window_vertices.shape[1];
-            if (slots < s.counts.shape[1]) value_error("slots must be at least the mapped landmarks");
+            if (slots < s.counts.shape[1])
+                value_error("slots must be at least the mapped landmarks");
             nb::tuple arrays = nb::make_tuple(
-                zeros(nb::make_tuple(size, window, slots, s.window_vertices.shape[3]), "complex128"),
+                zeros(nb::make_tuple(size, window, slots, s.window_vertices.shape[3]),
+                      "complex128"),
                 zeros(nb::make_tuple(size, window, slots), "int64"),
                 zeros(nb::make_tuple(size, window, slots), "bool"),
                 empty(nb::make_tuple(size, window), "bool"), empty(nb::make_tuple(size), "int64"),
@@ -627,7 +657,8 @@ void bind_env(nb::module_& m) {
             auto r = rows_of(rows, s.counts.shape[0], nullptr);
             const int64_t size = r.shape[0], levels = s.level_vertices.shape[2];
             const int64_t history = s.history_bearings.shape[1];
-            if (slots < s.counts.shape[1]) value_error("slots must be at least the mapped landmarks");
+            if (slots < s.counts.shape[1])
+                value_error("slots must be at least the mapped landmarks");
             nb::tuple arrays = nb::make_tuple(
                 zeros(nb::make_tuple(size, slots), "int64"),
                 zeros(nb::make_tuple(size, slots, levels, s.level_vertices.shape[3]), "complex128"),
@@ -675,8 +706,7 @@ void bind_env(nb::module_& m) {
         "potential_of of every row of areas (rows, m) into out.");
     m.def(
         "_move_ends",
-        [](std::complex<double> start, nb::handle headings, nb::handle distances,
-           nb::handle out) {
+        [](std::complex<double> start, nb::handle headings, nb::handle distances, nb::handle out) {
             auto h = view_of<const double, 1>(headings, "headings");
             auto d = view_of<const double, 1>(distances, "distances", {h.shape[0]});
             auto o = view_of<cplx, 1>(out, "out", {h.shape[0]});

@@ -7,10 +7,10 @@
 #include <string>
 #include <tuple>
 
+#include <bearing_core/sim/sensing.hpp>
+#include <bearing_core/sim/world.hpp>
 #include "bindings/arrays.hpp"
 #include "bindings/sim_args.hpp"
-#include "sim/sensing.hpp"
-#include "sim/world.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -44,6 +44,7 @@ void check_same_shape(const std::array<int64_t, 2>& shape, const std::array<int6
 
 void bind_sim(nb::module_& m) {
     namespace sim = bearing::sim;
+    m.attr("CONTACT_SLACK") = sim::CONTACT_SLACK;  // bearing_env.sensing reads it
 
     // bearing_env/world.py
     m.def(
@@ -86,8 +87,8 @@ void bind_sim(nb::module_& m) {
             return as_tuple(
                 sim::straight_move(x, y, heading, length, width, height, margin, min_baseline));
         },
-        "x"_a, "y"_a, "heading"_a, "length"_a, "width"_a, "height"_a, "margin"_a,
-        "min_baseline"_a, "One straight move stopped at the wall margin: (x, y, travelled, blocked).");
+        "x"_a, "y"_a, "heading"_a, "length"_a, "width"_a, "height"_a, "margin"_a, "min_baseline"_a,
+        "One straight move stopped at the wall margin: (x, y, travelled, blocked).");
     m.def(
         "obstructed_move",
         [](double x, double y, double heading, double length,
@@ -130,8 +131,8 @@ void bind_sim(nb::module_& m) {
         "How far a robot can go along heading before its centre comes within margin of an "
         "obstacle; inf without contact.");
     m.def("_cross", &sim::cross, "ox"_a, "oy"_a, "ax"_a, "ay"_a, "bx"_a, "by"_a);
-    m.def("segments_cross", &sim::segments_cross, "px"_a, "py"_a, "qx"_a, "qy"_a, "ax"_a,
-          "ay"_a, "bx"_a, "by"_a, "Whether segments pq and ab share a point (touching counts).");
+    m.def("segments_cross", &sim::segments_cross, "px"_a, "py"_a, "qx"_a, "qy"_a, "ax"_a, "ay"_a,
+          "bx"_a, "by"_a, "Whether segments pq and ab share a point (touching counts).");
     m.def("_on_segment", &sim::on_segment, "ax"_a, "ay"_a, "bx"_a, "by"_a, "px"_a, "py"_a);
     m.def(
         "line_of_sight",
@@ -143,8 +144,8 @@ void bind_sim(nb::module_& m) {
         "Whether the segment from (x, y) to the target crosses no obstacle edge.");
     m.def(
         "visible",
-        [](double x, double y, double heading, double target_x, double target_y,
-           double half_fov, double max_range, nb::handle vertices, nb::handle starts) {
+        [](double x, double y, double heading, double target_x, double target_y, double half_fov,
+           double max_range, nb::handle vertices, nb::handle starts) {
             return sim::visible(x, y, heading, target_x, target_y, half_fov, max_range,
                                 obstacles_of(vertices, starts));
         },

@@ -1,6 +1,6 @@
-// Bindings of the polygon and frame kernels (csrc/slam/polygons.hpp, frames.hpp), for tests
-// and one-off geometry: the same Python signatures and return conventions as the numba
-// kernels of bearing_env.slam.kernels (complex128 arrays in, `out` arrays written in
+// Bindings of the polygon and frame kernels (csrc/include/bearing_core/slam/polygons.hpp,
+// frames.hpp), for tests and one-off geometry: the same Python signatures and return conventions as
+// the numba kernels of bearing_env.slam.kernels (complex128 arrays in, `out` arrays written in
 // place, the same return tuples), so that the package can re-export either.
 //
 // Every array is checked (dtype, dimensions, C-contiguity, writeability), and every count
@@ -14,13 +14,13 @@
 #include <memory>
 #include <string>
 
+#include <bearing_core/slam/common.hpp>
+#include <bearing_core/slam/frames.hpp>
+#include <bearing_core/slam/local_bound.hpp>
+#include <bearing_core/slam/polygons.hpp>
+#include <bearing_core/slam/scratch.hpp>
+#include <bearing_core/slam/update.hpp>
 #include "bindings/arrays.hpp"
-#include "slam/common.hpp"
-#include "slam/frames.hpp"
-#include "slam/local_bound.hpp"
-#include "slam/polygons.hpp"
-#include "slam/scratch.hpp"
-#include "slam/update.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -29,6 +29,8 @@ namespace {
 
 using bearing::cplx;
 using bearing::View1;
+using bearing::bindings::extent_of;
+using bearing::bindings::require_apart;
 using bearing::bindings::value_error;
 using bearing::bindings::view_of;
 
@@ -110,15 +112,16 @@ int64_t convex_hull(nb::handle points_obj, int64_t n_points, nb::handle out_obj)
     const Out out = output(out_obj, "out");
     check_count(n_points, "n_points", points.shape[0], "points");
     check_room(n_points + 1, out.shape[0], "out");
+    require_apart({extent_of(points, "points"), extent_of(out, "out")});
     return bearing::slam::convex_hull(points.data, n_points, out.data);
 }
 
-int64_t small_convex_hull(nb::handle points_obj, int64_t n_points, nb::handle out_obj,
-                          double tol) {
+int64_t small_convex_hull(nb::handle points_obj, int64_t n_points, nb::handle out_obj, double tol) {
     const In points = input(points_obj, "points");
     const Out out = output(out_obj, "out");
     check_count(n_points, "n_points", points.shape[0], "points");
     check_room(n_points + 1, out.shape[0], "out");
+    require_apart({extent_of(points, "points"), extent_of(out, "out")});
     return bearing::slam::small_convex_hull(points.data, n_points, out.data, tol);
 }
 
@@ -128,6 +131,7 @@ int64_t small_hull_indices(nb::handle points_obj, int64_t n_points, nb::handle o
     const View1<int64_t> out = view_of<int64_t, 1>(out_obj, "out");
     check_count(n_points, "n_points", points.shape[0], "points");
     check_room(n_points + 1, out.shape[0], "out");
+    require_apart({extent_of(points, "points"), extent_of(out, "out")});
     return bearing::slam::small_hull_indices(points.data, n_points, out.data, tol);
 }
 
@@ -180,6 +184,8 @@ int64_t clip_convex(nb::handle subject_obj, int64_t n_subject, nb::handle clippe
     check_count(n_clipper, "n_clipper", clipper.shape[0], "clipper", 1);
     check_room(bearing::slam::SCRATCH, out.shape[0], "out");
     check_room(bearing::slam::SCRATCH, work.shape[0], "work");
+    require_apart({extent_of(subject, "subject"), extent_of(clipper, "clipper"),
+                   extent_of(out, "out"), extent_of(work, "work")});
     return bearing::slam::clip_convex(subject.data, n_subject, clipper.data, n_clipper, out.data,
                                       work.data);
 }
@@ -190,6 +196,7 @@ int64_t offset_outward(nb::handle poly_obj, int64_t n, double radius, nb::handle
     check_count(n, "n", poly.shape[0], "poly");
     if (n < 1) value_error("offset_outward needs n >= 1");
     check_room(n + 3, out.shape[0], "out");
+    require_apart({extent_of(poly, "poly"), extent_of(out, "out")});
     return bearing::slam::offset_outward(poly.data, n, radius, out.data);
 }
 
@@ -209,6 +216,7 @@ int64_t boundary_samples(nb::handle poly_obj, int64_t n, int64_t per_edge, nb::h
     const Out out = output(out_obj, "out");
     check_count(n, "n", poly.shape[0], "poly");
     check_room(product(n, per_edge), out.shape[0], "out");
+    require_apart({extent_of(poly, "poly"), extent_of(out, "out")});
     return bearing::slam::boundary_samples(poly.data, n, per_edge, out.data);
 }
 
@@ -218,9 +226,8 @@ nb::tuple frame_plan(nb::handle a1_obj, int64_t n1, nb::handle a2_obj, int64_t n
     const In a2 = input(a2_obj, "a2");
     check_count(n1, "n1", a1.shape[0], "a1", 1);
     check_count(n2, "n2", a2.shape[0], "a2", 1);
-    const bearing::slam::FramePlan plan =
-        bearing::slam::frame_plan(a1.data, n1, a2.data, n2,
-                                  bool_of(conservative, "conservative"), edge_samples);
+    const bearing::slam::FramePlan plan = bearing::slam::frame_plan(
+        a1.data, n1, a2.data, n2, bool_of(conservative, "conservative"), edge_samples);
     return nb::make_tuple(plan.status, plan.per_edge, plan.distance, plan.delta1, plan.delta2);
 }
 
@@ -239,6 +246,8 @@ int64_t sample_hypotheses(nb::handle a1_obj, int64_t n1, nb::handle a2_obj, int6
         check_room(pairs, h1.shape[0], "h1");
         check_room(pairs, inv_d.shape[0], "inv_d");
     }
+    require_apart(
+        {extent_of(a1, "a1"), extent_of(a2, "a2"), extent_of(h1, "h1"), extent_of(inv_d, "inv_d")});
     return bearing::slam::sample_hypotheses(a1.data, n1, a2.data, n2, per_edge, h1.data,
                                             inv_d.data);
 }
@@ -288,6 +297,10 @@ int64_t transfer_region(nb::handle target_obj, int64_t n_target, nb::handle fram
         check_room(k + 1, hull.shape[0], "hull");
         check_room(bearing::slam::SCRATCH, out.shape[0], "out");
     }
+    require_apart({extent_of(target, "target"), extent_of(a1, "frame.a1"),
+                   extent_of(a2, "frame.a2"), extent_of(h1, "frame.h1"),
+                   extent_of(inv_d, "frame.inv_d"), extent_of(cloud, "cloud"),
+                   extent_of(hull, "hull"), extent_of(out, "out")});
     return bearing::slam::transfer_region(target.data, n_target, change, cloud.data, hull.data,
                                           out.data);
 }
@@ -323,18 +336,21 @@ nb::tuple transfer_polygon(nb::handle target_obj, nb::handle a1_obj, nb::handle 
     const Out out = output(out_obj, "out");
     if (target.shape[0] < 1) value_error("target must hold at least one point");
     if (!slam::valid_transfer(transfer)) {
-        value_error("transfer must be TRANSFER_CONSERVATIVE (0), TRANSFER_PAPER (1) or "
-                    "TRANSFER_CONSERVATIVE_GLOBAL (2), got " + std::to_string(transfer));
+        value_error(
+            "transfer must be TRANSFER_CONSERVATIVE (0), TRANSFER_PAPER (1) or "
+            "TRANSFER_CONSERVATIVE_GLOBAL (2), got " +
+            std::to_string(transfer));
     }
     check_edge_samples(edge_samples, "edge_samples");
     check_room(slam::SCRATCH, out.shape[0], "out");
-    // Allocated without zero-filling (every slot used is written first).
-    const std::unique_ptr<slam::Buffers> buf(new slam::Buffers);
+    // The thread's reused buffers (every slot used is written first): a fresh Buffers
+    // would zero its 260 KB on every call.
+    slam::Buffers& buf = slam::thread_buffers();
     slam::FrameChange frame;
     const int64_t status = slam::change_of_frames(a1.data, a1.shape[0], a2.data, a2.shape[0],
-                                                  transfer, edge_samples, *buf, frame);
+                                                  transfer, edge_samples, buf, frame);
     if (status != slam::FRAME_OK) return nb::make_tuple(status, 0);
-    slam::Scratch& scratch = buf->scratch;
+    slam::Scratch& scratch = buf.scratch;
     const int64_t n = slam::transfer_region(target.data, target.shape[0], frame, scratch.cloud,
                                             scratch.hull, scratch.fresh);
     check_room(n, out.shape[0], "out");
@@ -373,11 +389,15 @@ void bind_slam_geometry(nb::module_& m) {
     // common.py and numerics.py's scalar helpers.
     m.def(
         "cross",
-        [](nb::handle a, nb::handle b) { return bearing::cross(complex_of(a, "a"), complex_of(b, "b")); },
+        [](nb::handle a, nb::handle b) {
+            return bearing::cross(complex_of(a, "a"), complex_of(b, "b"));
+        },
         "a"_a, "b"_a, "2-D cross product a.x * b.y - a.y * b.x.");
     m.def(
         "dot",
-        [](nb::handle a, nb::handle b) { return bearing::dot(complex_of(a, "a"), complex_of(b, "b")); },
+        [](nb::handle a, nb::handle b) {
+            return bearing::dot(complex_of(a, "a"), complex_of(b, "b"));
+        },
         "a"_a, "b"_a, "2-D dot product.");
     m.def("wrap", &bearing::wrap, "angle"_a, "An angle wrapped to [-pi, pi).");
     m.def("scale_of", &scale_of, "poly"_a, "n"_a,

@@ -1,4 +1,4 @@
-// Bindings of the batched map update (csrc/slam/update.hpp): MapState, Params,
+// Bindings of the batched map update (csrc/include/bearing_core/slam/update.hpp): MapState, Params,
 // update_maps, the batch helpers (check_indices, none_infinite, contains_points),
 // binomial_q, and the constants the Python side reads.
 #include <nanobind/nanobind.h>
@@ -13,13 +13,15 @@
 #include <string>
 #include <vector>
 
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/slam/fusion.hpp>
+#include <bearing_core/slam/map_batch.hpp>
+#include <bearing_core/slam/robust.hpp>
+#include <bearing_core/slam/scratch.hpp>
+#include <bearing_core/slam/state.hpp>
+#include <bearing_core/slam/update.hpp>
 #include "bindings/arrays.hpp"
-#include "core/errors.hpp"
-#include "slam/fusion.hpp"
-#include "slam/robust.hpp"
-#include "slam/scratch.hpp"
-#include "slam/state.hpp"
-#include "slam/update.hpp"
+#include "bindings/state_args.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -31,23 +33,8 @@ using bearing::bindings::value_error;
 using bearing::bindings::view_of;
 namespace slam = bearing::slam;
 
-// The fields of bearing_env.slam.kernels.State, in its order.
-constexpr const char* STATE_FIELDS[] = {
-    "vertices",        "counts",           "areas",
-    "centroids",       "robot_vertices",   "robot_counts",
-    "robot_area",      "robot_centroid",   "robot_heading",
-    "n_updates",       "n_frame_changes",  "n_inconsistent",
-    "window_vertices", "window_counts",    "window_inlier",
-    "window_rejected", "window_length",    "window_next",
-    "base_vertices",   "base_counts",      "n_dropped",
-    "outliers",        "level_vertices",   "level_counts",
-    "n_regions",       "robot_fixed_at",   "noise_scale",
-    "bound_events",    "probe_vertices",   "probe_counts",
-    "history_frame_bearings", "history_bearings", "history_length",
-    "history_next",
-};
-constexpr size_t N_FIELDS = sizeof(STATE_FIELDS) / sizeof(STATE_FIELDS[0]);
-static_assert(N_FIELDS == 34, "State has 34 fields");
+using bearing::bindings::N_STATE_FIELDS;
+using bearing::bindings::STATE_FIELDS;
 
 // A batch's state as the native update takes it: checked views of the 34 arrays of a
 // bearing_env.slam.kernels.State, and a reference to the tuple (the arrays stay alive).
@@ -55,30 +42,14 @@ struct PyMapState {
     nb::object tuple;
     slam::MapState views;
     int64_t maps = 0;
-    int64_t mapped = 0;   // m: landmarks mapped per map (L1 and L2 excluded)
-    int64_t window = 0;   // w
+    int64_t mapped = 0;  // m: landmarks mapped per map (L1 and L2 excluded)
+    int64_t window = 0;  // w
     int64_t levels = 0;
     int64_t history = 0;  // h
 };
 
-// The field `name` (index k) of the state tuple, as a view (shape checked against expect).
-template <class T, int D>
-bearing::View<T, D> field(nb::handle state, size_t k, const std::array<int64_t, D>& expect) {
-    const std::string name = std::string("state.") + STATE_FIELDS[k];
-    return view_of<T, D>(state[k], name.c_str(), expect);
-}
-
 void require(bool ok, const std::string& message) {
     if (!ok) value_error(message);
-}
-
-// Vertex axis of a per-landmark polygon array that may be left empty (0) by fusions
-// that do not use it.
-void check_vertex_axis(int64_t length, const char* name, bool may_be_empty) {
-    if (length == slam::CAPACITY || (may_be_empty && length == 0)) return;
-    value_error(std::string("state.") + name + " must have " + std::to_string(slam::CAPACITY) +
-                (may_be_empty ? " (or 0)" : "") + " vertex slots on its last axis, not " +
-                std::to_string(length));
 }
 
 void init_map_state(PyMapState* self, nb::handle state) {
@@ -88,132 +59,36 @@ void init_map_state(PyMapState* self, nb::handle state) {
                                       nb::type_name(state.type()).c_str());
     }
     const size_t size = nb::len(state);
-    if (size != N_FIELDS) {
-        value_error("state must have the " + std::to_string(N_FIELDS) +
+    if (size != N_STATE_FIELDS) {
+        value_error("state must have the " + std::to_string(N_STATE_FIELDS) +
                     " fields of bearing_env.slam.kernels.State, not " + std::to_string(size));
     }
     // Field names, when the tuple has them (a State namedtuple): in State's order.
     if (nb::hasattr(state, "_fields")) {
         nb::tuple names = nb::cast<nb::tuple>(state.attr("_fields"));
-        for (size_t k = 0; k < N_FIELDS; ++k) {
+        for (size_t k = 0; k < N_STATE_FIELDS; ++k) {
             if (nb::cast<std::string>(names[k]) != STATE_FIELDS[k]) {
                 value_error(std::string("state field ") + std::to_string(k) + " must be " +
                             STATE_FIELDS[k] + ", not " + nb::cast<std::string>(names[k]));
             }
         }
     }
-    slam::MapState v;
-    constexpr int64_t any = -1;
-    const int64_t cap = slam::CAPACITY;
-    v.vertices = field<cplx, 3>(state, 0, {any, any, cap});
-    const int64_t n = v.vertices.shape[0], m = v.vertices.shape[1];
-    v.counts = field<int64_t, 2>(state, 1, {n, m});
-    v.areas = field<double, 2>(state, 2, {n, m});
-    v.centroids = field<cplx, 2>(state, 3, {n, m});
-    v.robot_vertices = field<cplx, 2>(state, 4, {n, cap});
-    v.robot_counts = field<int64_t, 1>(state, 5, {n});
-    v.robot_area = field<double, 1>(state, 6, {n});
-    v.robot_centroid = field<cplx, 1>(state, 7, {n});
-    v.robot_heading = field<double, 1>(state, 8, {n});
-    v.n_updates = field<int64_t, 1>(state, 9, {n});
-    v.n_frame_changes = field<int64_t, 1>(state, 10, {n});
-    v.n_inconsistent = field<int64_t, 1>(state, 11, {n});
-    v.window_vertices = field<cplx, 4>(state, 12, {n, any, m, cap});
-    const int64_t w = v.window_vertices.shape[1];
-    v.window_counts = field<int64_t, 3>(state, 13, {n, w, m});
-    v.window_inlier = field<bool, 3>(state, 14, {n, w, m});
-    v.window_rejected = field<bool, 2>(state, 15, {n, w});
-    v.window_length = field<int64_t, 1>(state, 16, {n});
-    v.window_next = field<int64_t, 1>(state, 17, {n});
-    v.base_vertices = field<cplx, 3>(state, 18, {n, m, any});
-    v.base_counts = field<int64_t, 2>(state, 19, {n, m});
-    v.n_dropped = field<int64_t, 2>(state, 20, {n, m});
-    v.outliers = field<int64_t, 2>(state, 21, {n, m});
-    v.level_vertices = field<cplx, 4>(state, 22, {n, m, any, cap});
-    const int64_t levels = v.level_vertices.shape[2];
-    v.level_counts = field<int64_t, 3>(state, 23, {n, m, levels});
-    v.n_regions = field<int64_t, 2>(state, 24, {n, m});
-    v.robot_fixed_at = field<int64_t, 1>(state, 25, {n});
-    v.noise_scale = field<double, 1>(state, 26, {n});
-    v.bound_events = field<int64_t, 1>(state, 27, {n});
-    v.probe_vertices = field<cplx, 3>(state, 28, {n, m, any});
-    v.probe_counts = field<int64_t, 2>(state, 29, {n, m});
-    v.history_frame_bearings = field<double, 4>(state, 30, {n, any, 2, 2});
-    const int64_t h = v.history_frame_bearings.shape[1];
-    v.history_bearings = field<double, 4>(state, 31, {n, h, 2, m});
-    v.history_length = field<int64_t, 1>(state, 32, {n});
-    v.history_next = field<int64_t, 1>(state, 33, {n});
-    // view_of skips axes of expected length 0 (0 = any), so the 0-length cases of the
-    // consistency checks are spelled out here.
-    auto axis = [&](int64_t got, int64_t want, const char* name, int d) {
-        require(got == want, std::string("state.") + name + " has axis " + std::to_string(d) +
-                                 " of length " + std::to_string(got) + ", expected " +
-                                 std::to_string(want));
-    };
-    axis(v.counts.shape[0], n, "counts", 0);
-    axis(v.counts.shape[1], m, "counts", 1);
-    for (size_t k = 1; k < N_FIELDS; ++k) {
-        nb::handle array = state[k];
-        const int64_t first = nb::cast<int64_t>(array.attr("shape")[0]);
-        axis(first, n, STATE_FIELDS[k], 0);
-    }
-    const std::pair<const char*, int64_t> landmark_axes[] = {
-        {"areas", v.areas.shape[1]},           {"centroids", v.centroids.shape[1]},
-        {"window_vertices", v.window_vertices.shape[2]},
-        {"window_counts", v.window_counts.shape[2]},
-        {"window_inlier", v.window_inlier.shape[2]}, {"base_vertices", v.base_vertices.shape[1]},
-        {"base_counts", v.base_counts.shape[1]}, {"n_dropped", v.n_dropped.shape[1]},
-        {"outliers", v.outliers.shape[1]},     {"level_vertices", v.level_vertices.shape[1]},
-        {"level_counts", v.level_counts.shape[1]}, {"n_regions", v.n_regions.shape[1]},
-        {"probe_vertices", v.probe_vertices.shape[1]}, {"probe_counts", v.probe_counts.shape[1]},
-        {"history_bearings", v.history_bearings.shape[3]},
-    };
-    for (const auto& [name, length] : landmark_axes) {
-        require(length == m, std::string("state.") + name + " must have the " +
-                                 std::to_string(m) + " landmarks of state.vertices on its "
-                                 "landmark axis, not " + std::to_string(length));
-    }
-    axis(v.window_counts.shape[1], w, "window_counts", 1);
-    axis(v.window_inlier.shape[1], w, "window_inlier", 1);
-    axis(v.window_rejected.shape[1], w, "window_rejected", 1);
-    axis(v.level_counts.shape[2], levels, "level_counts", 2);
-    axis(v.history_bearings.shape[1], h, "history_bearings", 1);
-    check_vertex_axis(v.base_vertices.shape[2], "base_vertices", true);
-    check_vertex_axis(v.probe_vertices.shape[2], "probe_vertices", true);
-    require(w <= slam::MAX_WINDOW, "state.window_vertices has a window of " + std::to_string(w) +
-                                       " movements, more than MAX_WINDOW (" +
-                                       std::to_string(slam::MAX_WINDOW) + ")");
-    require(m + 2 <= slam::MAX_LANDMARKS,
-            "state.vertices has " + std::to_string(m) + " mapped landmarks, more than " +
-                std::to_string(slam::MAX_LANDMARKS - 2) + " (MAX_LANDMARKS - 2)");
-    new (self) PyMapState{nb::borrow<nb::object>(state), v, n, m, w, levels, h};
+    bearing::bindings::Kept kept;  // (the tuple keeps its arrays alive)
+    const auto parsed = bearing::bindings::parse_map_state(state, true, "state", kept);
+    new (self) PyMapState{nb::borrow<nb::object>(state),
+                          parsed.views,
+                          parsed.maps,
+                          parsed.mapped,
+                          parsed.window,
+                          parsed.levels,
+                          parsed.history};
 }
 
-// One update call's settings (bearing_env.slam.kernels.Params), validated.
+// One update call's settings (bearing_env.slam.kernels.Params), validated by the
+// library (slam::validate: std::invalid_argument, a ValueError in Python).
 slam::Params make_params(double epsilon, int64_t transfer, int64_t edge_samples,
                          int64_t on_inconsistency, int64_t fusion, int64_t max_outliers,
                          bool with_robot, double risk, bool likely, bool estimate_bound) {
-    require(std::isfinite(epsilon) && epsilon > 0.0,
-            "epsilon must be a positive finite number of radians, not " + std::to_string(epsilon));
-    require(slam::valid_transfer(transfer),
-            "transfer must be TRANSFER_CONSERVATIVE (0), TRANSFER_PAPER (1) or "
-            "TRANSFER_CONSERVATIVE_GLOBAL (2), not " +
-                std::to_string(transfer));
-    require(edge_samples >= 1 && edge_samples <= slam::MAX_EDGE_SAMPLES,
-            "edge_samples must be in [1, " + std::to_string(slam::MAX_EDGE_SAMPLES) + "], not " +
-                std::to_string(edge_samples));
-    require(on_inconsistency == slam::INCONSISTENCY_RESTART ||
-                on_inconsistency == slam::INCONSISTENCY_KEEP,
-            "on_inconsistency must be INCONSISTENCY_RESTART (0) or INCONSISTENCY_KEEP (1), not " +
-                std::to_string(on_inconsistency));
-    require(fusion == slam::FUSION_INTERSECT || fusion == slam::FUSION_RELAXED ||
-                fusion == slam::FUSION_ROBUST,
-            "fusion must be FUSION_INTERSECT (0), FUSION_RELAXED (1) or FUSION_ROBUST (2), not " +
-                std::to_string(fusion));
-    require(max_outliers >= 0 && max_outliers < slam::MAX_WINDOW,
-            "max_outliers must be in [0, " + std::to_string(slam::MAX_WINDOW) + "), not " +
-                std::to_string(max_outliers));
-    require(std::isfinite(risk), "risk must be a finite number, not " + std::to_string(risk));
     slam::Params p;
     p.epsilon = epsilon;
     p.transfer = transfer;
@@ -225,27 +100,8 @@ slam::Params make_params(double epsilon, int64_t transfer, int64_t edge_samples,
     p.risk = risk;
     p.likely = likely;
     p.estimate_bound = estimate_bound;
+    slam::validate(p);
     return p;
-}
-
-// What the fusion in `params` needs of the state's optional arrays.
-void check_state_for(const PyMapState& s, const slam::Params& p) {
-    if (p.fusion == slam::FUSION_RELAXED) {
-        require(s.window >= 1, "state has no relaxed window (state.window_vertices axis 1 is "
-                               "0), but params.fusion is FUSION_RELAXED");
-        require(s.views.base_vertices.shape[2] == slam::CAPACITY,
-                "state.base_vertices has no vertex slots, but params.fusion is FUSION_RELAXED");
-    }
-    if (p.fusion == slam::FUSION_ROBUST) {
-        require(s.levels >= 1, "state has no robust levels (state.level_vertices axis 2 is 0), "
-                               "but params.fusion is FUSION_ROBUST");
-        if (p.estimate_bound) {
-            require(s.views.probe_vertices.shape[2] == slam::CAPACITY,
-                    "state.probe_vertices has no vertex slots, but params.estimate_bound is set");
-            require(s.history >= 1, "state has no bearing history (state.history_bearings "
-                                    "axis 1 is 0), but params.estimate_bound is set");
-        }
-    }
 }
 
 void update_maps_binding(nb::handle bearings_start, nb::handle bearings_end, nb::handle rows,
@@ -257,13 +113,10 @@ void update_maps_binding(nb::handle bearings_start, nb::handle bearings_end, nb:
     const int64_t n_rows = rows_view.shape[0];
     auto start = view_of<const double, 2>(bearings_start, "bearings_start", {n_rows, n_landmarks});
     auto end = view_of<const double, 2>(bearings_end, "bearings_end", {n_rows, n_landmarks});
-    // view_of treats an expected 0 as "any": spell out the zero-row case.
-    require(start.shape[0] == n_rows && end.shape[0] == n_rows,
-            "bearings_start and bearings_end must have one row per entry of rows (" +
-                std::to_string(n_rows) + ")");
     if (!nb::isinstance<nb::tuple>(out) || nb::len(out) != 3) {
-        bearing::bindings::type_error("out must be a bearing_env.slam.kernels.Outputs tuple "
-                                      "(frame_status, landmark_status, n_bad)");
+        bearing::bindings::type_error(
+            "out must be a bearing_env.slam.kernels.Outputs tuple "
+            "(frame_status, landmark_status, n_bad)");
     }
     slam::Outputs outputs;
     outputs.frame_status = view_of<int8_t, 1>(out[0], "out.frame_status", {n_rows});
@@ -272,10 +125,10 @@ void update_maps_binding(nb::handle bearings_start, nb::handle bearings_end, nb:
     require(outputs.frame_status.shape[0] == n_rows && outputs.landmark_status.shape[0] == n_rows &&
                 outputs.landmark_status.shape[1] == m && outputs.n_bad.shape[0] == n_rows,
             "out's arrays must have one row per entry of rows (" + std::to_string(n_rows) +
-                ") and out.landmark_status one column per mapped landmark (" +
-                std::to_string(m) + ")");
+                ") and out.landmark_status one column per mapped landmark (" + std::to_string(m) +
+                ")");
     require(threads >= 1, "threads must be at least 1, not " + std::to_string(threads));
-    check_state_for(state, params);
+    bearing::bindings::check_state_for(state.views, params);
     for (int64_t i = 0; i < n_rows; ++i) {
         const int64_t row = rows_view(i);
         if (row < 0 || row >= state.maps) {
@@ -307,17 +160,15 @@ void copy_maps_binding(const PyMapState& from, nb::handle rows, const PyMapState
                 from.views.base_vertices.shape[2] == to.views.base_vertices.shape[2] &&
                 from.views.probe_vertices.shape[2] == to.views.probe_vertices.shape[2],
             "copy_maps needs states of the same landmarks and fusion arrays: from has " +
-                std::to_string(from.mapped) + " mapped landmarks, to " +
-                std::to_string(to.mapped));
+                std::to_string(from.mapped) + " mapped landmarks, to " + std::to_string(to.mapped));
     auto rows_view = view_of<const int64_t, 1>(rows, "rows");
     require(rows_view.shape[0] <= to.maps, "rows has " + std::to_string(rows_view.shape[0]) +
                                                " entries, more than to's " +
                                                std::to_string(to.maps) + " maps");
     for (int64_t i = 0; i < rows_view.shape[0]; ++i) {
         if (rows_view(i) < 0 || rows_view(i) >= from.maps) {
-            value_error("rows must be map indices in [0, " + std::to_string(from.maps) +
-                        "), got " + std::to_string(rows_view(i)) + " at position " +
-                        std::to_string(i));
+            value_error("rows must be map indices in [0, " + std::to_string(from.maps) + "), got " +
+                        std::to_string(rows_view(i)) + " at position " + std::to_string(i));
         }
     }
     slam::copy_maps(from.views, rows_view, to.views);
@@ -388,12 +239,10 @@ void contains_points_binding(nb::handle vertices, nb::handle counts, nb::handle 
     auto r = view_of<const int64_t, 1>(rows, "rows");
     auto p = view_of<const cplx, 2>(points, "points", {r.shape[0], c.shape[1]});
     auto o = view_of<bool, 2>(out, "out", {p.shape[0], p.shape[1]});
-    require(c.shape[0] == v.shape[0] && c.shape[1] == v.shape[1],
-            "counts must have the shape of vertices' first two axes");
-    require(p.shape[0] == r.shape[0] && p.shape[1] == c.shape[1],
-            "points must have one row per entry of rows and one column per landmark");
-    require(o.shape[0] == p.shape[0] && o.shape[1] == p.shape[1],
-            "out must have the shape of points");
+    bearing::bindings::require_apart(
+        {bearing::bindings::extent_of(v, "vertices"), bearing::bindings::extent_of(c, "counts"),
+         bearing::bindings::extent_of(r, "rows"), bearing::bindings::extent_of(p, "points"),
+         bearing::bindings::extent_of(o, "out")});
     for (int64_t i = 0; i < r.shape[0]; ++i) {
         if (r(i) < 0 || r(i) >= v.shape[0]) {
             value_error("rows must be map indices in [0, " + std::to_string(v.shape[0]) +
@@ -426,10 +275,10 @@ nb::tuple relaxed_region_binding(const PyMapState& s, int64_t row, int64_t j, nb
                                  bool use_base, int64_t max_outliers, nb::handle out) {
     auto k_slots = bearing::bindings::view_of<const int64_t, 1>(slots, "slots");
     auto o = bearing::bindings::view_of<cplx, 1>(out, "out");
-    require(0 <= row && row < s.maps, "row must be a map index in [0, " +
-                                          std::to_string(s.maps) + ")");
-    require(0 <= j && j < s.mapped, "j must be a landmark slot in [0, " +
-                                        std::to_string(s.mapped) + ")");
+    require(0 <= row && row < s.maps,
+            "row must be a map index in [0, " + std::to_string(s.maps) + ")");
+    require(0 <= j && j < s.mapped,
+            "j must be a landmark slot in [0, " + std::to_string(s.mapped) + ")");
     require(1 <= k_slots.shape[0] && k_slots.shape[0] <= s.window,
             "slots must hold 1.." + std::to_string(s.window) + " window slots");
     for (int64_t i = 0; i < k_slots.shape[0]; ++i) {
@@ -445,11 +294,11 @@ nb::tuple relaxed_region_binding(const PyMapState& s, int64_t row, int64_t j, nb
         check_region_count(s.views.base_counts(row, j), s.views.base_vertices.shape[2],
                            "base_counts");
     }
-    auto scratch = std::make_unique<slam::Scratch>();
-    for (int64_t i = 0; i < k_slots.shape[0]; ++i) scratch->slots[i] = k_slots(i);
-    auto [n, q] = slam::relaxed_region(s.views, row, j, k_slots.shape[0], use_base, max_outliers,
-                                       *scratch);
-    for (int64_t v = 0; v < n; ++v) o(v) = scratch->acc[v];
+    slam::Scratch& scratch = slam::thread_buffers().scratch;  // reused, not zeroed per call
+    for (int64_t i = 0; i < k_slots.shape[0]; ++i) scratch.slots[i] = k_slots(i);
+    auto [n, q] =
+        slam::relaxed_region(s.views, row, j, k_slots.shape[0], use_base, max_outliers, scratch);
+    for (int64_t v = 0; v < n; ++v) o(v) = scratch.acc[v];
     return nb::make_tuple(n, q);
 }
 
@@ -457,10 +306,10 @@ nb::tuple relaxed_region_binding(const PyMapState& s, int64_t row, int64_t j, nb
 // levels of map `row` (bearing_env.slam.geometry.robust_levels' kernel).
 void update_levels_binding(const PyMapState& s, int64_t row, int64_t j, nb::handle fresh) {
     auto f = bearing::bindings::view_of<const cplx, 1>(fresh, "fresh");
-    require(0 <= row && row < s.maps, "row must be a map index in [0, " +
-                                          std::to_string(s.maps) + ")");
-    require(0 <= j && j < s.mapped, "j must be a landmark slot in [0, " +
-                                        std::to_string(s.mapped) + ")");
+    require(0 <= row && row < s.maps,
+            "row must be a map index in [0, " + std::to_string(s.maps) + ")");
+    require(0 <= j && j < s.mapped,
+            "j must be a landmark slot in [0, " + std::to_string(s.mapped) + ")");
     require(s.levels > 0, "the state has no robust levels (fusion must be 'robust')");
     require(3 <= f.shape[0] && f.shape[0] <= slam::CAPACITY,
             "fresh must have 3.." + std::to_string(slam::CAPACITY) + " vertices");
@@ -469,9 +318,9 @@ void update_levels_binding(const PyMapState& s, int64_t row, int64_t j, nb::hand
         check_region_count(s.views.level_counts(row, j, k), s.views.level_vertices.shape[3],
                            "level_counts");
     }
-    auto scratch = std::make_unique<slam::Scratch>();
-    for (int64_t v = 0; v < f.shape[0]; ++v) scratch->fresh[v] = f(v);
-    slam::update_levels(s.views, row, j, f.shape[0], *scratch);
+    slam::Scratch& scratch = slam::thread_buffers().scratch;  // reused, not zeroed per call
+    for (int64_t v = 0; v < f.shape[0]; ++v) scratch.fresh[v] = f(v);
+    slam::update_levels(s.views, row, j, f.shape[0], scratch);
 }
 
 }  // namespace
@@ -489,16 +338,17 @@ void bind_slam_update(nb::module_& m) {
         .def_prop_ro("history", [](const PyMapState& s) { return s.history; });
 
     nb::class_<slam::Params>(m, "Params", "One update call's settings, validated.")
-        .def("__init__", [](slam::Params* self, double epsilon, int64_t transfer,
-                           int64_t edge_samples, int64_t on_inconsistency, int64_t fusion,
-                           int64_t max_outliers, bool with_robot, double risk, bool likely,
-                           bool estimate_bound) {
-                 new (self) slam::Params(make_params(epsilon, transfer, edge_samples,
-                                                     on_inconsistency, fusion, max_outliers,
-                                                     with_robot, risk, likely, estimate_bound));
-             },
-             "epsilon"_a, "transfer"_a, "edge_samples"_a, "on_inconsistency"_a, "fusion"_a,
-             "max_outliers"_a, "with_robot"_a, "risk"_a, "likely"_a, "estimate_bound"_a)
+        .def(
+            "__init__",
+            [](slam::Params* self, double epsilon, int64_t transfer, int64_t edge_samples,
+               int64_t on_inconsistency, int64_t fusion, int64_t max_outliers, bool with_robot,
+               double risk, bool likely, bool estimate_bound) {
+                new (self) slam::Params(make_params(epsilon, transfer, edge_samples,
+                                                    on_inconsistency, fusion, max_outliers,
+                                                    with_robot, risk, likely, estimate_bound));
+            },
+            "epsilon"_a, "transfer"_a, "edge_samples"_a, "on_inconsistency"_a, "fusion"_a,
+            "max_outliers"_a, "with_robot"_a, "risk"_a, "likely"_a, "estimate_bound"_a)
         .def_ro("epsilon", &slam::Params::epsilon)
         .def_ro("transfer", &slam::Params::transfer)
         .def_ro("edge_samples", &slam::Params::edge_samples)

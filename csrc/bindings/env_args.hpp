@@ -1,5 +1,6 @@
 // Checked arguments of the env kernels (bind_env.cpp): a group's Settings, the map update's
-// Params and MapState, the envs' BatchState, read from their Python objects once.
+// Params, the envs' BatchState, read from their Python objects once (the map state's
+// parser is state_args.hpp's).
 #pragma once
 
 #include <nanobind/nanobind.h>
@@ -10,24 +11,22 @@
 #include <type_traits>
 #include <vector>
 
+#include <bearing_core/env/types.hpp>
+#include <bearing_core/slam/scratch.hpp>
+#include <bearing_core/slam/state.hpp>
 #include "bindings/arrays.hpp"
 #include "bindings/sim_args.hpp"
-#include "env/types.hpp"
-#include "slam/scratch.hpp"
-#include "slam/state.hpp"
+#include "bindings/state_args.hpp"
 
 namespace bearing::bindings {
-
-// The Python objects a native object's views point into, kept alive with it.
-using Kept = std::vector<nb::object>;
 
 // The view of attribute `name` of obj, its array kept.
 template <class T, int D>
 void field_of(nb::handle obj, const char* name, View<T, D>& out, Kept& kept,
-              const std::array<int64_t, D>& expect = {}) {
+              const std::array<int64_t, D>& expect = any_shape<D>()) {
     if (!nb::hasattr(obj, name)) {
-        type_error(std::string("expected an object with the array attribute '") + name +
-                   "', got " + nb::type_name(obj.type()).c_str());
+        type_error(std::string("expected an object with the array attribute '") + name + "', got " +
+                   nb::type_name(obj.type()).c_str());
     }
     nb::object value = obj.attr(name);
     out = view_of<T, D>(value, name, expect);
@@ -104,179 +103,8 @@ inline slam::Params params_of(nb::handle obj) {
     p.risk = scalar_of<double>(obj, "risk");
     p.likely = scalar_of<bool>(obj, "likely");
     p.estimate_bound = scalar_of<bool>(obj, "estimate_bound");
-    // The ranges the native Params checks (the update's buffers are sized by them).
-    const bool valid =
-        std::isfinite(p.epsilon) && p.epsilon > 0.0 &&
-        slam::valid_transfer(p.transfer) &&
-        p.edge_samples >= 1 && p.edge_samples <= slam::MAX_EDGE_SAMPLES &&
-        (p.on_inconsistency == slam::INCONSISTENCY_RESTART ||
-         p.on_inconsistency == slam::INCONSISTENCY_KEEP) &&
-        (p.fusion == slam::FUSION_INTERSECT || p.fusion == slam::FUSION_RELAXED ||
-         p.fusion == slam::FUSION_ROBUST) &&
-        p.max_outliers >= 0 && p.max_outliers < slam::MAX_WINDOW && std::isfinite(p.risk);
-    if (!valid) value_error("params are out of range (see bearing_env._core.Params)");
+    slam::validate(p);  // the native Params' ranges (the update's buffers are sized by them)
     return p;
-}
-
-// kernels.State's fields, in order.
-inline constexpr const char* STATE_FIELDS[34] = {
-    "vertices",        "counts",           "areas",          "centroids",
-    "robot_vertices",  "robot_counts",     "robot_area",     "robot_centroid",
-    "robot_heading",   "n_updates",        "n_frame_changes", "n_inconsistent",
-    "window_vertices", "window_counts",    "window_inlier",  "window_rejected",
-    "window_length",   "window_next",      "base_vertices",  "base_counts",
-    "n_dropped",       "outliers",         "level_vertices", "level_counts",
-    "n_regions",       "robot_fixed_at",   "noise_scale",    "bound_events",
-    "probe_vertices",  "probe_counts",     "history_frame_bearings", "history_bearings",
-    "history_length",  "history_next"};
-
-// Field k of a map state given as a State tuple (by position) or as an object with the
-// arrays as attributes (a BatchedPolygonSLAM), its array kept.
-template <class T, int D>
-void state_field(nb::handle obj, bool by_position, size_t k, View<T, D>& out, Kept& kept,
-                 const typename std::common_type<std::array<int64_t, D>>::type& expect) {
-    const char* name = STATE_FIELDS[k];
-    if (!by_position && !nb::hasattr(obj, name)) {
-        type_error(std::string("maps must be a MapState, a bearing_env.slam.kernels.State or "
-                               "an object with its arrays; it has no '") + name + "'");
-    }
-    nb::object value = by_position ? nb::borrow(obj[k]) : obj.attr(name);
-    const std::string label = std::string("maps.") + name;
-    out = view_of<T, D>(value, label.c_str(), expect);
-    kept.push_back(std::move(value));
-}
-
-// A map batch's state: the native MapState (bind_slam_update.cpp: its State tuple, .state),
-// a kernels.State tuple, or any object with State's 34 arrays as attributes (a
-// BatchedPolygonSLAM); checked as the native update's bindings check it (M maps, m mapped
-// landmarks, vertex axes of CAPACITY, the window and landmark counts the update's buffers
-// hold).
-inline slam::MapState map_state_of(nb::handle obj, Kept& kept) {
-    nb::object source = nb::borrow(obj);
-    if (!nb::isinstance<nb::tuple>(source) && !nb::hasattr(source, "vertices") &&
-        nb::hasattr(source, "state")) {
-        source = source.attr("state");
-    }
-    const bool by_position = nb::isinstance<nb::tuple>(source);
-    if (by_position && nb::len(source) != 34) {
-        value_error("maps must hold the 34 arrays of bearing_env.slam.kernels.State, not " +
-                    std::to_string(nb::len(source)));
-    }
-    kept.push_back(source);
-    const int64_t C = slam::CAPACITY;
-    slam::MapState s;
-    size_t k = 0;
-    auto get = [&](auto& view, const auto& expect) {
-        state_field(source, by_position, k++, view, kept, expect);
-    };
-    using A1 = std::array<int64_t, 1>;
-    using A2 = std::array<int64_t, 2>;
-    using A3 = std::array<int64_t, 3>;
-    using A4 = std::array<int64_t, 4>;
-    get(s.vertices, A3{-1, -1, C});
-    const int64_t M = s.vertices.shape[0], m = s.vertices.shape[1];
-    get(s.counts, A2{M, m});
-    get(s.areas, A2{M, m});
-    get(s.centroids, A2{M, m});
-    get(s.robot_vertices, A2{M, C});
-    get(s.robot_counts, A1{M});
-    get(s.robot_area, A1{M});
-    get(s.robot_centroid, A1{M});
-    get(s.robot_heading, A1{M});
-    get(s.n_updates, A1{M});
-    get(s.n_frame_changes, A1{M});
-    get(s.n_inconsistent, A1{M});
-    get(s.window_vertices, A4{M, -1, m, C});
-    const int64_t w = s.window_vertices.shape[1];
-    get(s.window_counts, A3{M, w, m});
-    get(s.window_inlier, A3{M, w, m});
-    get(s.window_rejected, A2{M, w});
-    get(s.window_length, A1{M});
-    get(s.window_next, A1{M});
-    get(s.base_vertices, A3{M, m, -1});
-    get(s.base_counts, A2{M, m});
-    get(s.n_dropped, A2{M, m});
-    get(s.outliers, A2{M, m});
-    get(s.level_vertices, A4{M, m, -1, C});
-    const int64_t levels = s.level_vertices.shape[2];
-    get(s.level_counts, A3{M, m, levels});
-    get(s.n_regions, A2{M, m});
-    get(s.robot_fixed_at, A1{M});
-    get(s.noise_scale, A1{M});
-    get(s.bound_events, A1{M});
-    get(s.probe_vertices, A3{M, m, -1});
-    get(s.probe_counts, A2{M, m});
-    get(s.history_frame_bearings, A4{M, -1, 2, 2});
-    const int64_t h = s.history_frame_bearings.shape[1];
-    get(s.history_bearings, A4{M, h, 2, m});
-    get(s.history_length, A1{M});
-    get(s.history_next, A1{M});
-    // view_of skips axes of expected length 0 (0 = any): spell those out.
-    const std::array<int64_t, 34> firsts{
-        s.vertices.shape[0], s.counts.shape[0], s.areas.shape[0], s.centroids.shape[0],
-        s.robot_vertices.shape[0], s.robot_counts.shape[0], s.robot_area.shape[0],
-        s.robot_centroid.shape[0], s.robot_heading.shape[0], s.n_updates.shape[0],
-        s.n_frame_changes.shape[0], s.n_inconsistent.shape[0], s.window_vertices.shape[0],
-        s.window_counts.shape[0], s.window_inlier.shape[0], s.window_rejected.shape[0],
-        s.window_length.shape[0], s.window_next.shape[0], s.base_vertices.shape[0],
-        s.base_counts.shape[0], s.n_dropped.shape[0], s.outliers.shape[0],
-        s.level_vertices.shape[0], s.level_counts.shape[0], s.n_regions.shape[0],
-        s.robot_fixed_at.shape[0], s.noise_scale.shape[0], s.bound_events.shape[0],
-        s.probe_vertices.shape[0], s.probe_counts.shape[0], s.history_frame_bearings.shape[0],
-        s.history_bearings.shape[0], s.history_length.shape[0], s.history_next.shape[0]};
-    for (size_t f = 0; f < firsts.size(); ++f) {
-        if (firsts[f] != M) {
-            value_error(std::string("maps.") + STATE_FIELDS[f] + " has " +
-                        std::to_string(firsts[f]) + " maps, maps.vertices " + std::to_string(M));
-        }
-    }
-    const std::array<int64_t, 15> landmark_axes{
-        s.counts.shape[1], s.areas.shape[1], s.centroids.shape[1], s.window_vertices.shape[2],
-        s.window_counts.shape[2], s.window_inlier.shape[2], s.base_vertices.shape[1],
-        s.base_counts.shape[1], s.n_dropped.shape[1], s.outliers.shape[1],
-        s.level_vertices.shape[1], s.level_counts.shape[1], s.n_regions.shape[1],
-        s.probe_vertices.shape[1], s.history_bearings.shape[3]};
-    for (int64_t length : landmark_axes) {
-        if (length != m) {
-            value_error("maps' per-landmark arrays must all map the " + std::to_string(m) +
-                        " landmarks of maps.vertices");
-        }
-    }
-    const bool axes_match = s.window_counts.shape[1] == w && s.window_inlier.shape[1] == w &&
-                            s.window_rejected.shape[1] == w &&
-                            s.level_counts.shape[2] == levels &&
-                            s.history_bearings.shape[1] == h;
-    if (!axes_match) value_error("maps' window, level or history axes do not match");
-    for (const auto& [length, name] : {std::pair{s.base_vertices.shape[2], "base_vertices"},
-                                       std::pair{s.probe_vertices.shape[2], "probe_vertices"}}) {
-        if (length != C && length != 0) {
-            value_error(std::string("maps.") + name + " must have " + std::to_string(C) +
-                        " (or 0) vertex slots on its last axis, not " + std::to_string(length));
-        }
-    }
-    if (w > slam::MAX_WINDOW) value_error("maps' window is longer than MAX_WINDOW");
-    if (m + 2 > slam::MAX_LANDMARKS) {
-        value_error("maps map " + std::to_string(m) + " landmarks, more than MAX_LANDMARKS - 2");
-    }
-    return s;
-}
-
-// What the fusion of `params` needs of the map state's optional arrays (as the native
-// update's bindings check it before an update).
-inline void check_state_for(const slam::MapState& s, const slam::Params& p) {
-    if (p.fusion == slam::FUSION_RELAXED &&
-        (s.window_vertices.shape[1] < 1 || s.base_vertices.shape[2] != slam::CAPACITY)) {
-        value_error("params.fusion is FUSION_RELAXED but maps have no relaxed window or bases");
-    }
-    if (p.fusion == slam::FUSION_ROBUST) {
-        if (s.level_vertices.shape[2] < 1) {
-            value_error("params.fusion is FUSION_ROBUST but maps have no robust levels");
-        }
-        if (p.estimate_bound && (s.probe_vertices.shape[2] != slam::CAPACITY ||
-                                 s.history_bearings.shape[1] < 1)) {
-            value_error("params.estimate_bound is set but maps have no probe or history");
-        }
-    }
 }
 
 // The envs' state (state.BatchState's KERNEL_ARRAYS) from a BatchState.

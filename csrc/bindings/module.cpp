@@ -2,7 +2,7 @@
 // (bind_slam.cpp, bind_sim.cpp, bind_env.cpp), each only when its part is built.
 #include <nanobind/nanobind.h>
 
-#include "core/errors.hpp"
+#include <bearing_core/core/errors.hpp>
 
 namespace nb = nanobind;
 

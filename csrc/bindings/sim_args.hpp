@@ -5,8 +5,8 @@
 
 #include <string>
 
+#include <bearing_core/sim/sensing.hpp>
 #include "bindings/arrays.hpp"
-#include "sim/sensing.hpp"
 
 namespace bearing::bindings {
 
@@ -22,10 +22,9 @@ inline sim::Obstacles obstacles_of(nb::handle vertices, nb::handle starts,
     for (int64_t p = 0; p + 1 < obstacles.starts.shape[0]; ++p) {
         const int64_t first = obstacles.starts[p], last = obstacles.starts[p + 1];
         if (first < last && (first < 0 || last > count)) {
-            value_error(std::string(starts_name) + " indexes past the " +
-                        std::to_string(count) + " obstacle vertices (polygon " +
-                        std::to_string(p) + ": " + std::to_string(first) + " to " +
-                        std::to_string(last) + ")");
+            value_error(std::string(starts_name) + " indexes past the " + std::to_string(count) +
+                        " obstacle vertices (polygon " + std::to_string(p) + ": " +
+                        std::to_string(first) + " to " + std::to_string(last) + ")");
         }
     }
     return obstacles;

@@ -1,17 +1,17 @@
 // bearing_env/envs/kernels.py's kernels (see kernels.hpp).
-#include "env/kernels.hpp"
+#include <bearing_core/env/kernels.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/errors.hpp"
-#include "core/pymath.hpp"
-#include "env/robot_map.hpp"
-#include "sim/sensing.hpp"
-#include "sim/world.hpp"
-#include "slam/polygons.hpp"
-#include "slam/update.hpp"
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/core/pymath.hpp>
+#include <bearing_core/env/robot_map.hpp>
+#include <bearing_core/sim/sensing.hpp>
+#include <bearing_core/sim/world.hpp>
+#include <bearing_core/slam/polygons.hpp>
+#include <bearing_core/slam/update.hpp>
 
 namespace bearing::env {
 
@@ -238,8 +238,8 @@ void write_observation(int64_t row, const Inputs& inputs, float* out) {
     const double floor = settings.floor, cap = settings.cap, limit = settings.coordinate_limit;
     const int64_t bearings_at = ROBOT_FEATURES + LANDMARK_FEATURES * (settings.n_slots - 2);
     const cplx centroid = maps.robot_centroid[row];
-    const bool known = maps.robot_counts[row] > 0 && std::isfinite(centroid.re) &&
-                       std::isfinite(centroid.im);
+    const bool known =
+        maps.robot_counts[row] > 0 && std::isfinite(centroid.re) && std::isfinite(centroid.im);
     if (known) {
         out[0] = static_cast<float>(coordinate(centroid.re, limit));
         out[1] = static_cast<float>(coordinate(centroid.im, limit));
@@ -389,9 +389,9 @@ StepStatus room_for_step(View1<const int64_t> rows, const Inputs& inputs,
 }
 
 StepStatus step_rows(View1<const int64_t> rows, View1<const double> turns,
-                     View1<const double> lengths, const Inputs& inputs,
-                     View3<double> trajectory, int64_t threads, const Report& full_report,
-                     const StepBuffers& buffers, const Encoded* encoded) {
+                     View1<const double> lengths, const Inputs& inputs, View3<double> trajectory,
+                     int64_t threads, const Report& full_report, const StepBuffers& buffers,
+                     const Encoded* encoded) {
     const BatchState& state = inputs.state;
     const int64_t size = rows.shape[0], n = inputs.settings.n;
     View1<const int64_t> trajectory_length{state.trajectory_length.data,
@@ -436,8 +436,8 @@ StepStatus step_rows(View1<const int64_t> rows, View1<const double> turns,
 }
 
 template <class T>
-ActionsStatus decode_continuous(View2<const T> actions, double lo, double hi,
-                                View1<double> turns, View1<double> lengths) {
+ActionsStatus decode_continuous(View2<const T> actions, double lo, double hi, View1<double> turns,
+                                View1<double> lengths) {
     for (int64_t i = 0; i < actions.shape[0]; ++i) {
         double a = static_cast<double>(actions(i, 0)), b = static_cast<double>(actions(i, 1));
         if (!(std::isfinite(a) && std::isfinite(b))) return ACTIONS_NOT_FINITE;
@@ -450,9 +450,9 @@ ActionsStatus decode_continuous(View2<const T> actions, double lo, double hi,
     return ACTIONS_OK;
 }
 
-template ActionsStatus decode_continuous<float>(View2<const float>, double, double,
-                                                View1<double>, View1<double>);
-template ActionsStatus decode_continuous<double>(View2<const double>, double, double,
-                                                 View1<double>, View1<double>);
+template ActionsStatus decode_continuous<float>(View2<const float>, double, double, View1<double>,
+                                                View1<double>);
+template ActionsStatus decode_continuous<double>(View2<const double>, double, double, View1<double>,
+                                                 View1<double>);
 
 }  // namespace bearing::env

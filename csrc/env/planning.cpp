@@ -1,9 +1,9 @@
 // agents/planning.py's kernels (see planning.hpp).
-#include "env/planning.hpp"
+#include <bearing_core/env/planning.hpp>
 
 #include <cmath>
 
-#include "env/kernels.hpp"
+#include <bearing_core/env/kernels.hpp>
 
 namespace bearing::env {
 

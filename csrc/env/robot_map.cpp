@@ -1,5 +1,5 @@
 // bearing_env/envs/robot_map.py's kernels (see robot_map.hpp).
-#include "env/robot_map.hpp"
+#include <bearing_core/env/robot_map.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -46,16 +46,15 @@ void encode_map_into(const slam::MapState& state, View1<const int64_t> rows,
         encoded.robot_area[i] = state.robot_area[row];
         encoded.robot_centroid[i] = known(state.robot_centroid[row]);
         const double heading = state.robot_heading[row];
-        encoded.robot_heading[i] = std::isnan(heading) ? std::numeric_limits<double>::infinity()
-                                                       : heading;
+        encoded.robot_heading[i] =
+            std::isnan(heading) ? std::numeric_limits<double>::infinity() : heading;
         encoded.n_updates[i] = state.n_updates[row];
         encoded.n_frame_changes[i] = state.n_frame_changes[row];
         encoded.n_inconsistent[i] = state.n_inconsistent[row];
     }
 }
 
-void encode_window_into(const slam::MapState& state, View1<const int64_t> rows,
-                        const Window& out) {
+void encode_window_into(const slam::MapState& state, View1<const int64_t> rows, const Window& out) {
     const int64_t mapped = state.counts.shape[1];
     const int64_t window = state.window_vertices.shape[1];
     const int64_t capacity = state.window_vertices.shape[3];
@@ -85,8 +84,7 @@ void encode_window_into(const slam::MapState& state, View1<const int64_t> rows,
     }
 }
 
-void encode_levels_into(const slam::MapState& state, View1<const int64_t> rows,
-                        const Levels& out) {
+void encode_levels_into(const slam::MapState& state, View1<const int64_t> rows, const Levels& out) {
     const int64_t mapped = state.counts.shape[1];
     const int64_t levels = state.level_vertices.shape[2];
     const int64_t capacity = state.level_vertices.shape[3];

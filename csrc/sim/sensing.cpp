@@ -1,11 +1,11 @@
 // bearing_env/sensing.py's kernels (see sensing.hpp).
-#include "sim/sensing.hpp"
+#include <bearing_core/sim/sensing.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/pymath.hpp"
+#include <bearing_core/core/pymath.hpp>
 
 namespace bearing::sim {
 
@@ -44,8 +44,7 @@ double disc_entry(double x, double y, double dx, double dy, double cx, double cy
     return -b - std::sqrt(disc);
 }
 
-double free_length(double x, double y, double heading, const Obstacles& obstacles,
-                   double margin) {
+double free_length(double x, double y, double heading, const Obstacles& obstacles, double margin) {
     const double dx = std::cos(heading), dy = std::sin(heading);
     const auto& vertices = obstacles.vertices;
     const auto& starts = obstacles.starts;
@@ -103,8 +102,8 @@ bool line_of_sight(double x, double y, double target_x, double target_y,
     return true;
 }
 
-bool visible(double x, double y, double heading, double target_x, double target_y,
-             double half_fov, double max_range, const Obstacles& obstacles) {
+bool visible(double x, double y, double heading, double target_x, double target_y, double half_fov,
+             double max_range, const Obstacles& obstacles) {
     if (half_fov < PI) {
         const double angle = wrap(std::atan2(target_y - y, target_x - x) - heading);
         if (std::fabs(angle) > half_fov) return false;
@@ -113,8 +112,7 @@ bool visible(double x, double y, double heading, double target_x, double target_
     return line_of_sight(x, y, target_x, target_y, obstacles);
 }
 
-bool inside_polygon(double x, double y, View2<const double> vertices, int64_t first,
-                    int64_t last) {
+bool inside_polygon(double x, double y, View2<const double> vertices, int64_t first, int64_t last) {
     bool inside = false;
     for (int64_t k = first; k < last; ++k) {
         const int64_t following = k + 1 < last ? k + 1 : first;
@@ -144,8 +142,7 @@ double clearance(double x, double y, const Obstacles& obstacles) {
         for (int64_t k = first; k < last; ++k) {
             const int64_t following = k + 1 < last ? k + 1 : first;
             best = std::min(best, segment_distance(x, y, vertices(k, 0), vertices(k, 1),
-                                                   vertices(following, 0),
-                                                   vertices(following, 1)));
+                                                   vertices(following, 0), vertices(following, 1)));
         }
     }
     return best;

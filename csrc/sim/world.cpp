@@ -1,11 +1,11 @@
 // bearing_env/world.py's kernels (see world.hpp).
-#include "sim/world.hpp"
+#include <bearing_core/sim/world.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/pymath.hpp"
+#include <bearing_core/core/pymath.hpp>
 
 namespace bearing::sim {
 
@@ -34,13 +34,14 @@ double bearing(double landmark_x, double landmark_y, double x, double y, double 
     return wrap(std::atan2(landmark_y - y, landmark_x - x) - heading);
 }
 
-Move straight_move(double x, double y, double heading, double length, double width,
-                   double height, double margin, double min_baseline) {
+Move straight_move(double x, double y, double heading, double length, double width, double height,
+                   double margin, double min_baseline) {
     constexpr double inf = std::numeric_limits<double>::infinity();
     const double dx = std::cos(heading), dy = std::sin(heading);
     const double room_x = dx > 0.0 ? (width - margin - x) / dx : dx < 0.0 ? (margin - x) / dx : inf;
-    const double room_y =
-        dy > 0.0 ? (height - margin - y) / dy : dy < 0.0 ? (margin - y) / dy : inf;
+    const double room_y = dy > 0.0   ? (height - margin - y) / dy
+                          : dy < 0.0 ? (margin - y) / dy
+                                     : inf;
     double free = std::max(0.0, std::min(room_x, room_y));
     if (free < min_baseline) free = 0.0;
     const double travelled = std::min(length, free);

@@ -1,5 +1,5 @@
 // Scalar helpers shared by every kernel (bearing_env/slam/kernels/common.py).
-#include "slam/common.hpp"
+#include <bearing_core/slam/common.hpp>
 
 namespace bearing::slam {
 

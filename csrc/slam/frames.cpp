@@ -1,15 +1,15 @@
 // Cones in the robot frame FR and the change of frames FR -> FL: a function-for-function
 // port of bearing_env/slam/kernels/frames.py (same operations in the same order).
-#include "slam/frames.hpp"
+#include <bearing_core/slam/frames.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <limits>
 
-#include "core/errors.hpp"
-#include "slam/local_bound.hpp"
-#include "slam/polygons.hpp"
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/slam/local_bound.hpp>
+#include <bearing_core/slam/polygons.hpp>
 
 namespace bearing::slam {
 
@@ -120,8 +120,8 @@ FramePlan frame_plan(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2, boo
             longest2 / static_cast<double>(per_edge)};
 }
 
-int64_t sample_hypotheses(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2,
-                          int64_t per_edge, cplx* h1, cplx* inv_d) {
+int64_t sample_hypotheses(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2, int64_t per_edge,
+                          cplx* h1, cplx* inv_d) {
     // Buffers not zero-filled (PointBuffer): every slot read was written first.
     PointBuffer<MAX_SAMPLES> s1_buffer, s2_buffer, column_buffer;
     cplx* s1 = s1_buffer.data;
@@ -164,8 +164,8 @@ int64_t sample_hypotheses(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2
     return k;
 }
 
-int64_t transfer_region(const cplx* target, int64_t n_target, const FrameChange& frame,
-                        cplx* cloud, cplx* hull, cplx* out) {
+int64_t transfer_region(const cplx* target, int64_t n_target, const FrameChange& frame, cplx* cloud,
+                        cplx* hull, cplx* out) {
     const cplx* a1 = frame.a1;
     const cplx* a2 = frame.a2;
     const int64_t n1 = frame.n1, n2 = frame.n2;

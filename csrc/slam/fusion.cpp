@@ -1,11 +1,11 @@
 // bearing_env/slam/kernels/fusion.py in C++ (same branches, same order of operations).
-#include "slam/fusion.hpp"
+#include <bearing_core/slam/fusion.hpp>
 
 #include <array>
 #include <limits>
 
-#include "core/pymath.hpp"
-#include "slam/polygons.hpp"
+#include <bearing_core/core/pymath.hpp>
+#include <bearing_core/slam/polygons.hpp>
 
 namespace bearing::slam {
 
@@ -52,8 +52,8 @@ bool intersect_landmark(const MapState& state, int64_t row, int64_t j, int64_t n
 // Relaxed fusion: the q-relaxed intersection over a window of movements
 // ------------------------------------------------------------------------------------
 
-int64_t merge_hull(cplx* acc, int64_t n_acc, int64_t acc_capacity, const cplx* poly,
-                   int64_t n_poly, cplx* cloud, cplx* hull) {
+int64_t merge_hull(cplx* acc, int64_t n_acc, int64_t acc_capacity, const cplx* poly, int64_t n_poly,
+                   cplx* cloud, cplx* hull) {
     check_capacity("a merged hull's points", n_acc + n_poly, MAX_CLOUD);
     for (int64_t v = 0; v < n_acc; ++v) cloud[v] = acc[v];
     for (int64_t v = 0; v < n_poly; ++v) cloud[n_acc + v] = poly[v];
@@ -78,9 +78,8 @@ int64_t window_slots(const MapState& state, int64_t row, int64_t j, int64_t* out
     return k;
 }
 
-std::pair<int64_t, bool> intersect_kept(const MapState& state, int64_t row, int64_t j,
-                                        int64_t k, const bool* discarded, bool use_base,
-                                        Scratch& scratch) {
+std::pair<int64_t, bool> intersect_kept(const MapState& state, int64_t row, int64_t j, int64_t k,
+                                        const bool* discarded, bool use_base, Scratch& scratch) {
     const int64_t* slots = scratch.slots;
     cplx* first = scratch.fused;
     cplx* second = scratch.fresh;
@@ -150,9 +149,8 @@ int64_t relaxed_union(const MapState& state, int64_t row, int64_t j, int64_t k, 
     }
 }
 
-std::pair<int64_t, int64_t> relaxed_region(const MapState& state, int64_t row, int64_t j,
-                                           int64_t k, bool use_base, int64_t max_outliers,
-                                           Scratch& scratch) {
+std::pair<int64_t, int64_t> relaxed_region(const MapState& state, int64_t row, int64_t j, int64_t k,
+                                           bool use_base, int64_t max_outliers, Scratch& scratch) {
     // Without a base, at least one region must be kept.
     const int64_t q_max = std::min(max_outliers, use_base ? k : k - 1);
     for (int64_t q = 0; q < q_max + 1; ++q) {
@@ -185,12 +183,10 @@ void solve_landmark(const MapState& state, int64_t row, int64_t j, const Params&
         const int64_t newest = slots[k - 1];
         if (params.on_inconsistency == INCONSISTENCY_KEEP && state.counts(row, j) > 0) return;
         n = state.window_counts(row, newest, j);
-        copy_polygon(state.window_vertices.row(row, newest, j), n, acc, SCRATCH,
-                     "a window region");
+        copy_polygon(state.window_vertices.row(row, newest, j), n, acc, SCRATCH, "a window region");
         state.window_inlier(row, newest, j) = true;
     }
-    copy_polygon(acc, n, state.vertices.row(row, j), state.vertices.shape[2],
-                 "a landmark region");
+    copy_polygon(acc, n, state.vertices.row(row, j), state.vertices.shape[2], "a landmark region");
     state.counts(row, j) = n;
     if (n > 0) {
         set_area_centroid(state, row, j, n);

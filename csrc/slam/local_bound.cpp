@@ -1,12 +1,12 @@
 // The conservative transfer's local growth bound (see local_bound.hpp and
 // docs/world_model.md, "The local bound", for the proof each factor follows).
-#include "slam/local_bound.hpp"
+#include <bearing_core/slam/local_bound.hpp>
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/errors.hpp"
-#include "slam/frames.hpp"
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/slam/frames.hpp>
 
 namespace bearing::slam {
 
@@ -164,8 +164,8 @@ double local_growth(const cplx* target, int64_t n_target, const SubSquares& sub)
                 for (int64_t j = 0; j < m2; ++j) {
                     const int64_t j_next = next_index(j, m2);
                     const double rc = r2[j], rd = r2[j_next];
-                    const double order_a = std::max(rc * exact1[j], rd * exact1[j_next]) +
-                                           far1 * moving2[j];
+                    const double order_a =
+                        std::max(rc * exact1[j], rd * exact1[j_next]) + far1 * moving2[j];
                     // sigma = min(order_a, order_b) can raise the growth only if both do.
                     if (order_a <= growth) continue;
                     const double order_b = std::max(ra * exact2_a[j], rb * exact2_b[j]) +

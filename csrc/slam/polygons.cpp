@@ -1,14 +1,17 @@
 // Convex polygons in fixed-capacity arrays: a function-for-function port of
 // bearing_env/slam/kernels/polygons.py (same operations in the same order, so the same
-// bits). Temporary arrays the numba kernels allocate are fixed-capacity arrays on the
-// stack here, sized by the documented maxima and guarded by check_capacity.
-#include "slam/polygons.hpp"
+// bits). Temporary arrays the numba kernels allocate are small fixed-capacity arrays on
+// the stack here, or, for the hulls' (up to MAX_HULL_POINTS points), per-thread heap
+// arrays (core/workspace.hpp); either way sized by the documented maxima and guarded by
+// check_capacity.
+#include <bearing_core/slam/polygons.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/errors.hpp"
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/core/workspace.hpp>
 
 namespace bearing::slam {
 
@@ -63,6 +66,30 @@ inline bool separated(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q, cp
     return lo_q > hi_p || lo_p > hi_q;
 }
 
+// convex_hull's temporaries: its candidates' indices and sides, its task stack and the
+// copy of its hull (about 490 KB at MAX_HULL_POINTS points: too much for a thread's stack).
+struct HullWorkspace {
+    ScratchArray<int64_t> index, task_start, task_end, chain_from, chain_to, task_far;
+    ScratchArray<double> sides;
+    ScratchArray<cplx> candidates;
+};
+
+// The monotone chain's temporaries (hull_indices' sort order, and the chain that
+// small_convex_hull and small_hull_indices read back).
+struct ChainWorkspace {
+    ScratchArray<int64_t> order, chosen;
+};
+
+HullWorkspace& hull_workspace() {
+    thread_local HullWorkspace workspace;
+    return workspace;
+}
+
+ChainWorkspace& chain_workspace() {
+    thread_local ChainWorkspace workspace;
+    return workspace;
+}
+
 }  // namespace
 
 // --------------------------------------------------------------------------------------
@@ -82,8 +109,9 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
     const cplx a = points[first], b = points[last];
     out[0] = a;
     if (a == b) return 1;
+    HullWorkspace& work = hull_workspace();
     // Candidate indices, the lower side (right of a -> b) first, then the upper side.
-    int64_t index[MAX_HULL_POINTS];
+    int64_t* const index = work.index.at_least(n_points);
     int64_t n_lower = 0, n_upper = 0;
     // The lower chain's task (a -> b) finds its farthest candidate here: its scan's
     // expression bx * (p.im - ay) - by * (p.re - ax), with ax, ay = a and bx, by = b - a,
@@ -93,7 +121,7 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
     // the upper side: the same value).
     int64_t far_lower = -1;
     double min_lower = 0.0;
-    double sides[MAX_HULL_POINTS];
+    double* const sides = work.sides.at_least(n_points);
     for (int64_t i = 0; i < n_points; ++i) {
         const double side = cross(b - a, points[i] - a);
         sides[i] = side;
@@ -114,12 +142,14 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
     }
     // A stack of tasks: hull the chain from point chain_from to chain_to over the
     // candidates index[start:end]; a task with start < 0 emits point chain_from instead.
-    constexpr int64_t MAX_TASKS = 2 * MAX_HULL_POINTS + 4;
     const int64_t size = 2 * n_points + 4;
     // task_far: the slot of the task's farthest candidate when its parent found it while
     // partitioning (-1: the task scans for it).
-    int64_t task_start[MAX_TASKS], task_end[MAX_TASKS], chain_from[MAX_TASKS],
-        chain_to[MAX_TASKS], task_far[MAX_TASKS];
+    int64_t* const task_start = work.task_start.at_least(size);
+    int64_t* const task_end = work.task_end.at_least(size);
+    int64_t* const chain_from = work.chain_from.at_least(size);
+    int64_t* const chain_to = work.chain_to.at_least(size);
+    int64_t* const task_far = work.task_far.at_least(size);
     task_far[0] = -1;
     task_far[2] = far_lower;
     task_start[0] = n_lower;
@@ -218,10 +248,10 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
     }
     // out[:k] is copied (the small hull writes out; the slots it does not rewrite keep
     // the quickhull's vertices, as in numba) into storage not zero-filled first.
-    PointBuffer<MAX_HULL_POINTS + 1> candidates;
-    std::copy(out, out + k, candidates.data);
-    const auto [extent, magnitude] = scale_of(candidates.data, k);
-    return small_convex_hull(candidates.data, k, out, tolerance_of(extent, magnitude));
+    cplx* const candidates = work.candidates.at_least(k);
+    std::copy(out, out + k, candidates);
+    const auto [extent, magnitude] = scale_of(candidates, k);
+    return small_convex_hull(candidates, k, out, tolerance_of(extent, magnitude));
 }
 
 namespace {
@@ -234,7 +264,7 @@ int64_t hull_indices(const cplx* points, int64_t n_points, int64_t* out, double 
                      int64_t capacity) {
     if (n_points <= 0) return 0;
     check_capacity("small_hull_indices points", n_points, MAX_HULL_POINTS);
-    int64_t order[MAX_HULL_POINTS];
+    int64_t* const order = chain_workspace().order.at_least(n_points);
     for (int64_t i = 0; i < n_points; ++i) {  // insertion sort by (x, y)
         const cplx p = points[i];
         int64_t j = i;
@@ -269,21 +299,24 @@ int64_t hull_indices(const cplx* points, int64_t n_points, int64_t* out, double 
 
 }  // namespace
 
+// Slots of the chain buffer: a chain of any accepted input fits (see hull_indices).
+constexpr int64_t CHAIN_SLOTS = 2 * MAX_HULL_POINTS;
+
 // The chains of small_convex_hull and small_hull_indices run in a buffer of their own
 // (numba's kernels wrote past their n_points + 1 slots in the disagreeing case above,
 // corrupting the heap); only a hull of more than n_points + 1 vertices, which would
 // overflow the caller's `out`, raises CapacityError.
 int64_t small_convex_hull(const cplx* points, int64_t n_points, cplx* out, double tol) {
-    int64_t chosen[2 * MAX_HULL_POINTS];
-    const int64_t k = hull_indices(points, n_points, chosen, tol, 2 * MAX_HULL_POINTS);
+    int64_t* const chosen = chain_workspace().chosen.at_least(CHAIN_SLOTS);
+    const int64_t k = hull_indices(points, n_points, chosen, tol, CHAIN_SLOTS);
     check_capacity("small_convex_hull output", k, n_points + 1);
     for (int64_t v = 0; v < k; ++v) out[v] = points[chosen[v]];
     return k;
 }
 
 int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol) {
-    int64_t chosen[2 * MAX_HULL_POINTS];
-    const int64_t k = hull_indices(points, n_points, chosen, tol, 2 * MAX_HULL_POINTS);
+    int64_t* const chosen = chain_workspace().chosen.at_least(CHAIN_SLOTS);
+    const int64_t k = hull_indices(points, n_points, chosen, tol, CHAIN_SLOTS);
     check_capacity("small_hull_indices output", k, n_points + 1);
     std::copy(chosen, chosen + k, out);
     return k;
@@ -370,7 +403,8 @@ double polygon_distance(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q) 
 
 double longest_edge(const cplx* poly, int64_t n) {
     double longest = 0.0;
-    for (int64_t i = 0; i < n; ++i) longest = std::max(longest, abs(poly[py_mod(i + 1, n)] - poly[i]));
+    for (int64_t i = 0; i < n; ++i)
+        longest = std::max(longest, abs(poly[py_mod(i + 1, n)] - poly[i]));
     return longest;
 }
 
@@ -448,8 +482,8 @@ int64_t drop_edges_outward(cplx* poly, int64_t n, int64_t capacity) {
     return n;
 }
 
-int64_t clip_convex(const cplx* subject, int64_t n_subject, const cplx* clipper,
-                    int64_t n_clipper, cplx* out, cplx* work) {
+int64_t clip_convex(const cplx* subject, int64_t n_subject, const cplx* clipper, int64_t n_clipper,
+                    cplx* out, cplx* work) {
     const auto [size_s, mag_s] = scale_of(subject, n_subject);
     const auto [size_c, mag_c] = scale_of(clipper, n_clipper);
     const double size = std::min(size_s, size_c);

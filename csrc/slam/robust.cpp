@@ -1,12 +1,12 @@
 // bearing_env/slam/kernels/robust.py in C++ (same branches, same order of operations).
-#include "slam/robust.hpp"
+#include <bearing_core/slam/robust.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "slam/fusion.hpp"
-#include "slam/polygons.hpp"
+#include <bearing_core/slam/fusion.hpp>
+#include <bearing_core/slam/polygons.hpp>
 
 namespace bearing::slam {
 
@@ -37,6 +37,10 @@ int64_t binomial_q(int64_t n, double p, double risk, int64_t q_cap) {
     double below = term;                  // P(X <= q)
     int64_t q = 0;
     while (q < q_cap && 1.0 - below >= risk) {
+        // A zero term stays zero (past q = n, or underflowed), so `below` and the test
+        // above no longer change: the loop would run on to q_cap (endless for a huge
+        // q_cap, such as a risk <= 0 never met). Its answer, at once:
+        if (term == 0.0) return q_cap;
         term *= static_cast<double>(n - q) / (static_cast<double>(q) + 1.0) * p / (1.0 - p);
         q += 1;
         below += term;
@@ -54,8 +58,7 @@ double contamination(const MapState& state, int64_t row) {
     return UNSEEN_FACTOR * contradictions / regions;
 }
 
-void update_levels(const MapState& state, int64_t row, int64_t j, int64_t n_new,
-                   Scratch& scratch) {
+void update_levels(const MapState& state, int64_t row, int64_t j, int64_t n_new, Scratch& scratch) {
     const int64_t n_levels = state.level_counts.shape[2];
     const int64_t capacity = state.level_vertices.shape[3];
     int64_t* counts = state.level_counts.row(row, j);
@@ -68,8 +71,7 @@ void update_levels(const MapState& state, int64_t row, int64_t j, int64_t n_new,
             copy_polygon(scratch.fresh, n_new, level(k), capacity, "a robust level");
             n = n_new;
         } else if (counts[k] > 0) {
-            n = clip_convex(level(k), counts[k], scratch.fresh, n_new, scratch.fused,
-                            scratch.work);
+            n = clip_convex(level(k), counts[k], scratch.fresh, n_new, scratch.fused, scratch.work);
             copy_polygon(scratch.fused, n, level(k), capacity, "a robust level");
         } else {
             n = 0;
@@ -162,8 +164,7 @@ int64_t bound_growths(const MapState& state, int64_t row) {
 }
 
 bool grow_bound(const MapState& state, int64_t row, double epsilon) {
-    const int64_t per_growth =
-        std::max<int64_t>(1, py_floordiv(state.counts.shape[1] + 1, 2));
+    const int64_t per_growth = std::max<int64_t>(1, py_floordiv(state.counts.shape[1] + 1, 2));
     if (state.bound_events(row) < per_growth * (bound_growths(state, row) + 1)) return false;
     const double scale = state.noise_scale(row) * BOUND_GROWTH;
     if (scale > MAX_NOISE_SCALE * (1.0 + 1e-9) || scale * epsilon >= MAX_BOUND) return false;

@@ -1,5 +1,5 @@
 // Copies of whole maps between batches (bearing_env/slam/batch.py's fill_from and take).
-#include "slam/state.hpp"
+#include <bearing_core/slam/state.hpp>
 
 #include <algorithm>
 

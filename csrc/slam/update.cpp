@@ -1,7 +1,7 @@
 // bearing_env/slam/kernels/update.py in C++: one movement per map for a batch of maps,
 // serial or on kept worker threads over contiguous blocks of rows (same branches, same
 // order of operations as the numba kernels, so the same bits).
-#include "slam/update.hpp"
+#include <bearing_core/slam/update.hpp>
 
 #include <cmath>
 #include <limits>
@@ -9,14 +9,14 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/errors.hpp"
-#include "core/pymath.hpp"
-#include "core/worker_pool.hpp"
-#include "slam/frames.hpp"
-#include "slam/fusion.hpp"
-#include "slam/polygons.hpp"
-#include "slam/robust.hpp"
-#include "slam/scratch.hpp"
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/core/pymath.hpp>
+#include <bearing_core/core/worker_pool.hpp>
+#include <bearing_core/slam/frames.hpp>
+#include <bearing_core/slam/fusion.hpp>
+#include <bearing_core/slam/polygons.hpp>
+#include <bearing_core/slam/robust.hpp>
+#include <bearing_core/slam/scratch.hpp>
 
 namespace bearing::slam {
 
@@ -27,8 +27,8 @@ constexpr double NaN = std::numeric_limits<double>::quiet_NaN();
 
 // One movement's frame code and change of frames from the FR regions of L1 and L2.
 int64_t frame_of(Buffers& buf, const Params& params, FrameChange& frame) {
-    return change_of_frames(buf.fr[0], buf.fr_count[0], buf.fr[1], buf.fr_count[1],
-                            params.transfer, params.edge_samples, buf, frame);
+    return change_of_frames(buf.fr[0], buf.fr_count[0], buf.fr[1], buf.fr_count[1], params.transfer,
+                            params.edge_samples, buf, frame);
 }
 
 // Make room in map row's window for a new movement (ageing out the oldest when it is
@@ -47,8 +47,7 @@ int64_t open_window_slot(const MapState& state, int64_t row, Scratch& scratch) {
 }
 
 // Map row's robot region (the FR point R2 = 1 in FL) and heading.
-void transfer_robot(const MapState& state, int64_t row, const FrameChange& frame,
-                    Buffers& buf) {
+void transfer_robot(const MapState& state, int64_t row, const FrameChange& frame, Buffers& buf) {
     Scratch& scratch = buf.scratch;
     cplx* fresh = scratch.fresh;
     const int64_t n_robot =
@@ -76,8 +75,8 @@ void transfer_robot(const MapState& state, int64_t row, const FrameChange& frame
 
 // Every landmark's FR region from one movement's bearings; returns the frame code the
 // regions of L1 and L2 allow (FRAME_OK if both are bounded).
-int64_t cone_regions(const double* bearings_start, const double* bearings_end,
-                     int64_t n_landmarks, double epsilon, Buffers& buf) {
+int64_t cone_regions(const double* bearings_start, const double* bearings_end, int64_t n_landmarks,
+                     double epsilon, Buffers& buf) {
     for (int64_t j = 0; j < n_landmarks; ++j) {
         if (std::isnan(bearings_start[j]) || std::isnan(bearings_end[j])) {
             buf.fr_count[j] = 0;
@@ -108,8 +107,8 @@ void update_row(int64_t i, int64_t row, const double* bearings_start, const doub
     state.n_updates(row) += 1;
     out.n_bad(i) = 0;
     for (int64_t j = 0; j < n_landmarks - 2; ++j) out.landmark_status(i, j) = LANDMARK_SKIPPED;
-    out.frame_status(i) = static_cast<int8_t>(
-        cone_regions(bearings_start, bearings_end, n_landmarks, epsilon, buf));
+    out.frame_status(i) =
+        static_cast<int8_t>(cone_regions(bearings_start, bearings_end, n_landmarks, epsilon, buf));
     if (out.frame_status(i) != FRAME_OK) return;
     FrameChange frame;
     const int64_t status = frame_of(buf, params, frame);
@@ -184,10 +183,9 @@ void update_row(int64_t i, int64_t row, const double* bearings_start, const doub
 // Fuse the movement just fused into map row (with the bound epsilon, as out row i
 // reports) into its probe, at PROBE_SHRINK * epsilon; returns how many landmarks give
 // evidence that the bound is too small.
-int64_t probe_row(int64_t i, int64_t row, const double* bearings_start,
-                  const double* bearings_end, int64_t n_landmarks, double epsilon,
-                  const Params& params, const MapState& state, const Outputs& out,
-                  Buffers& buf) {
+int64_t probe_row(int64_t i, int64_t row, const double* bearings_start, const double* bearings_end,
+                  int64_t n_landmarks, double epsilon, const Params& params, const MapState& state,
+                  const Outputs& out, Buffers& buf) {
     if (out.frame_status(i) != FRAME_OK) return 0;
     Scratch& scratch = buf.scratch;
     int64_t status =
@@ -241,10 +239,35 @@ void rebuild_row(int64_t i, int64_t row, int64_t n_landmarks, const Params& para
     throw std::invalid_argument("map " + std::to_string(row) + " has a corrupt state: " + what);
 }
 
-// The counts and positions of map row that the update indexes buffers with (written by
-// the kernels only, but a user can write the arrays): any out of range raises
-// std::invalid_argument (a ValueError in Python) before the map is written.
+// A counter the update adds to: in [0, MAX_COUNTER], so the additions cannot overflow.
+void check_counter(int64_t value, int64_t row, const char* what) {
+    if (value < 0 || value > MAX_COUNTER) corrupt(row, what);
+}
+
+// The counters of map row that the update adds to (check_map).
+void check_counters(const MapState& state, int64_t row, const Params& params) {
+    check_counter(state.n_updates(row), row, "n_updates out of range");
+    check_counter(state.n_frame_changes(row), row, "n_frame_changes out of range");
+    check_counter(state.n_inconsistent(row), row, "n_inconsistent out of range");
+    for (int64_t j = 0; j < state.counts.shape[1]; ++j) {
+        if (params.fusion == FUSION_RELAXED) {
+            check_counter(state.n_dropped(row, j), row, "n_dropped out of range");
+        }
+        if (params.fusion == FUSION_ROBUST) {
+            check_counter(state.n_regions(row, j), row, "n_regions out of range");
+        }
+    }
+    if (params.fusion == FUSION_ROBUST && params.estimate_bound) {
+        check_counter(state.bound_events(row), row, "bound_events out of range");
+    }
+}
+
+// The counts and positions of map row that the update indexes buffers with, and the
+// counters it adds to (written by the kernels only, but a user can write the arrays):
+// any out of range raises std::invalid_argument (a ValueError in Python) before the map
+// is written.
 void check_map(const MapState& state, int64_t row, const Params& params) {
+    check_counters(state, row, params);
     const int64_t m = state.counts.shape[1];
     for (int64_t j = 0; j < m; ++j) {
         const int64_t n = state.counts(row, j);
@@ -308,9 +331,8 @@ void check_map(const MapState& state, int64_t row, const Params& params) {
 
 // update_maps for bearings rows first to stop, in one thread's buffers.
 void update_rows(int64_t first, int64_t stop, View2<const double> bearings_start,
-                 View2<const double> bearings_end, View1<const int64_t> rows,
-                 const Params& params, const MapState& state, const Outputs& out,
-                 Buffers& buf) {
+                 View2<const double> bearings_end, View1<const int64_t> rows, const Params& params,
+                 const MapState& state, const Outputs& out, Buffers& buf) {
     const bool estimating = params.fusion == FUSION_ROBUST && params.estimate_bound;
     const int64_t n_landmarks = bearings_start.shape[1];
     // As update.py's _new_buffers: zeroed counts, the FR robot point R2 = 1.
@@ -337,19 +359,16 @@ void update_rows(int64_t first, int64_t stop, View2<const double> bearings_start
     }
 }
 
-// This thread's buffers: allocated on the thread's first update, then reused (one
-// allocation per thread, none per call on a long-lived thread, none per movement).
+}  // namespace
+
 Buffers& thread_buffers() {
     thread_local std::unique_ptr<Buffers> buffers;
     if (!buffers) buffers = std::make_unique<Buffers>();
     return *buffers;
 }
 
-}  // namespace
-
-int64_t change_of_frames(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2,
-                         int64_t transfer, int64_t edge_samples, Buffers& buf,
-                         FrameChange& frame) {
+int64_t change_of_frames(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2, int64_t transfer,
+                         int64_t edge_samples, Buffers& buf, FrameChange& frame) {
     const bool conservative = transfer != TRANSFER_PAPER;
     const bool local = transfer == TRANSFER_CONSERVATIVE;
     const FramePlan plan = frame_plan(a1, n1, a2, n2, conservative, edge_samples);
@@ -379,10 +398,9 @@ void update_maps(View2<const double> bearings_start, View2<const double> bearing
     const int64_t n_rows = rows.shape[0];
     check_capacity("landmarks per movement", bearings_start.shape[1], MAX_LANDMARKS);
     if (bearings_start.shape[1] != state.counts.shape[1] + 2 ||
-        bearings_end.shape[1] != bearings_start.shape[1] ||
-        bearings_start.shape[0] < n_rows || bearings_end.shape[0] < n_rows ||
-        out.frame_status.shape[0] < n_rows || out.n_bad.shape[0] < n_rows ||
-        out.landmark_status.shape[0] < n_rows ||
+        bearings_end.shape[1] != bearings_start.shape[1] || bearings_start.shape[0] < n_rows ||
+        bearings_end.shape[0] < n_rows || out.frame_status.shape[0] < n_rows ||
+        out.n_bad.shape[0] < n_rows || out.landmark_status.shape[0] < n_rows ||
         out.landmark_status.shape[1] != state.counts.shape[1]) {
         throw std::invalid_argument("update_maps: bearings or outputs of the wrong shape");
     }
@@ -409,8 +427,7 @@ void update_maps(View2<const double> bearings_start, View2<const double> bearing
     });
 }
 
-int64_t check_indices(const int64_t* indices, int64_t n, int64_t size, bool distinct,
-                      bool* seen) {
+int64_t check_indices(const int64_t* indices, int64_t n, int64_t size, bool distinct, bool* seen) {
     if (distinct) {
         for (int64_t k = 0; k < size; ++k) seen[k] = false;
     }
@@ -431,7 +448,8 @@ void contains_points(View3<const cplx> vertices, View2<const int64_t> counts,
     for (int64_t i = 0; i < rows.shape[0]; ++i) {
         for (int64_t j = 0; j < points.shape[1]; ++j) {
             const int64_t n = counts(rows(i), j);
-            out(i, j) = n > 0 && contains_point(vertices.row(rows(i), j), n, points(i, j), relative);
+            out(i, j) =
+                n > 0 && contains_point(vertices.row(rows(i), j), n, points(i, j), relative);
         }
     }
 }

@@ -8,11 +8,13 @@ the binding went away, fails here.
 from __future__ import annotations
 
 import ast
-from pathlib import Path
+import importlib.resources
 
 from bearing_env import _core
 
-STUB = Path(__file__).resolve().parents[2] / "bearing_env" / "_core.pyi"
+#: The stub as installed with the package (the source tree is absent when the installed
+#: package's tests run, e.g. from the sdist).
+STUB = importlib.resources.files("bearing_env") / "_core.pyi"
 
 
 def _stub_names() -> set[str]:

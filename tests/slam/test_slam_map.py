@@ -795,3 +795,33 @@ def test_status_names_are_indexed_by_contiguous_kernel_codes() -> None:
     assert _names_by_code({1: "b", 0: "a"}) == ("a", "b")
     with pytest.raises(ValueError, match=r"0\.\.1, got \[0, 2\]"):
         _names_by_code({0: "a", 2: "c"})
+
+
+@pytest.mark.parametrize(
+    ("fusion", "counter", "value"),
+    [
+        ("intersect", "n_updates", 2**63 - 1),
+        ("intersect", "n_frame_changes", 2**62 + 1),
+        ("intersect", "n_inconsistent", -1),
+        ("relaxed", "n_dropped", 2**63 - 1),
+        ("robust", "n_regions", 2**63 - 1),
+        ("robust", "bound_events", 2**63 - 1),
+    ],
+)
+def test_a_counter_that_would_overflow_is_refused_and_the_map_left_alone(
+    fusion: str, counter: str, value: int
+) -> None:
+    # A user can write the state's arrays; the update refuses a counter it would carry
+    # past int64's end (or a negative one) instead of overflowing it.
+    maps = BatchedPolygonSLAM(2, 4, np.deg2rad(3.0), fusion=fusion)
+    getattr(maps, counter).reshape(2, -1)[1, 0] = value
+    before = {name: getattr(maps, name).copy() for name in STATE_ARRAYS}
+    episode = random_episode(np.random.default_rng(4), 4, 1)
+    b1, b2 = episode.readings(np.deg2rad(1.0))[0]
+    with pytest.raises(ValueError, match=f"map 1 has a corrupt state: {counter} out of range"):
+        maps.update(b1[None], b2[None], maps=[1])
+    for name in STATE_ARRAYS:
+        np.testing.assert_array_equal(getattr(maps, name), before[name], err_msg=name)
+    # At the limit, the update runs.
+    getattr(maps, counter).reshape(2, -1)[1, 0] = 2**62
+    maps.update(np.stack([b1, b1]), np.stack([b2, b2]))

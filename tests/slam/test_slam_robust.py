@@ -353,3 +353,13 @@ def test_a_reset_forgets_the_grown_bound_and_the_history(vector: bool) -> None:
         assert slam.bound == slam.epsilon and batch.history_length[row] == 0
         assert batch.bound_events[row] == 0 and not batch.probe_counts[row].any()
     env.close()
+
+
+@pytest.mark.parametrize("n", [10, 2**62])
+def test_binomial_q_returns_q_cap_at_once_when_the_risk_is_never_met(n: int) -> None:
+    # risk <= 0 is never met: the answer is q_cap, however large (the loop once ran up to
+    # q_cap, endless for a huge one).
+    assert kernels.binomial_q(n, 0.5, 0.0, 2**63 - 1) == 2**63 - 1
+    assert kernels.binomial_q(n, 0.5, -1.0, 7) == 7
+    # A huge q_cap with a risk that is met: the smallest q, as with a small cap.
+    assert kernels.binomial_q(10, 0.5, 0.05, 2**63 - 1) == kernels.binomial_q(10, 0.5, 0.05, 10)

@@ -1,5 +1,5 @@
-"""The native update's kept worker threads (csrc/core/worker_pool.hpp): the same maps
-whatever runs them, from a forked child and from two Python threads at once."""
+"""The native update's kept worker threads (csrc/include/bearing_core/core/worker_pool.hpp):
+the same maps whatever runs them, from a forked child and from two Python threads at once."""
 
 from __future__ import annotations
 

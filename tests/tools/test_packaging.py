@@ -88,6 +88,9 @@ def test_the_sdist_carries_the_tests_the_native_sources_and_no_build_output(
     native = {p.relative_to(ROOT).as_posix() for p in (ROOT / "csrc").rglob("*") if p.is_file()}
     assert native and native <= names, sorted(native - names)
     assert {"LICENSE", "CITATION.cff", "docs/design.md", "CMakeLists.txt"} <= names
+    # The C++ library's package config and its example project (docs/cpp.md).
+    assert {"cmake/bearing_coreConfig.cmake.in", "examples/cpp/CMakeLists.txt",
+            "examples/cpp/replay.cpp", "examples/cpp/bearing_log.csv"} <= names  # fmt: skip
     assert not [n for n in names if n.endswith((".nbi", ".nbc", ".pyc", ".so", ".o"))]
     assert not [n for n in names if n.startswith(("build/", ".venv/", "docs/_build/"))]
 

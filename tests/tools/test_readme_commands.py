@@ -22,7 +22,9 @@ How each kind is checked, cheaply:
   and whose source is written by a documented ``compare`` command;
 - ``zoo``: an rl-zoo3 command, which ``tests/tools/test_zoo_commands.py`` runs (briefly)
   as it reads it from the docs;
-- ``pip``: a ``pip install`` of the package, whose extras are all in ``pyproject.toml``.
+- ``pip``: a ``pip install`` of the package, whose extras are all in ``pyproject.toml``;
+- ``cpp``: a command of the C++ library's build, which ``tests/tools/test_cpp_library.py``
+  runs as it reads it from ``docs/cpp.md``.
 
 CI's entry point, ``.ci/run``, runs exactly the README's test command
 (:func:`test_ci_runs_the_readme_test_command`).
@@ -60,6 +62,8 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "make bench-slam": ("make", ()),
     "make lint": ("make", ()),
     "make native": ("make", ()),
+    "make format": ("make", ()),
+    "make wheel": ("make", ()),
     "bearing-env train": ("parse", ("--algo", "ppo")),
     "bearing-env train --algo ppo --env BearingSLAM-Khepera-v1 --seeds 0 1 2 --workers 2 "
     "--eval-freq 250000 --output runs/ppo_khepera": ("parse", ()),
@@ -245,6 +249,16 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "cp outputs/compare_random6/summary.json "
     "docs/compare/results/settings_random6.json": ("copy", ()),
     'cp outputs/compare_lookahead/summary.json docs/compare/results/lookahead.json': ('copy', ()),
+    "cmake -S . -B build/cpp -G Ninja -DBEARING_ENV_PYTHON=OFF": ("cpp", ()),
+    "cmake --build build/cpp": ("cpp", ()),
+    "ctest --test-dir build/cpp --output-on-failure": ("cpp", ()),
+    "cmake --install build/cpp --prefix /opt/bearing_core": ("cpp", ()),
+    "cmake -S examples/cpp -B build/replay -G Ninja -DCMAKE_PREFIX_PATH=/opt/bearing_core": (
+        "cpp",
+        (),
+    ),
+    "cmake --build build/replay": ("cpp", ()),
+    "build/replay/replay examples/cpp/bearing_log.csv 0.0349": ("cpp", ()),
 }
 
 
@@ -431,6 +445,12 @@ def test_readme_command_runs_or_parses(command: str, tmp_path: Path) -> None:
         writers = ("bearing-env compare", "python -m bearing_env.train.studies.generalisation")
         producers = [c for c in CHECKS if c.startswith(writers) and out_option in c]
         assert producers, f"no documented command writes {source}"
+    elif kind == "cpp":
+        # The C++ build's commands: tests/tools/test_cpp_library.py runs them as it reads
+        # them from docs/cpp.md.
+        from tests.tools.test_cpp_library import page_commands
+
+        assert command in page_commands()
     elif kind == "zoo":
         from tests.tools.test_zoo_commands import COMMANDS
 

@@ -23,7 +23,7 @@
 
 #include <cstdint>
 
-#include "slam/common.hpp"
+#include <bearing_core/slam/common.hpp>
 
 namespace bearing::slam {
 

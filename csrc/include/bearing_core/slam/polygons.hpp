@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <utility>
 
-#include "slam/common.hpp"
+#include <bearing_core/slam/common.hpp>
 
 namespace bearing::slam {
 
@@ -20,8 +20,8 @@ inline constexpr int64_t MAX_HULL_POINTS = MAX_CLOUD + SCRATCH;
 // NaNs, raises CapacityError; the small hulls' chains run in a buffer of their own, see
 // polygons.cpp); clip_convex's out and work hold SCRATCH; offset_outward's out n + 3, and
 // it throws std::invalid_argument for n < 1 (numba read poly[-1]); its out must not
-// overlap poly (each edge's tangent is computed once and reused for the next vertex). Points: at most
-// MAX_HULL_POINTS, else CapacityError.
+// overlap poly (each edge's tangent is computed once and reused for the next vertex). Points: at
+// most MAX_HULL_POINTS, else CapacityError.
 int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out);
 int64_t small_convex_hull(const cplx* points, int64_t n_points, cplx* out, double tol);
 int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol);
@@ -31,8 +31,8 @@ double polygon_distance(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q);
 double longest_edge(const cplx* poly, int64_t n);
 int64_t simplify(cplx* poly, int64_t n, double tol);
 int64_t drop_edges_outward(cplx* poly, int64_t n, int64_t capacity);
-int64_t clip_convex(const cplx* subject, int64_t n_subject, const cplx* clipper,
-                    int64_t n_clipper, cplx* out, cplx* work);
+int64_t clip_convex(const cplx* subject, int64_t n_subject, const cplx* clipper, int64_t n_clipper,
+                    cplx* out, cplx* work);
 int64_t offset_outward(const cplx* poly, int64_t n, double radius, cplx* out);
 
 // Distance from z to the segment [a, b].

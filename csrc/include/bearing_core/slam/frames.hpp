@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <utility>
 
-#include "slam/common.hpp"
+#include <bearing_core/slam/common.hpp>
 
 namespace bearing::slam {
 
@@ -24,8 +24,8 @@ struct FrameChange {
     // With conservative: the movement's sub-squares, for the local bound (the growth is
     // the smaller of it and the global one); nullptr grows by the global bound alone.
     const SubSquares* local = nullptr;
-    double distance = 0.0;      // distance between the regions of L1 and L2
-    double delta1 = 0.0;        // sample spacing on L1's edges
+    double distance = 0.0;  // distance between the regions of L1 and L2
+    double delta1 = 0.0;    // sample spacing on L1's edges
     double delta2 = 0.0;
 };
 
@@ -44,10 +44,10 @@ int64_t boundary_samples(const cplx* poly, int64_t n, int64_t per_edge, cplx* ou
 FramePlan frame_plan(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2, bool conservative,
                      int64_t edge_samples);
 // h1 and inv_d hold MAX_PAIRS; returns the pair count.
-int64_t sample_hypotheses(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2,
-                          int64_t per_edge, cplx* h1, cplx* inv_d);
+int64_t sample_hypotheses(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2, int64_t per_edge,
+                          cplx* h1, cplx* inv_d);
 // cloud holds MAX_CLOUD, hull MAX_CLOUD + 1, out SCRATCH (frames.py's contract).
-int64_t transfer_region(const cplx* target, int64_t n_target, const FrameChange& frame,
-                        cplx* cloud, cplx* hull, cplx* out);
+int64_t transfer_region(const cplx* target, int64_t n_target, const FrameChange& frame, cplx* cloud,
+                        cplx* hull, cplx* out);
 
 }  // namespace bearing::slam

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "env/types.hpp"
+#include <bearing_core/env/types.hpp>
 
 namespace bearing::env {
 
@@ -20,8 +20,7 @@ double move_and_read(int64_t row, double turn, double length, const Inputs& inpu
 bool append_positions(View1<const int64_t> rows, View2<const double> positions,
                       View3<double> trajectory, View1<int64_t> lengths);
 
-double potential_of(const double* areas, int64_t n_mapped, bool log_area, double floor,
-                    double cap);
+double potential_of(const double* areas, int64_t n_mapped, bool log_area, double floor, double cap);
 void potentials(View1<const int64_t> rows, const Inputs& inputs, View1<double> out);
 
 // report's first rows as kernels._new_report makes them (zero observations and reward
@@ -43,14 +42,14 @@ StepStatus room_for_step(View1<const int64_t> rows, const Inputs& inputs,
 // len(rows) rows; the per-call buffers are `buffers` (capacity >= len(rows)). With
 // `encoded` (not null), the robot map's arrays too (kernels.step_rows).
 StepStatus step_rows(View1<const int64_t> rows, View1<const double> turns,
-                     View1<const double> lengths, const Inputs& inputs,
-                     View3<double> trajectory, int64_t threads, const Report& report,
-                     const StepBuffers& buffers, const Encoded* encoded);
+                     View1<const double> lengths, const Inputs& inputs, View3<double> trajectory,
+                     int64_t threads, const Report& report, const StepBuffers& buffers,
+                     const Encoded* encoded);
 
 // Turn angles and move lengths of continuous actions (N, 2) in [-1, 1]^2.
 template <class T>
-ActionsStatus decode_continuous(View2<const T> actions, double lo, double hi,
-                                View1<double> turns, View1<double> lengths);
+ActionsStatus decode_continuous(View2<const T> actions, double lo, double hi, View1<double> turns,
+                                View1<double> lengths);
 
 inline double capped(double area, double floor, double cap) {
     return std::min(std::max(area, floor), cap);

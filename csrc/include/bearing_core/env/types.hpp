@@ -6,10 +6,10 @@
 
 #include <cstdint>
 
-#include "core/complex.hpp"
-#include "core/views.hpp"
-#include "sim/sensing.hpp"
-#include "slam/state.hpp"
+#include <bearing_core/core/complex.hpp>
+#include <bearing_core/core/views.hpp>
+#include <bearing_core/sim/sensing.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::env {
 
@@ -34,12 +34,12 @@ struct Settings {
     bool shape_features = false;  // the flat vector ends with the regions' shapes
     double width = 0.0;           // the arena, metres
     double height = 0.0;
-    double margin = 0.0;          // the wall margin
-    double min_baseline = 0.0;    // shortest move that changes frames
-    bool log_area = false;        // the reward's potential sums log-areas (else areas)
-    double floor = 0.0;           // areas are floored here before taking logs
-    double cap = 0.0;             // and capped here (area_cap)
-    double target_area = 0.0;     // success: every landmark's area at most this
+    double margin = 0.0;        // the wall margin
+    double min_baseline = 0.0;  // shortest move that changes frames
+    bool log_area = false;      // the reward's potential sums log-areas (else areas)
+    double floor = 0.0;         // areas are floored here before taking logs
+    double cap = 0.0;           // and capped here (area_cap)
+    double target_area = 0.0;   // success: every landmark's area at most this
     int64_t max_moves = 0;
     double path_cost = 0.0;         // per metre
     double move_cost = 0.0;         // per move
@@ -85,22 +85,22 @@ struct Inputs {
 
 // What a step (or a reset) of a group gives, per row (kernels.Report, same order).
 struct Report {
-    View2<float> observations;             // (rows, observation size)
-    View1<double> rewards;                 // (rows,)
-    View1<bool> terminated;                // (rows,)
-    View1<bool> truncated;                 // (rows,)
-    View1<bool> frame_changed;             // (rows,)
-    View1<int64_t> inconsistent;           // (rows,)
-    View1<double> path_length;             // (rows,)
-    View1<double> uncertainty;             // (rows,)
-    View1<double> path_cost;               // (rows,)
-    View1<double> move_cost;               // (rows,)
-    View2<double> landmark_area;           // (rows, n - 2)
-    View2<double> landmark_error;          // (rows, n - 2)
-    View2<bool> landmark_contains_truth;   // (rows, n - 2)
-    View1<double> total_area;              // (rows,)
-    View1<double> robot_error;             // (rows,)
-    View2<int64_t> outliers;               // (rows, n - 2)
+    View2<float> observations;            // (rows, observation size)
+    View1<double> rewards;                // (rows,)
+    View1<bool> terminated;               // (rows,)
+    View1<bool> truncated;                // (rows,)
+    View1<bool> frame_changed;            // (rows,)
+    View1<int64_t> inconsistent;          // (rows,)
+    View1<double> path_length;            // (rows,)
+    View1<double> uncertainty;            // (rows,)
+    View1<double> path_cost;              // (rows,)
+    View1<double> move_cost;              // (rows,)
+    View2<double> landmark_area;          // (rows, n - 2)
+    View2<double> landmark_error;         // (rows, n - 2)
+    View2<bool> landmark_contains_truth;  // (rows, n - 2)
+    View1<double> total_area;             // (rows,)
+    View1<double> robot_error;            // (rows,)
+    View2<int64_t> outliers;              // (rows, n - 2)
 
     // The first `size` rows (C-contiguous: a prefix of every array).
     Report first(int64_t size) const;
@@ -108,16 +108,16 @@ struct Report {
 
 // The robot map's arrays as robot_map.encode_map gives them (MAP_ARRAYS, same order).
 struct Encoded {
-    View3<cplx> vertices;          // (rows, slots, capacity)
-    View2<int64_t> counts;         // (rows, slots)
-    View2<double> areas;           // (rows, slots)
-    View2<cplx> centroids;         // (rows, slots)
-    View2<cplx> robot_vertices;    // (rows, capacity)
-    View1<int64_t> robot_counts;   // (rows,)
-    View1<double> robot_area;      // (rows,)
-    View1<cplx> robot_centroid;    // (rows,)
-    View1<double> robot_heading;   // (rows,)
-    View1<int64_t> n_updates;      // (rows,)
+    View3<cplx> vertices;            // (rows, slots, capacity)
+    View2<int64_t> counts;           // (rows, slots)
+    View2<double> areas;             // (rows, slots)
+    View2<cplx> centroids;           // (rows, slots)
+    View2<cplx> robot_vertices;      // (rows, capacity)
+    View1<int64_t> robot_counts;     // (rows,)
+    View1<double> robot_area;        // (rows,)
+    View1<cplx> robot_centroid;      // (rows,)
+    View1<double> robot_heading;     // (rows,)
+    View1<int64_t> n_updates;        // (rows,)
     View1<int64_t> n_frame_changes;  // (rows,)
     View1<int64_t> n_inconsistent;   // (rows,)
 

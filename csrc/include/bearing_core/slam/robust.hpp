@@ -5,10 +5,10 @@
 
 #include <cstdint>
 
-#include "core/pymath.hpp"
-#include "slam/frames.hpp"
-#include "slam/scratch.hpp"
-#include "slam/state.hpp"
+#include <bearing_core/core/pymath.hpp>
+#include <bearing_core/slam/frames.hpp>
+#include <bearing_core/slam/scratch.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::slam {
 
@@ -35,8 +35,7 @@ int64_t binomial_q(int64_t n, double p, double risk, int64_t q_cap);
 // Map row's estimated share of contaminated regions.
 double contamination(const MapState& state, int64_t row);
 // Fuse scratch.fresh[:n_new] into landmark j's levels.
-void update_levels(const MapState& state, int64_t row, int64_t j, int64_t n_new,
-                   Scratch& scratch);
+void update_levels(const MapState& state, int64_t row, int64_t j, int64_t n_new, Scratch& scratch);
 // Fuse scratch.fresh[:n_new] into landmark j (rate: the map's contamination before this
 // movement); false when it contradicts the landmark's regions.
 bool robust_landmark(const MapState& state, int64_t row, int64_t j, int64_t n_new, double rate,
@@ -47,8 +46,7 @@ bool frame_contradicts_robot(const MapState& state, int64_t row, const FrameChan
                              Scratch& scratch);
 // Intersect the probe's new region scratch.fresh[:n_new] into its region of landmark j;
 // false when they miss each other (the old one is kept).
-bool probe_landmark(const MapState& state, int64_t row, int64_t j, int64_t n_new,
-                    Scratch& scratch);
+bool probe_landmark(const MapState& state, int64_t row, int64_t j, int64_t n_new, Scratch& scratch);
 // How many times map row's bound has grown.
 int64_t bound_growths(const MapState& state, int64_t row);
 // Grow map row's bound by BOUND_GROWTH when its probe's evidence warrants; returns

@@ -20,7 +20,8 @@ struct cplx {
     double re = 0.0;
     double im = 0.0;
     constexpr cplx() = default;
-    constexpr cplx(double real, double imag = 0.0) : re(real), im(imag) {}  // NOLINT: implicit like numba's promotion
+    constexpr cplx(double real, double imag = 0.0)
+        : re(real), im(imag) {}  // NOLINT: implicit like numba's promotion
 };
 
 inline cplx operator+(cplx a, cplx b) { return {a.re + b.re, a.im + b.im}; }

@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "slam/state.hpp"
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::slam {
 
@@ -15,9 +15,8 @@ struct FrameChange;  // slam/frames.hpp
 // frames from A_L1 = a1[:n1] and A_L2 = a2[:n2] as `transfer` makes it: the hypotheses
 // sampled into buf.h1 and buf.inv_d and, for TRANSFER_CONSERVATIVE, the sub-squares
 // planned into buf.sub. The update and the transfer_polygon binding both use it.
-int64_t change_of_frames(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2,
-                         int64_t transfer, int64_t edge_samples, Buffers& buf,
-                         FrameChange& frame);
+int64_t change_of_frames(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2, int64_t transfer,
+                         int64_t edge_samples, Buffers& buf, FrameChange& frame);
 
 // Fuse one movement into each map rows[i] (bearings row i), in place, reporting to out
 // row i. With threads > 1 the rows are split into `threads` contiguous blocks, one per
@@ -39,8 +38,7 @@ enum IndexCheck : int64_t { INDEX_OK = 0, INDEX_OUT_OF_RANGE = 1, INDEX_REPEATED
 
 // Whether indices[:n] are in [0, size) (and, if distinct, none repeats). `seen` holds
 // `size` flags (only used when distinct; the caller provides it).
-int64_t check_indices(const int64_t* indices, int64_t n, int64_t size, bool distinct,
-                      bool* seen);
+int64_t check_indices(const int64_t* indices, int64_t n, int64_t size, bool distinct, bool* seen);
 
 // out(i, j): region j of map rows[i] contains points(i, j) (relative tolerance).
 void contains_points(View3<const cplx> vertices, View2<const int64_t> counts,

@@ -3,8 +3,8 @@
 
 #include <cstdint>
 
-#include "core/complex.hpp"
-#include "core/views.hpp"
+#include <bearing_core/core/complex.hpp>
+#include <bearing_core/core/views.hpp>
 
 namespace bearing::env {
 

@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-#include "core/views.hpp"
+#include <bearing_core/core/views.hpp>
 
 namespace bearing::sim {
 
@@ -32,8 +32,8 @@ bool segments_cross(double px, double py, double qx, double qy, double ax, doubl
 bool on_segment(double ax, double ay, double bx, double by, double px, double py);
 bool line_of_sight(double x, double y, double target_x, double target_y,
                    const Obstacles& obstacles);
-bool visible(double x, double y, double heading, double target_x, double target_y,
-             double half_fov, double max_range, const Obstacles& obstacles);
+bool visible(double x, double y, double heading, double target_x, double target_y, double half_fov,
+             double max_range, const Obstacles& obstacles);
 bool inside_polygon(double x, double y, View2<const double> vertices, int64_t first, int64_t last);
 double segment_distance(double x, double y, double ax, double ay, double bx, double by);
 double clearance(double x, double y, const Obstacles& obstacles);

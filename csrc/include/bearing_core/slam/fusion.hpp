@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <utility>
 
-#include "slam/scratch.hpp"
-#include "slam/state.hpp"
+#include <bearing_core/slam/scratch.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::slam {
 
@@ -20,8 +20,8 @@ bool intersect_landmark(const MapState& state, int64_t row, int64_t j, int64_t n
 
 // The convex hull of acc[:n_acc] and poly[:n_poly] into acc (which holds acc_capacity
 // points), reduced to CAPACITY vertices; returns its count.
-int64_t merge_hull(cplx* acc, int64_t n_acc, int64_t acc_capacity, const cplx* poly,
-                   int64_t n_poly, cplx* cloud, cplx* hull);
+int64_t merge_hull(cplx* acc, int64_t n_acc, int64_t acc_capacity, const cplx* poly, int64_t n_poly,
+                   cplx* cloud, cplx* hull);
 
 // The window slots (oldest first) holding a region of landmark j from a movement not
 // rejected, into out (MAX_WINDOW); returns how many.
@@ -29,18 +29,16 @@ int64_t window_slots(const MapState& state, int64_t row, int64_t j, int64_t* out
 
 // (n, in_first): the intersection of the base (if used) and the kept regions of
 // scratch.slots[:k] (those not `discarded`), in scratch.fused if in_first else fresh.
-std::pair<int64_t, bool> intersect_kept(const MapState& state, int64_t row, int64_t j,
-                                        int64_t k, const bool* discarded, bool use_base,
-                                        Scratch& scratch);
+std::pair<int64_t, bool> intersect_kept(const MapState& state, int64_t row, int64_t j, int64_t k,
+                                        const bool* discarded, bool use_base, Scratch& scratch);
 
 // The hull of the union over every choice of q left-out slots into scratch.acc.
 int64_t relaxed_union(const MapState& state, int64_t row, int64_t j, int64_t k, bool use_base,
                       int64_t q, Scratch& scratch);
 
 // (n, q): the q-relaxed region for the smallest q <= max_outliers, into scratch.acc.
-std::pair<int64_t, int64_t> relaxed_region(const MapState& state, int64_t row, int64_t j,
-                                           int64_t k, bool use_base, int64_t max_outliers,
-                                           Scratch& scratch);
+std::pair<int64_t, int64_t> relaxed_region(const MapState& state, int64_t row, int64_t j, int64_t k,
+                                           bool use_base, int64_t max_outliers, Scratch& scratch);
 
 // Landmark j's region from its base and window, from scratch.
 void solve_landmark(const MapState& state, int64_t row, int64_t j, const Params& params,

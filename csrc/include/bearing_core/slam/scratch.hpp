@@ -9,10 +9,10 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "core/complex.hpp"
-#include "core/errors.hpp"
-#include "slam/local_bound.hpp"
-#include "slam/state.hpp"
+#include <bearing_core/core/complex.hpp>
+#include <bearing_core/core/errors.hpp>
+#include <bearing_core/slam/local_bound.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::slam {
 
@@ -56,6 +56,11 @@ struct Buffers {
     SubSquares sub;  // the movement's sub-squares (TRANSFER_CONSERVATIVE only)
     Scratch scratch;
 };
+
+// This thread's buffers: allocated (and zeroed) on the thread's first use, then reused:
+// one allocation per thread, none per call or movement. The update and the single-step
+// kernels' bindings use them, never two at once on one thread.
+Buffers& thread_buffers();
 
 // Copy poly[:n] into a buffer of `capacity` points, raising CapacityError if it does not
 // fit (numba's kernels, unchecked, would have written past the buffer).

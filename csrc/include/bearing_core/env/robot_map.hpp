@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "env/types.hpp"
+#include <bearing_core/env/types.hpp>
 
 namespace bearing::env {
 
@@ -43,8 +43,7 @@ struct Window {
     View2<int64_t> n_dropped;
     View2<int64_t> outliers;
 };
-void encode_window_into(const slam::MapState& state, View1<const int64_t> rows,
-                        const Window& out);
+void encode_window_into(const slam::MapState& state, View1<const int64_t> rows, const Window& out);
 
 // encode_levels's arrays (ROBUST_STATE_ARRAYS), zero-initialised by the caller where
 // encode_levels makes zeros.
@@ -63,7 +62,6 @@ struct Levels {
     View1<int64_t> history_length;
     View1<int64_t> history_next;
 };
-void encode_levels_into(const slam::MapState& state, View1<const int64_t> rows,
-                        const Levels& out);
+void encode_levels_into(const slam::MapState& state, View1<const int64_t> rows, const Levels& out);
 
 }  // namespace bearing::env

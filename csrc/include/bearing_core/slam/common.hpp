@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <utility>
 
-#include "core/complex.hpp"
-#include "core/pymath.hpp"
-#include "slam/state.hpp"
+#include <bearing_core/core/complex.hpp>
+#include <bearing_core/core/pymath.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::slam {
 

@@ -4,14 +4,13 @@
 
 #include <cstdint>
 
-#include "core/views.hpp"
-#include "sim/sensing.hpp"
+#include <bearing_core/core/views.hpp>
+#include <bearing_core/sim/sensing.hpp>
 
 namespace bearing::sim {
 
 // out = wrap(true_bearings + offsets), elementwise over (N, n).
-void add_wrapped(View2<const double> true_bearings, View2<const double> offsets,
-                 View2<double> out);
+void add_wrapped(View2<const double> true_bearings, View2<const double> offsets, View2<double> out);
 // As add_wrapped, with replacement[i, j] (wrapped) where is_outlier[i, j].
 void add_wrapped_with_outliers(View2<const double> true_bearings, View2<const double> offsets,
                                View2<const bool> is_outlier, View2<const double> replacement,
@@ -37,8 +36,8 @@ struct MoveSettings {
     double min_baseline;
 };
 
-Move straight_move(double x, double y, double heading, double length, double width,
-                   double height, double margin, double min_baseline);
+Move straight_move(double x, double y, double heading, double length, double width, double height,
+                   double margin, double min_baseline);
 Move obstructed_move(double x, double y, double heading, double length,
                      const MoveSettings& settings, const Obstacles& obstacles);
 // Noise-free bearings of landmarks (N, n, 2) from poses (N, 2), (N,) into out (N, n).

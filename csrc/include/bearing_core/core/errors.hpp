@@ -14,8 +14,7 @@ struct CapacityError : std::runtime_error {
 
 [[noreturn]] inline void capacity_exceeded(const char* what, long long needed, long long capacity) {
     throw CapacityError(std::string("bearing_env native core: ") + what + " needs " +
-                        std::to_string(needed) + " slots, capacity is " +
-                        std::to_string(capacity));
+                        std::to_string(needed) + " slots, capacity is " + std::to_string(capacity));
 }
 
 // Check `needed <= capacity`, raising CapacityError otherwise.
