@@ -24,7 +24,7 @@ skip_module_without("train")
 import torch  # noqa: E402
 
 import bearing_env.train.sb3.distill as distill_module  # noqa: E402
-from bearing_env.agents import SB3Policy  # noqa: E402
+from bearing_env.agents import SB3Policy, pretrained_record  # noqa: E402
 from bearing_env.agents.sb3 import PRETRAINED_DIR, find_vecnormalize  # noqa: E402
 from bearing_env.train.sb3.callbacks import StopRequest  # noqa: E402
 from bearing_env.train.sb3.distill import (  # noqa: E402
@@ -99,9 +99,11 @@ def test_the_output_is_a_model_that_compare_and_init_from_read(tmp_path: Path) -
     env = policy.make_env()
     observation, info = env.reset(seed=1)
     assert env.action_space.contains(policy.act(observation, info))
-    assert json.loads(model.with_suffix(".json").read_text())["env_kwargs"] == {
-        "scenario": "khepera"
-    }
+    record, student = (
+        json.loads(model.with_suffix(".json").read_text()),
+        pretrained_record("ppo_khepera"),
+    )
+    assert (record["env_id"], record["env_kwargs"]) == (student["env_id"], student["env_kwargs"])
     fresh = SB3Policy.pretrained("ppo_khepera").model
     start_from(fresh, model, "cpu")
     expected = parameters(model)
