@@ -483,3 +483,21 @@ def test_a_task_id_keeps_its_own_arena(
     made = gym.make(config.env_id, **config.env_kwargs)
     assert made.unwrapped.config.scenario == scenario
     made.close()
+
+
+def test_worker_processes_release_the_native_objects_they_cache(tmp_path: Path) -> None:
+    """Workers keep an env and policies per comparison; they close them at exit, so the
+    native core's objects are freed before the interpreter ends (nanobind would otherwise
+    report leaked instances on stderr)."""
+    import subprocess
+    import sys
+
+    result = subprocess.run(
+        [sys.executable, "-m", "bearing_env.train.compare.cli", "--policies", "random",
+         "greedy", "--env-kwargs", "scenario=khepera", "max_moves=3", "--episodes", "2",
+         "--workers", "2", "--no-progress", "--no-plots", "--bootstrap", "10",
+         "--out", str(tmp_path / "out")],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert "leaked" not in result.stderr, result.stderr
