@@ -9,9 +9,9 @@ them through the library's own map batch and hashes the same bytes;
 ``tests/slam/test_golden_replay.py`` checks that the file agrees with the recorded
 corpus, so the two cannot drift apart.
 
-Only cases whose run here hashes as recorded are written: numpy's transcendental functions
-may differ in the last bit between CPUs (its SIMD paths), so on some machines a seed gives
-other bearings than those the corpus was recorded with.
+Only cases whose run here hashes as recorded are written (a guard: the corpus's inputs
+take their angles from the C library's scalar functions, ``tests/slam_sim.py``, so every
+case should), up to :data:`MAX_CASES`, spread over the corpus's settings.
 
     python -m tests.golden_replay --update    # write the file (a deliberate change only)
 
