@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 # of bearing_env (setuptools package-dir), so the view links them in under that name.
 TYPECHECK_VIEW := $(VENV)/typecheck
 
-.PHONY: test test-slow demo docs lint typecheck format format-check bench bench-slam clean native wheel
+.PHONY: test test-slow demo docs lint typecheck format format-check bench bench-slam clean native wheel stubs
 
 # The native core's sources: any change rebuilds the extension before a test or demo runs,
 # so no stale binary is ever tested.
@@ -63,6 +63,11 @@ wheel: $(STAMP)
 		-w $(DIST)/raw .
 	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(PY) -m auditwheel repair -w $(DIST) $(DIST)/raw/*.whl
 	rm -rf $(DIST)/raw
+
+# The files generated from the built core: its type stub and the Python structs
+# (bearing_env/_core.pyi, bearing_env/_schema.py); a test fails when they drift.
+stubs: $(NATIVE)
+	$(PY) -m tests.tools.generate_stubs
 
 bench: $(NATIVE)
 	$(PY) -m bearing_env.benchmarks.bench_env

@@ -22,6 +22,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from bearing_env import _core
+from bearing_env._schema import StateArrays
 from bearing_env.slam import kernels
 from bearing_env.slam.settings import (
     DEFAULT_MAX_OUTLIERS,
@@ -100,7 +102,7 @@ class BatchUpdateResult:
     n_inconsistent: IntArray
 
 
-class BatchedPolygonSLAM(HasMapSettings):
+class BatchedPolygonSLAM(HasMapSettings, StateArrays):
     """``num_maps`` independent polygon-SLAM maps, updated together.
 
     Args mirror :class:`~bearing_env.slam.PolygonSLAM`, plus ``num_maps``; they are
@@ -150,48 +152,20 @@ class BatchedPolygonSLAM(HasMapSettings):
         self.n_landmarks = int_at_least(n_landmarks, 3, "n_landmarks", "(L1, L2 and one more)")
         #: The map's settings, validated (``self.epsilon`` and the others read them).
         self.settings = settings
-        n, m, cap = self.num_maps, self.n_landmarks - 2, kernels.CAPACITY
-        self.vertices = np.zeros((n, m, cap), dtype=np.complex128)
-        self.counts = np.zeros((n, m), dtype=np.int64)
-        self.areas = np.empty((n, m))
-        self.centroids = np.empty((n, m), dtype=np.complex128)
-        self.robot_vertices = np.zeros((n, cap), dtype=np.complex128)
-        self.robot_counts = np.zeros(n, dtype=np.int64)
-        self.robot_area = np.empty(n)
-        self.robot_centroid = np.empty(n, dtype=np.complex128)
-        self.robot_heading = np.empty(n)
-        self.n_updates = np.empty(n, dtype=np.int64)
-        self.n_frame_changes = np.empty(n, dtype=np.int64)
-        self.n_inconsistent = np.empty(n, dtype=np.int64)
-        # The relaxed fusion's window and bases (empty window axis for "intersect").
-        w = self.window if self.fusion == "relaxed" else 0
-        self.window_vertices = np.zeros((n, w, m, cap), dtype=np.complex128)
-        self.window_counts = np.zeros((n, w, m), dtype=np.int64)
-        self.window_inlier = np.zeros((n, w, m), dtype=bool)
-        self.window_rejected = np.zeros((n, w), dtype=bool)
-        self.window_length = np.zeros(n, dtype=np.int64)
-        self.window_next = np.zeros(n, dtype=np.int64)
-        self.base_vertices = np.zeros((n, m, cap if w else 0), dtype=np.complex128)
-        self.base_counts = np.zeros((n, m), dtype=np.int64)
-        self.n_dropped = np.zeros((n, m), dtype=np.int64)
-        self.outliers = np.zeros((n, m), dtype=np.int64)
-        # The robust fusion's nested levels (none unless "robust").
-        levels = kernels.ROBUST_LEVELS if self.fusion == "robust" else 0
-        self.level_vertices = np.zeros((n, m, levels, cap), dtype=np.complex128)
-        self.level_counts = np.zeros((n, m, levels), dtype=np.int64)
-        self.n_regions = np.zeros((n, m), dtype=np.int64)
-        self.robot_fixed_at = np.zeros(n, dtype=np.int64)
-        # The robust fusion's noise-bound estimate: its probe and bearing history.
-        robust = self.fusion == "robust"
-        h = kernels.HISTORY if robust else 0
-        self.noise_scale = np.ones(n)
-        self.bound_events = np.zeros(n, dtype=np.int64)
-        self.probe_vertices = np.zeros((n, m, cap if robust else 0), dtype=np.complex128)
-        self.probe_counts = np.zeros((n, m), dtype=np.int64)
-        self.history_frame_bearings = np.zeros((n, h, 2, 2))
-        self.history_bearings = np.zeros((n, h, 2, m))
-        self.history_length = np.zeros(n, dtype=np.int64)
-        self.history_next = np.zeros(n, dtype=np.int64)
+        # The state's arrays (State's fields, shaped by their rules); the fusion's arrays
+        # not used have an empty axis.
+        relaxed, robust = self.fusion == "relaxed", self.fusion == "robust"
+        lengths = {
+            "maps": self.num_maps,
+            "m": self.n_landmarks - 2,
+            "w": self.window if relaxed else 0,
+            "base_capacity": kernels.CAPACITY if relaxed else 0,
+            "levels": kernels.ROBUST_LEVELS if robust else 0,
+            "probe_capacity": kernels.CAPACITY if robust else 0,
+            "h": kernels.HISTORY if robust else 0,
+        }
+        for name, array in zip(STATE_ARRAYS, _core.new_arrays("State", lengths), strict=True):
+            setattr(self, name, array)
         self._state_ref: kernels.MapState | None = None
         self.reset()
 
@@ -400,18 +374,20 @@ class BatchedPolygonSLAM(HasMapSettings):
         per batch (its settings never change) rather than on every call."""
         both: tuple[kernels.Params, kernels.Params] | None = self.__dict__.get("_params")
         if both is None:
-            settings = (
-                self.epsilon,
-                TRANSFERS.index(self.transfer),
-                self.edge_samples,
-                INCONSISTENCY_POLICIES.index(self.on_inconsistency),
-                FUSIONS.index(self.fusion),
-                self.max_outliers,
-            )
-            robust = (self.risk, self.robust_set == "likely", self.noise_bound == "estimate")
+            settings: dict[str, Any] = {
+                "epsilon": self.epsilon,
+                "transfer": TRANSFERS.index(self.transfer),
+                "edge_samples": self.edge_samples,
+                "on_inconsistency": INCONSISTENCY_POLICIES.index(self.on_inconsistency),
+                "fusion": FUSIONS.index(self.fusion),
+                "max_outliers": self.max_outliers,
+                "risk": self.risk,
+                "likely": self.robust_set == "likely",
+                "estimate_bound": self.noise_bound == "estimate",
+            }
             both = (
-                kernels.Params(*settings, False, *robust),
-                kernels.Params(*settings, True, *robust),
+                kernels.Params(**settings, with_robot=False),
+                kernels.Params(**settings, with_robot=True),
             )
             self._params = both
         return both[with_robot]
@@ -468,23 +444,9 @@ ROBUST_STATE_ARRAYS = ("outliers", *STATE_ARRAYS[STATE_ARRAYS.index("level_verti
 #: The state arrays with a landmark axis, and which axis it is (the map axis is 0): what
 #: pads or trims a map's state to a number of landmark slots.
 LANDMARK_AXES: dict[str, int] = {
-    "vertices": 1,
-    "counts": 1,
-    "areas": 1,
-    "centroids": 1,
-    "window_vertices": 2,
-    "window_counts": 2,
-    "window_inlier": 2,
-    "base_vertices": 1,
-    "base_counts": 1,
-    "n_dropped": 1,
-    "outliers": 1,
-    "level_vertices": 1,
-    "level_counts": 1,
-    "n_regions": 1,
-    "probe_vertices": 1,
-    "probe_counts": 1,
-    "history_bearings": 3,
+    name: rule.split().index("m")
+    for name, _, rule, _ in _core.SCHEMAS["State"]
+    if "m" in rule.split()
 }
 
 #: The vertex arrays of the state and the arrays counting their used vertices.

@@ -29,7 +29,7 @@ double noisy(double true_bearing, const BatchState& state, int64_t row, int64_t 
 double read(const Settings& settings, double x, double y, double heading, double lx, double ly,
             double reading) {
     if (sim::visible(x, y, heading, lx, ly, settings.half_fov, settings.max_range,
-                     settings.obstacles)) {
+                     settings.obstacles())) {
         return reading;
     }
     return std::numeric_limits<double>::quiet_NaN();
@@ -93,43 +93,9 @@ void update_moving_maps(View2<double> start, View2<double> end, View1<const int6
 
 }  // namespace
 
-Report Report::first(int64_t size) const {
-    Report r = *this;
-    r.observations.shape[0] = size;
-    r.rewards.shape[0] = size;
-    r.terminated.shape[0] = size;
-    r.truncated.shape[0] = size;
-    r.frame_changed.shape[0] = size;
-    r.inconsistent.shape[0] = size;
-    r.path_length.shape[0] = size;
-    r.uncertainty.shape[0] = size;
-    r.path_cost.shape[0] = size;
-    r.move_cost.shape[0] = size;
-    r.landmark_area.shape[0] = size;
-    r.landmark_error.shape[0] = size;
-    r.landmark_contains_truth.shape[0] = size;
-    r.total_area.shape[0] = size;
-    r.robot_error.shape[0] = size;
-    r.outliers.shape[0] = size;
-    return r;
-}
+Report Report::first(int64_t size) const { return first_rows(*this, size); }
 
-Encoded Encoded::first(int64_t size) const {
-    Encoded e = *this;
-    e.vertices.shape[0] = size;
-    e.counts.shape[0] = size;
-    e.areas.shape[0] = size;
-    e.centroids.shape[0] = size;
-    e.robot_vertices.shape[0] = size;
-    e.robot_counts.shape[0] = size;
-    e.robot_area.shape[0] = size;
-    e.robot_centroid.shape[0] = size;
-    e.robot_heading.shape[0] = size;
-    e.n_updates.shape[0] = size;
-    e.n_frame_changes.shape[0] = size;
-    e.n_inconsistent.shape[0] = size;
-    return e;
-}
+Encoded Encoded::first(int64_t size) const { return first_rows(*this, size); }
 
 double move_and_read(int64_t row, double turn, double length, const Inputs& inputs,
                      double* reading_start, double* reading_end) {
@@ -141,7 +107,7 @@ double move_and_read(int64_t row, double turn, double length, const Inputs& inpu
     const sim::Move move = sim::obstructed_move(
         x, y, heading, length,
         sim::MoveSettings{settings.width, settings.height, settings.margin, settings.min_baseline},
-        settings.obstacles);
+        settings.obstacles());
     const double new_x = move.x, new_y = move.y;
     const int64_t first = state.noise_used[row];
     for (int64_t j = 0; j < n; ++j) {

@@ -12,6 +12,7 @@
 #include <string>
 
 #include <bearing_core/core/pymath.hpp>
+#include <bearing_core/core/schema.hpp>
 #include <bearing_core/slam/robust.hpp>
 #include <bearing_core/slam/scratch.hpp>
 #include <bearing_core/slam/update.hpp>
@@ -100,16 +101,10 @@ void MapSettings::validate() const {
 
 Params MapSettings::params(bool with_robot) const {
     Params p;
-    p.epsilon = epsilon;
-    p.transfer = transfer;
-    p.edge_samples = edge_samples;
-    p.on_inconsistency = on_inconsistency;
-    p.fusion = fusion;
-    p.max_outliers = max_outliers;
+#define BEARING_CORE_COPY_SETTING(T, name, value, doc) p.name = name;
+    BEARING_CORE_UPDATE_SETTINGS(BEARING_CORE_COPY_SETTING)
+#undef BEARING_CORE_COPY_SETTING
     p.with_robot = with_robot;
-    p.risk = risk;
-    p.likely = likely;
-    p.estimate_bound = estimate_bound;
     slam::validate(p);
     return p;
 }
@@ -118,16 +113,14 @@ Params MapSettings::params(bool with_robot) const {
 struct MapBatch::Storage {
     std::vector<std::shared_ptr<void>> blocks;
 
-    // An array of `shape`, every element `value`.
+    // view = a new zero-filled array of `shape` (the state's schema gives it).
     template <class T, int D>
-    View<T, D> array(const std::array<int64_t, D>& shape, T value) {
-        View<T, D> view;
-        view.shape = shape;
+    void allocate(View<T, D>& view, const std::vector<int64_t>& shape) {
+        for (int d = 0; d < D; ++d) view.shape[d] = shape[static_cast<size_t>(d)];
         std::shared_ptr<T[]> block(new T[static_cast<size_t>(std::max<int64_t>(view.size(), 1))]);
         view.data = block.get();
-        fill(view, value);
+        fill(view, T{});
         blocks.push_back(block);
-        return view;
     }
 };
 
@@ -143,51 +136,21 @@ MapBatch::MapBatch(int64_t num_maps, int64_t n_landmarks, const MapSettings& set
             "n_landmarks must be in [3, " + std::to_string(MAX_LANDMARKS) +
                 "] (L1, L2 and one more), not " + std::to_string(n_landmarks));
     settings.validate();
-    const int64_t n = num_maps, m = n_landmarks - 2, cap = CAPACITY;
+    // The lengths of the state's shape rules (state.hpp); the fusion's arrays not used
+    // have an empty axis.
     const bool relaxed = settings.fusion == FUSION_RELAXED;
     const bool robust = settings.fusion == FUSION_ROBUST;
-    const int64_t w = relaxed ? settings.window : 0;
-    const int64_t levels = robust ? ROBUST_LEVELS : 0;
-    const int64_t h = robust ? HISTORY : 0;
-    Storage& a = *storage_;
-    MapState& s = state_;
-    const cplx zero(0.0, 0.0);
-    s.vertices = a.array<cplx, 3>({n, m, cap}, zero);
-    s.counts = a.array<int64_t, 2>({n, m}, 0);
-    s.areas = a.array<double, 2>({n, m}, INF);
-    s.centroids = a.array<cplx, 2>({n, m}, zero);
-    s.robot_vertices = a.array<cplx, 2>({n, cap}, zero);
-    s.robot_counts = a.array<int64_t, 1>({n}, 0);
-    s.robot_area = a.array<double, 1>({n}, INF);
-    s.robot_centroid = a.array<cplx, 1>({n}, zero);
-    s.robot_heading = a.array<double, 1>({n}, NAN_VALUE);
-    s.n_updates = a.array<int64_t, 1>({n}, 0);
-    s.n_frame_changes = a.array<int64_t, 1>({n}, 0);
-    s.n_inconsistent = a.array<int64_t, 1>({n}, 0);
-    // The relaxed fusion's window and bases (an empty window axis otherwise).
-    s.window_vertices = a.array<cplx, 4>({n, w, m, cap}, zero);
-    s.window_counts = a.array<int64_t, 3>({n, w, m}, 0);
-    s.window_inlier = a.array<bool, 3>({n, w, m}, false);
-    s.window_rejected = a.array<bool, 2>({n, w}, false);
-    s.window_length = a.array<int64_t, 1>({n}, 0);
-    s.window_next = a.array<int64_t, 1>({n}, 0);
-    s.base_vertices = a.array<cplx, 3>({n, m, w > 0 ? cap : 0}, zero);
-    s.base_counts = a.array<int64_t, 2>({n, m}, 0);
-    s.n_dropped = a.array<int64_t, 2>({n, m}, 0);
-    s.outliers = a.array<int64_t, 2>({n, m}, 0);
-    // The robust fusion's levels, and its noise-bound estimate's probe and history.
-    s.level_vertices = a.array<cplx, 4>({n, m, levels, cap}, zero);
-    s.level_counts = a.array<int64_t, 3>({n, m, levels}, 0);
-    s.n_regions = a.array<int64_t, 2>({n, m}, 0);
-    s.robot_fixed_at = a.array<int64_t, 1>({n}, 0);
-    s.noise_scale = a.array<double, 1>({n}, 1.0);
-    s.bound_events = a.array<int64_t, 1>({n}, 0);
-    s.probe_vertices = a.array<cplx, 3>({n, m, robust ? cap : 0}, zero);
-    s.probe_counts = a.array<int64_t, 2>({n, m}, 0);
-    s.history_frame_bearings = a.array<double, 4>({n, h, 2, 2}, 0.0);
-    s.history_bearings = a.array<double, 4>({n, h, 2, m}, 0.0);
-    s.history_length = a.array<int64_t, 1>({n}, 0);
-    s.history_next = a.array<int64_t, 1>({n}, 0);
+    const schema::Sizes sizes{{"maps", num_maps},
+                              {"m", n_landmarks - 2},
+                              {"CAPACITY", CAPACITY},
+                              {"w", relaxed ? settings.window : 0},
+                              {"base_capacity", relaxed ? CAPACITY : 0},
+                              {"levels", robust ? ROBUST_LEVELS : 0},
+                              {"probe_capacity", robust ? CAPACITY : 0},
+                              {"h", robust ? HISTORY : 0}};
+    for_each_field(state_, [&](const char*, const char* rule, auto& view) {
+        storage_->allocate(view, schema::shape_of(rule, sizes));
+    });
     reset();
 }
 

@@ -66,8 +66,12 @@ std::vector<ReplayCase> read_cases(const char* path) {
             line >> cases.back().name >> cases.back().sha256;
         } else if (kind == "settings") {
             slam::MapSettings& s = cases.back().settings;
-            line >> s.epsilon >> s.transfer >> s.edge_samples >> s.on_inconsistency >> s.fusion >>
+            int64_t transfer = 0, on_inconsistency = 0, fusion = 0;
+            line >> s.epsilon >> transfer >> s.edge_samples >> on_inconsistency >> fusion >>
                 s.max_outliers >> s.window >> s.risk >> s.likely >> s.estimate_bound;
+            s.transfer = static_cast<slam::Transfer>(transfer);
+            s.on_inconsistency = static_cast<slam::Inconsistency>(on_inconsistency);
+            s.fusion = static_cast<slam::Fusion>(fusion);
         } else if (kind == "shape") {
             line >> cases.back().maps >> cases.back().landmarks >> cases.back().moves;
         } else if (kind == "start" || kind == "end") {
@@ -131,7 +135,7 @@ void feed_state(Sha256& digest, const slam::MapState& state, int64_t fusion) {
     // The robust fusion's names put outliers first, then the levels and history.
     int k = 0;
     const bool robust = fusion == slam::FUSION_ROBUST;
-    slam::for_each_field(state, [&](const char* name, const auto& view) {
+    slam::for_each_field(state, [&](const char* name, const char*, const auto& view) {
         if (hashed(k, fusion) && !(robust && std::strcmp(name, "outliers") == 0)) {
             feed(digest, view);
         }

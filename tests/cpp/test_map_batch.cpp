@@ -40,10 +40,13 @@ void settings_are_validated() {
     CHECK(refused([](auto& s) { s.epsilon = 0.0; }, "epsilon must be in (0, pi/2) radians, not 0"));
     CHECK(refused([](auto& s) { s.epsilon = std::nan(""); }, "epsilon must be in (0, pi/2)"));
     CHECK(refused([](auto& s) { s.epsilon = 2.0; }, "not 2"));
-    CHECK(refused([](auto& s) { s.transfer = 3; }, "transfer must be"));
+    CHECK(
+        refused([](auto& s) { s.transfer = static_cast<slam::Transfer>(3); }, "transfer must be"));
     CHECK(refused([](auto& s) { s.edge_samples = 0; }, "edge_samples must be in [1, 8], not 0"));
-    CHECK(refused([](auto& s) { s.on_inconsistency = -1; }, "on_inconsistency must be"));
-    CHECK(refused([](auto& s) { s.fusion = 7; }, "fusion must be FUSION_INTERSECT (0)"));
+    CHECK(refused([](auto& s) { s.on_inconsistency = static_cast<slam::Inconsistency>(-1); },
+                  "on_inconsistency must be"));
+    CHECK(refused([](auto& s) { s.fusion = static_cast<slam::Fusion>(7); },
+                  "fusion must be FUSION_INTERSECT (0)"));
     CHECK(refused([](auto& s) { s.window = 33; }, "window must be in [1, 32], not 33"));
     CHECK(refused([](auto& s) { s.max_outliers = 8; }, "max_outliers must be in [0, window = 8)"));
     CHECK(refused([](auto& s) { s.risk = 0.0; }, "risk must be in (0, 0.5], not 0"));

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import ast
 import dataclasses
+import enum
 import functools
 import importlib.resources
 import math
@@ -99,7 +100,7 @@ FUZZED: frozenset[str] = frozenset(
         "free_length", "_cross", "segments_cross", "_on_segment", "line_of_sight",
         "visible", "inside_polygon", "_segment_distance", "clearance", "visible_rows",
         # bind_env.cpp
-        "EnvInputs", "StepOutputs", "step_rows", "new_report",
+        "EnvInputs", "StepOutputs", "step_rows", "new_report", "new_arrays",
         "report_rows_into", "potentials", "move_and_read", "append_positions", "capped",
         "potential_of", "_write_shape", "decode_continuous", "_known", "encode_map",
         "encode_map_into", "encode_window", "encode_levels", "_potentials_of_rows",
@@ -711,10 +712,9 @@ def test_update_maps_of_any_bearings(
     maps = result(_core.MapState, state)
     assert maps is not None and maps.num_maps == MAPS and maps.n_mapped == LANDMARKS - 2
     base = params_of(fusion)
-    params = _core.Params(
-        base.epsilon, base.transfer, base.edge_samples, base.on_inconsistency, base.fusion,
-        base.max_outliers, with_robot, base.risk, data.draw(st.booleans()), base.estimate_bound,
-    )  # fmt: skip
+    settings = {name: getattr(base, name) for name, *_ in _core.SCHEMAS["Params"]}
+    settings.update(with_robot=with_robot, likely=data.draw(st.booleans()))
+    params = _core.Params(**settings)
     rows = data.draw(map_rows(MAPS))
     start = data.draw(bearings(rows.size, LANDMARKS))
     end = data.draw(bearings(rows.size, LANDMARKS))
@@ -1327,6 +1327,28 @@ def test_reports_and_potentials_of_any_state(name: str, data: st.DataObject) -> 
     out = np.zeros(out_length(data.draw, rows.size))
     if completes(_core.potentials, rows, inputs, out) and clean:
         assert not np.any(np.isnan(out))
+
+
+@fuzz(
+    schema=st.sampled_from(("State", "BatchState", "Report", "Settings", "Nothing")),
+    lengths=st.dictionaries(
+        st.sampled_from(("maps", "m", "w", "levels", "h", "base_capacity", "probe_capacity",
+                         "N", "slots", "values", "rows", "obs", "CAPACITY", "other")),
+        st.integers(-3, 6),
+    ),
+)  # fmt: skip
+def test_new_arrays_of_any_lengths(schema: str, lengths: dict[str, int]) -> None:
+    arrays = result(_core.new_arrays, schema, lengths)
+    if arrays is None:
+        return
+    fields = _core.SCHEMAS[schema]
+    assert len(arrays) == len(fields)
+    known = {"CAPACITY": _core.CAPACITY, **lengths}
+    for array, (name, dtype, rule, _) in zip(arrays, fields, strict=True):
+        shape = tuple(known[a[:-2]] - 2 if a.endswith("-2") else int(a) if a.isdigit() else known[a]
+                      for a in rule.split())  # fmt: skip
+        assert array.dtype == np.dtype(dtype) and array.shape == shape, name
+        assert not array.any(), name
 
 
 @fuzz(name=st.sampled_from(sorted(WORLDS)), data=st.data())
@@ -1954,10 +1976,11 @@ def test_every_entry_point_of_the_native_core_is_fuzzed() -> None:
         for name in dir(_core)
         if not name.startswith("_")
         and callable(getattr(_core, name))
-        # CapacityError is what a call raises, not something to call.
+        # CapacityError is what a call raises, and the codes' enums are values, not
+        # something to call.
         and not (
             isinstance(getattr(_core, name), type)
-            and issubclass(getattr(_core, name), BaseException)
+            and issubclass(getattr(_core, name), BaseException | enum.Enum)
         )
     }
     private = stub_private_functions()

@@ -84,7 +84,7 @@ def test_copy_maps_refuses_mismatched_states_and_rows() -> None:
     with pytest.raises(ValueError, match="two different states"):
         kernels.copy_maps(four._kernel_state(), rows, four._kernel_state())
     other = four.empty_like(2)
-    with pytest.raises(ValueError, match="rows must be map indices"):
+    with pytest.raises(ValueError, match=r"rows holds -?\d+ at position \d+, outside \[0, "):
         kernels.copy_maps(four._kernel_state(), np.array([0, 2]), other._kernel_state())
     with pytest.raises(ValueError, match="more than to's 2 maps"):
         kernels.copy_maps(four._kernel_state(), np.zeros(3, dtype=np.int64), other._kernel_state())

@@ -29,39 +29,11 @@ inline int64_t slice_stop(int64_t count, int64_t length) {
 void encode_map_into(const slam::MapState& state, View1<const int64_t> rows,
                      const Encoded& encoded);
 
-// encode_window's arrays (RELAXED_STATE_ARRAYS), zero-initialised by the caller except
-// window_rejected, window_length and window_next (written).
-struct Window {
-    View4<cplx> window_vertices;
-    View3<int64_t> window_counts;
-    View3<bool> window_inlier;
-    View2<bool> window_rejected;
-    View1<int64_t> window_length;
-    View1<int64_t> window_next;
-    View3<cplx> base_vertices;
-    View2<int64_t> base_counts;
-    View2<int64_t> n_dropped;
-    View2<int64_t> outliers;
-};
+// encode_window's arrays, zero-initialised by the caller except window_rejected,
+// window_length and window_next (written).
 void encode_window_into(const slam::MapState& state, View1<const int64_t> rows, const Window& out);
 
-// encode_levels's arrays (ROBUST_STATE_ARRAYS), zero-initialised by the caller where
-// encode_levels makes zeros.
-struct Levels {
-    View2<int64_t> outliers;
-    View4<cplx> level_vertices;
-    View3<int64_t> level_counts;
-    View2<int64_t> n_regions;
-    View1<int64_t> robot_fixed_at;
-    View1<double> noise_scale;
-    View1<int64_t> bound_events;
-    View3<cplx> probe_vertices;
-    View2<int64_t> probe_counts;
-    View4<double> history_frame_bearings;
-    View4<double> history_bearings;
-    View1<int64_t> history_length;
-    View1<int64_t> history_next;
-};
+// encode_levels's arrays, zero-initialised by the caller where encode_levels makes zeros.
 void encode_levels_into(const slam::MapState& state, View1<const int64_t> rows, const Levels& out);
 
 }  // namespace bearing::env

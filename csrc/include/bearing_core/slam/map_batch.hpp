@@ -22,18 +22,11 @@
 
 namespace bearing::slam {
 
-// A map's settings (bearing_env.slam.settings.MapSettings), as the kernels' codes.
+// A map's settings (bearing_env.slam.settings.MapSettings): the update's shared settings
+// and the relaxed fusion's window.
 struct MapSettings {
-    double epsilon = 0.0;                              // bearing error bound, radians, in (0, pi/2)
-    int64_t transfer = TRANSFER_CONSERVATIVE;          // Transfer
-    int64_t edge_samples = 3;                          // [1, MAX_EDGE_SAMPLES]
-    int64_t on_inconsistency = INCONSISTENCY_RESTART;  // Inconsistency
-    int64_t fusion = FUSION_INTERSECT;                 // Fusion
-    int64_t max_outliers = 2;                          // relaxed fusion: [0, window)
-    int64_t window = 8;                                // relaxed fusion: [1, MAX_WINDOW]
-    double risk = 0.05;                                // robust fusion: (0, 0.5]
-    bool likely = false;                               // robust fusion: report the likely set
-    bool estimate_bound = true;                        // robust fusion: estimate the noise bound
+    BEARING_CORE_UPDATE_SETTINGS(BEARING_CORE_DECLARE_SETTING)
+    int64_t window = 8;  // relaxed fusion: movements in the window, [1, MAX_WINDOW]
 
     // Throws std::invalid_argument naming the first bad value.
     void validate() const;

@@ -34,7 +34,8 @@ void update_maps(View2<const double> bearings_start, View2<const double> bearing
 namespace bearing::slam {
 
 // Outcomes of check_indices.
-enum IndexCheck : int64_t { INDEX_OK = 0, INDEX_OUT_OF_RANGE = 1, INDEX_REPEATED = 2 };
+#define BEARING_CORE_INDEX_CHECK(E) E(INDEX_OK, 0) E(INDEX_OUT_OF_RANGE, 1) E(INDEX_REPEATED, 2)
+enum IndexCheck : int64_t { BEARING_CORE_INDEX_CHECK(BEARING_CORE_ENUM_MEMBER) };
 
 // Whether indices[:n] are in [0, size) (and, if distinct, none repeats). `seen` holds
 // `size` flags (only used when distinct; the caller provides it).
