@@ -374,16 +374,19 @@ class BatchedPolygonSLAM(HasMapSettings, StateArrays):
         per batch (its settings never change) rather than on every call."""
         both: tuple[kernels.Params, kernels.Params] | None = self.__dict__.get("_params")
         if both is None:
-            settings: dict[str, Any] = {
-                "epsilon": self.epsilon,
+            # Params' fields (declared in the C++ library) from this batch's settings:
+            # the codes of the named choices, the rest under their own names.
+            codes: dict[str, Any] = {
                 "transfer": TRANSFERS.index(self.transfer),
-                "edge_samples": self.edge_samples,
                 "on_inconsistency": INCONSISTENCY_POLICIES.index(self.on_inconsistency),
                 "fusion": FUSIONS.index(self.fusion),
-                "max_outliers": self.max_outliers,
-                "risk": self.risk,
                 "likely": self.robust_set == "likely",
                 "estimate_bound": self.noise_bound == "estimate",
+            }
+            settings = {
+                name: codes[name] if name in codes else getattr(self, name)
+                for name, *_ in _core.SCHEMAS["Params"]
+                if name != "with_robot"
             }
             both = (
                 kernels.Params(**settings, with_robot=False),

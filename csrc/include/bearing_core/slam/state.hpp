@@ -104,8 +104,6 @@ inline bool valid_transfer(int64_t transfer) {
     X(int64_t, 1, n_updates, "maps", "movements fused")                              \
     X(int64_t, 1, n_frame_changes, "maps", "of which changed frames")                \
     X(int64_t, 1, n_inconsistent, "maps", "inconsistent landmark regions so far")
-#define BEARING_CORE_OUTLIERS(X) \
-    X(int64_t, 2, outliers, "maps m", "regions left out, window included")
 #define BEARING_CORE_RELAXED_ARRAYS(X)                                                   \
     X(cplx, 4, window_vertices, "maps w m CAPACITY", "the window's regions")             \
     X(int64_t, 3, window_counts, "maps w m", "their vertex counts")                      \
@@ -117,6 +115,8 @@ inline bool valid_transfer(int64_t transfer) {
     X(int64_t, 2, base_counts, "maps m", "their vertex counts")                          \
     X(int64_t, 2, n_dropped, "maps m", "regions left out for good")                      \
     BEARING_CORE_OUTLIERS(X)
+#define BEARING_CORE_OUTLIERS(X) \
+    X(int64_t, 2, outliers, "maps m", "regions left out, window included")
 #define BEARING_CORE_ROBUST_ARRAYS(X)                                                           \
     X(cplx, 4, level_vertices, "maps m levels CAPACITY", "the robust fusion's levels")          \
     X(int64_t, 3, level_counts, "maps m levels", "their vertex counts")                         \
