@@ -90,38 +90,32 @@ ChainWorkspace& chain_workspace() {
     return workspace;
 }
 
-}  // namespace
+// convex_hull is a quickhull; its steps follow, each with its arithmetic as it was in
+// the one function (and as numba's kernel has it), operation for operation.
 
-// --------------------------------------------------------------------------------------
-// Convex hulls
-// --------------------------------------------------------------------------------------
-
-int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
-    if (n_points == 0) return 0;
-    check_capacity("convex_hull points", n_points, MAX_HULL_POINTS);
-    int64_t first = 0, last = 0;
+// The first of the lowest-x (then lowest-y) points and the first of the highest-x (then
+// highest-y) points: the ends of the lower and upper chains.
+inline void extreme_points(const cplx* points, int64_t n_points, int64_t& first, int64_t& last) {
     for (int64_t i = 1; i < n_points; ++i) {
         const cplx p = points[i];
         const cplx lo = points[first], hi = points[last];
         if (p.re < lo.re || (p.re == lo.re && p.im < lo.im)) first = i;
         if (p.re > hi.re || (p.re == hi.re && p.im > hi.im)) last = i;
     }
-    const cplx a = points[first], b = points[last];
-    out[0] = a;
-    if (a == b) return 1;
-    HullWorkspace& work = hull_workspace();
-    // Candidate indices, the lower side (right of a -> b) first, then the upper side.
-    int64_t* const index = work.index.at_least(n_points);
-    int64_t n_lower = 0, n_upper = 0;
-    // The lower chain's task (a -> b) finds its farthest candidate here: its scan's
-    // expression bx * (p.im - ay) - by * (p.re - ax), with ax, ay = a and bx, by = b - a,
-    // is cross(b - a, p - a) operation for operation, and its candidates are these, in
-    // this order (the first minimum wins, as in the scan).
-    // Each point's side is computed once (numba evaluated the same expression again for
-    // the upper side: the same value).
+}
+
+// Sort the points' indices into `index` by side of a -> b: the lower side (right of it)
+// first, n_lower of them, then the upper side, n_upper; the rest are on the line. Returns
+// the slot of the lower side's farthest candidate (-1 if it has none).
+// The lower chain's task (a -> b) would find that candidate by its scan, whose expression
+// bx * (p.im - ay) - by * (p.re - ax), with ax, ay = a and bx, by = b - a, is
+// cross(b - a, p - a) operation for operation, over these candidates, in this order (the
+// first minimum wins, as in the scan). Each point's side is computed once (numba
+// evaluated the same expression again for the upper side: the same value).
+inline int64_t split_sides(const cplx* points, int64_t n_points, cplx a, cplx b, double* sides,
+                           int64_t* index, int64_t& n_lower, int64_t& n_upper) {
     int64_t far_lower = -1;
     double min_lower = 0.0;
-    double* const sides = work.sides.at_least(n_points);
     for (int64_t i = 0; i < n_points; ++i) {
         const double side = cross(b - a, points[i] - a);
         sides[i] = side;
@@ -140,34 +134,86 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
             n_upper += 1;
         }
     }
-    // A stack of tasks: hull the chain from point chain_from to chain_to over the
-    // candidates index[start:end]; a task with start < 0 emits point chain_from instead.
-    const int64_t size = 2 * n_points + 4;
-    // task_far: the slot of the task's farthest candidate when its parent found it while
-    // partitioning (-1: the task scans for it).
-    int64_t* const task_start = work.task_start.at_least(size);
-    int64_t* const task_end = work.task_end.at_least(size);
-    int64_t* const chain_from = work.chain_from.at_least(size);
-    int64_t* const chain_to = work.chain_to.at_least(size);
-    int64_t* const task_far = work.task_far.at_least(size);
-    task_far[0] = -1;
-    task_far[2] = far_lower;
-    task_start[0] = n_lower;
-    task_end[0] = n_lower + n_upper;
-    chain_from[0] = last;
-    chain_to[0] = first;
-    task_start[1] = -1;
-    chain_from[1] = last;
-    task_start[2] = 0;
-    task_end[2] = n_lower;
-    chain_from[2] = first;
-    chain_to[2] = last;
+    return far_lower;
+}
+
+// convex_hull's stack of tasks: hull the chain from point chain_from to chain_to over the
+// candidates index[start:end]; a task with start < 0 emits point chain_from instead.
+// task_far: the slot of the task's farthest candidate when its parent found it while
+// partitioning (-1: the task scans for it).
+struct HullTasks {
+    int64_t* task_start;
+    int64_t* task_end;
+    int64_t* chain_from;
+    int64_t* chain_to;
+    int64_t* task_far;
+
+    void chain(int64_t slot, int64_t start, int64_t end, int64_t from, int64_t to,
+               int64_t far) const {
+        task_start[slot] = start;
+        task_end[slot] = end;
+        chain_from[slot] = from;
+        chain_to[slot] = to;
+        task_far[slot] = far;
+    }
+    void emit(int64_t slot, int64_t from) const {
+        task_start[slot] = -1;
+        chain_from[slot] = from;
+    }
+};
+
+// The slot in index[start:end] of the candidate farthest right of the line from (ax, ay)
+// along (bx, by): the first minimum of its side, or `start` if none is right of it.
+inline int64_t farthest_right(const cplx* points, const int64_t* index, int64_t start, int64_t end,
+                              double ax, double ay, double bx, double by) {
+    int64_t far = start;
+    double far_side = 0.0;
+    for (int64_t j = start; j < end; ++j) {
+        const cplx p = points[index[j]];
+        const double side = bx * (p.im - ay) - by * (p.re - ax);
+        if (side < far_side) {
+            far_side = side;
+            far = j;
+        }
+    }
+    return far;
+}
+
+// Move the candidates of index[start:end] right of the line from (ax, ay) along (bx, by)
+// to the front of the range, in the order they are met (each goes to the next slot; no
+// later swap reaches it); returns how many, with `far` the slot of the farthest of them
+// (the first minimum of its side, -1 if none). The side's expression is farthest_right's,
+// operation for operation, so `far` is the slot that the child task's scan would find.
+inline int64_t partition_right(const cplx* points, int64_t* index, int64_t start, int64_t end,
+                               double ax, double ay, double bx, double by, int64_t& far) {
+    int64_t n = 0;
+    double min_side = 0.0;
+    far = -1;
+    for (int64_t j = start; j < end; ++j) {
+        const cplx p = points[index[j]];
+        const double side = bx * (p.im - ay) - by * (p.re - ax);
+        if (side < 0.0) {
+            if (side < min_side) {
+                min_side = side;
+                far = start + n;
+            }
+            std::swap(index[start + n], index[j]);
+            n += 1;
+        }
+    }
+    return n;
+}
+
+// Run convex_hull's three first tasks (in slots 0 to 2) and every task they push, writing
+// the hull's vertices after out[0]; returns how many out holds.
+int64_t run_hull_tasks(const cplx* points, int64_t n_points, int64_t* index, const HullTasks& tasks,
+                       int64_t size, cplx* out) {
     int64_t top = 3;
     int64_t k = 1;
     while (top > 0) {
         top -= 1;
-        const int64_t start = task_start[top], end = task_end[top], i_from = chain_from[top],
-                      i_to = chain_to[top];
+        const int64_t start = tasks.task_start[top], end = tasks.task_end[top],
+                      i_from = tasks.chain_from[top], i_to = tasks.chain_to[top];
         if (start < 0) {
             check_capacity("convex_hull output", k + 1, n_points + 1);
             out[k] = points[i_from];
@@ -176,76 +222,60 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
         }
         if (end <= start) continue;
         const double ax = points[i_from].re, ay = points[i_from].im;
-        int64_t far = task_far[top];
+        int64_t far = tasks.task_far[top];
         if (far < 0) {
             const double bx = points[i_to].re - ax, by = points[i_to].im - ay;
-            far = start;
-            double far_side = 0.0;
-            for (int64_t j = start; j < end; ++j) {
-                const cplx p = points[index[j]];
-                const double side = bx * (p.im - ay) - by * (p.re - ax);
-                if (side < far_side) {
-                    far_side = side;
-                    far = j;
-                }
-            }
+            far = farthest_right(points, index, start, end, ax, ay, bx, by);
         }
         const int64_t i_far = index[far];
         const double cx = points[i_far].re, cy = points[i_far].im;
-        // Right of a -> c to the front, then right of c -> b; the rest is inside.
-        // Each partition's expression is, operation for operation, the scan its child
-        // task would run (the child a -> c has ax, ay = a and bx, by = c - a = ux, uy;
-        // the child c -> b has ax, ay = c and bx, by = b - c = vx, vy), and the selected
-        // candidates keep their order in the child's slots (each goes to the next slot
-        // as it is met; no later swap reaches them). So the farthest candidate of each
-        // child, the first minimum in its slots, is found here (`far_left`, `far_right`).
+        // Right of a -> c to the front, then right of c -> b; the rest is inside. Each
+        // partition finds its child task's farthest candidate (the child a -> c has
+        // ax, ay = a and bx, by = c - a = ux, uy; the child c -> b has ax, ay = c and
+        // bx, by = b - c = vx, vy).
         const double ux = cx - ax, uy = cy - ay;
-        int64_t n_left = 0, far_left = -1;
-        double min_left = 0.0;
-        for (int64_t j = start; j < end; ++j) {
-            const cplx p = points[index[j]];
-            const double side = ux * (p.im - ay) - uy * (p.re - ax);
-            if (side < 0.0) {
-                if (side < min_left) {
-                    min_left = side;
-                    far_left = start + n_left;
-                }
-                std::swap(index[start + n_left], index[j]);
-                n_left += 1;
-            }
-        }
-        const double vx = points[i_to].re - cx, vy = points[i_to].im - cy;
-        int64_t n_right = 0, far_right = -1;
-        double min_right = 0.0;
-        for (int64_t j = start + n_left; j < end; ++j) {
-            const cplx p = points[index[j]];
-            const double side = vx * (p.im - cy) - vy * (p.re - cx);
-            if (side < 0.0) {
-                const int64_t slot = start + n_left + n_right;
-                if (side < min_right) {
-                    min_right = side;
-                    far_right = slot;
-                }
-                std::swap(index[slot], index[j]);
-                n_right += 1;
-            }
-        }
+        int64_t far_left = -1, far_right = -1;
+        const int64_t n_left = partition_right(points, index, start, end, ax, ay, ux, uy, far_left);
         const int64_t mid = start + n_left;
+        const double vx = points[i_to].re - cx, vy = points[i_to].im - cy;
+        const int64_t n_right = partition_right(points, index, mid, end, cx, cy, vx, vy, far_right);
         check_capacity("convex_hull task stack", top + 3, size);
-        task_far[top] = far_right;
-        task_far[top + 2] = far_left;
-        task_start[top] = mid;
-        task_end[top] = mid + n_right;
-        chain_from[top] = i_far;
-        chain_to[top] = i_to;
-        task_start[top + 1] = -1;
-        chain_from[top + 1] = i_far;
-        task_start[top + 2] = start;
-        task_end[top + 2] = mid;
-        chain_from[top + 2] = i_from;
-        chain_to[top + 2] = i_far;
+        tasks.chain(top, mid, mid + n_right, i_far, i_to, far_right);
+        tasks.emit(top + 1, i_far);
+        tasks.chain(top + 2, start, mid, i_from, i_far, far_left);
         top += 3;
     }
+    return k;
+}
+
+}  // namespace
+
+// --------------------------------------------------------------------------------------
+// Convex hulls
+// --------------------------------------------------------------------------------------
+
+int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
+    if (n_points == 0) return 0;
+    check_capacity("convex_hull points", n_points, MAX_HULL_POINTS);
+    int64_t first = 0, last = 0;
+    extreme_points(points, n_points, first, last);
+    const cplx a = points[first], b = points[last];
+    out[0] = a;
+    if (a == b) return 1;
+    HullWorkspace& work = hull_workspace();
+    // Candidate indices, the lower side (right of a -> b) first, then the upper side.
+    int64_t* const index = work.index.at_least(n_points);
+    int64_t n_lower = 0, n_upper = 0;
+    const int64_t far_lower =
+        split_sides(points, n_points, a, b, work.sides.at_least(n_points), index, n_lower, n_upper);
+    const int64_t size = 2 * n_points + 4;
+    const HullTasks tasks{work.task_start.at_least(size), work.task_end.at_least(size),
+                          work.chain_from.at_least(size), work.chain_to.at_least(size),
+                          work.task_far.at_least(size)};
+    tasks.chain(0, n_lower, n_lower + n_upper, last, first, -1);  // the upper chain, b -> a
+    tasks.emit(1, last);
+    tasks.chain(2, 0, n_lower, first, last, far_lower);  // the lower chain, a -> b
+    const int64_t k = run_hull_tasks(points, n_points, index, tasks, size, out);
     // out[:k] is copied (the small hull writes out; the slots it does not rewrite keep
     // the quickhull's vertices, as in numba) into storage not zero-filled first.
     cplx* const candidates = work.candidates.at_least(k);

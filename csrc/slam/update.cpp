@@ -94,6 +94,32 @@ int64_t cone_regions(const double* bearings_start, const double* bearings_end, i
     return FRAME_OK;
 }
 
+// The end of update_row, once the movement's landmarks are fused into map row: count
+// the frame change and the inconsistent landmarks (out row i), then place the robot by
+// the frame change, or mark it unknown when that change was rejected. (Its own function
+// so that update_row reads as the landmark loop it is; one call per map and movement.)
+void finish_row(int64_t i, int64_t row, int64_t n_landmarks, const Params& params,
+                const MapState& state, const Outputs& out, const FrameChange& frame, Buffers& buf) {
+    state.n_frame_changes(row) += out.frame_status(i) == FRAME_OK ? 1 : 0;
+    int64_t bad = 0;
+    for (int64_t j = 0; j < n_landmarks - 2; ++j) {
+        if (out.landmark_status(i, j) == LANDMARK_INCONSISTENT) bad += 1;
+    }
+    out.n_bad(i) = bad;
+    state.n_inconsistent(row) += bad;
+    if (!params.with_robot) return;
+    if (out.frame_status(i) == FRAME_REJECTED) {
+        // The frame change itself is the outlier: the robot's region is unknown.
+        state.robot_counts(row) = 0;
+        state.robot_area(row) = INF;
+        state.robot_centroid(row) = complex_nan();
+        state.robot_heading(row) = NaN;
+        return;
+    }
+    transfer_robot(state, row, frame, buf);
+    state.robot_fixed_at(row) = state.n_updates(row);
+}
+
 // Fuse one movement (bearings_start, bearings_end: n_landmarks each, read with the bound
 // epsilon) into map row, reporting to out row i.
 void update_row(int64_t i, int64_t row, const double* bearings_start, const double* bearings_end,
@@ -160,24 +186,7 @@ void update_row(int64_t i, int64_t row, const double* bearings_start, const doub
     if (relaxed && relaxed_movement(state, row, fresh_counts, params, out, i, scratch)) {
         out.frame_status(i) = FRAME_REJECTED;
     }
-    state.n_frame_changes(row) += out.frame_status(i) == FRAME_OK ? 1 : 0;
-    int64_t bad = 0;
-    for (int64_t j = 0; j < n_landmarks - 2; ++j) {
-        if (out.landmark_status(i, j) == LANDMARK_INCONSISTENT) bad += 1;
-    }
-    out.n_bad(i) = bad;
-    state.n_inconsistent(row) += bad;
-    if (!params.with_robot) return;
-    if (out.frame_status(i) == FRAME_REJECTED) {
-        // The frame change itself is the outlier: the robot's region is unknown.
-        state.robot_counts(row) = 0;
-        state.robot_area(row) = INF;
-        state.robot_centroid(row) = complex_nan();
-        state.robot_heading(row) = NaN;
-        return;
-    }
-    transfer_robot(state, row, frame, buf);
-    state.robot_fixed_at(row) = state.n_updates(row);
+    finish_row(i, row, n_landmarks, params, state, out, frame, buf);
 }
 
 // Fuse the movement just fused into map row (with the bound epsilon, as out row i

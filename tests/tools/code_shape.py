@@ -2,6 +2,9 @@
 
     python -m tests.tools.code_shape        # the counts, and every function over a limit
 
+(The C++ functions' lengths, held to the same MAX_FUNCTION_LINES, are measured by the
+sibling module ``tests/tools/cpp_shape.py``; this module's summary lists them too.)
+
 A function's length is ``end_lineno - lineno + 1`` of its ``def`` (decorators not counted);
 its parameters are the positional, keyword-only and ``*args``/``**kwargs`` ones, without a
 method's ``self``/``cls``. Numba kernels (``@njit``, ``@jit``, ``@vectorize``,
@@ -79,9 +82,7 @@ def function_shapes(path: Path, root: Path = ROOT) -> Iterator[FunctionShape]:
                     lines=child.end_lineno - child.lineno + 1,
                     parameters=parameter_count(child, method=in_class),
                     public=not any(part.startswith("_") for part in name.split(".")),
-                    kernel=any(
-                        decorator_name(d) in NUMBA_DECORATORS for d in child.decorator_list
-                    ),
+                    kernel=any(decorator_name(d) in NUMBA_DECORATORS for d in child.decorator_list),
                 )
                 yield from visit(child, f"{name}.", in_class=False)
             else:
@@ -103,9 +104,7 @@ def too_long(shapes: list[FunctionShape]) -> list[FunctionShape]:
 
 def too_many_parameters(shapes: list[FunctionShape]) -> list[FunctionShape]:
     """The public non-kernel functions with more than MAX_PUBLIC_PARAMETERS parameters."""
-    return [
-        s for s in shapes if s.public and not s.kernel and s.parameters > MAX_PUBLIC_PARAMETERS
-    ]
+    return [s for s in shapes if s.public and not s.kernel and s.parameters > MAX_PUBLIC_PARAMETERS]
 
 
 def main() -> None:
@@ -119,6 +118,11 @@ def main() -> None:
     print(f"public, more than {MAX_PUBLIC_PARAMETERS} parameters: {len(wide_ones)}")
     for shape in wide_ones:
         print(f"  {shape.key} ({shape.parameters} parameters, line {shape.lineno})")
+    # Imported here: cpp_shape takes its limit and root from this module.
+    from tests.tools.cpp_shape import iter_report, project_cpp_functions
+
+    for line in iter_report(project_cpp_functions()):
+        print(line)
 
 
 if __name__ == "__main__":
