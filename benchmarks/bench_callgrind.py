@@ -7,11 +7,15 @@ run of the same build on the same inputs. Use it to compare two versions of a ke
 
     bearing-env bench-callgrind [--movements 400] [--steps 400] [--json out.json]
 
-Two runs of a small driver under ``valgrind --tool=callgrind``, each collecting only
-inside one native entry point (``--toggle-collect``):
+Runs of a small driver under ``valgrind --tool=callgrind``, each collecting only inside
+one native entry point (``--toggle-collect``):
 
-- ``update``: ``bearing::slam::update_maps``, called by ``PolygonSLAM.update`` on the
-  readings of ``bench-slam`` (4 landmarks, epsilon 2 degrees), per transfer;
+- ``update``: ``bearing::slam::update_maps``, called by ``PolygonSLAM.update``, per
+  transfer, on the readings ``bench-slam`` replays: first those recorded from seeded
+  BearingSLAM-Khepera-v1 episodes of the random polygonal trajectory (4 landmarks, the
+  env's map settings, a fresh map per episode; recorded outside valgrind and handed to
+  the driver in a file), then the synthetic readings (4 landmarks, epsilon 2 degrees,
+  one layout in a 100 x 100 arena, repeated), a secondary figure;
 - ``step``: ``bearing::env::step_rows``, the whole native env step (moves, readings, map
   update, rewards, observation and info arrays), on ``BearingSLAM-Khepera-v1`` with
   seeded random actions.
@@ -22,6 +26,7 @@ and the functions with the largest inclusive share are listed: where the time go
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 import shutil
@@ -32,6 +37,9 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
+from bearing_env.benchmarks.bench_readings import SYNTHETIC_LABEL
 from bearing_env.slam.transfer import TRANSFERS
 from bearing_env.train.common.cli_parser import add_json_output, command_parser, doc_summary
 from bearing_env.train.common.cli_values import at_least
@@ -43,22 +51,55 @@ from bearing_env.train.common.provenance import measured_here, measured_sentence
 #: The native entry point each measurement collects inside.
 ENTRY_POINTS = {"update": "bearing::slam::update_maps*", "step": "bearing::env::step_rows*"}
 
+#: The workloads of the update counts: (key, what the page calls them), the first primary.
+UPDATE_WORKLOADS: tuple[tuple[str, str], ...] = (
+    ("khepera", "recorded Khepera-v1 readings"),
+    ("synthetic_4", SYNTHETIC_LABEL),
+)
+
 UPDATE_DRIVER = """
-import sys
+import dataclasses, json, sys
 import numpy as np
-from bearing_env.benchmarks.bench_slam import make_readings
-from bearing_env.slam import PolygonSLAM
-movements, transfer = int(sys.argv[1]), sys.argv[2]
-readings = make_readings(4, 20, seed=4)
-slam = PolygonSLAM(4, np.deg2rad(2.0), transfer=transfer)
+from bearing_env.slam import MapSettings, PolygonSLAM
+movements, transfer, path = int(sys.argv[1]), sys.argv[2], sys.argv[3]
+data = np.load(path)
+start, end, episodes = data["start"], data["end"], data["episodes"]
+settings = MapSettings(**json.loads(str(data["settings"])))
+slam = PolygonSLAM.from_settings(start.shape[1], dataclasses.replace(settings, transfer=transfer))
 done = 0
 while done < movements:
-    slam.reset()
-    for b1, b2 in readings[: movements - done]:
-        slam.update(b1, b2)
+    for k in range(len(start)):
+        if done == movements:
+            break
+        if k == 0 or episodes[k] != episodes[k - 1]:
+            slam.reset()
+        slam.update(start[k], end[k])
         done += 1
 print(done)
 """
+
+
+def save_workload(key: str, path: Path) -> None:
+    """Write the readings of workload ``key`` (:data:`UPDATE_WORKLOADS`) to ``path`` for
+    :data:`UPDATE_DRIVER`: recorded here, outside valgrind, whose count would otherwise
+    take in the recording's env steps (which update maps too)."""
+    from bearing_env.benchmarks import bench_slam
+
+    workload = (
+        bench_slam.recorded_workload("BearingSLAM-Khepera-v1")
+        if key == "khepera"
+        else bench_slam.synthetic_workload(int(key.rpartition("_")[2]))
+    )
+    pairs = [pair for episode in workload.episodes for pair in episode]
+    episodes = [index for index, episode in enumerate(workload.episodes) for _ in episode]
+    np.savez(
+        path,
+        start=np.array([b1 for b1, _ in pairs]),
+        end=np.array([b2 for _, b2 in pairs]),
+        episodes=np.array(episodes, dtype=np.int64),
+        settings=json.dumps(dataclasses.asdict(workload.settings)),
+    )
+
 
 STEP_DRIVER = """
 import sys
@@ -153,12 +194,22 @@ def main(argv: Sequence[str] | None = None) -> None:
     arguments = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(arguments)
     results: dict[str, Any] = {}
-    for transfer in TRANSFERS:
-        counted = count(UPDATE_DRIVER, ENTRY_POINTS["update"], [str(args.movements), transfer])
-        per = counted["instructions"] / args.movements
-        results[f"update_{transfer}_4"] = {**counted, "count": args.movements, "per_call": per}
-        print(f"PolygonSLAM.update, 4 landmarks, {transfer:>12}: {per:12,.0f} instructions"
-              " per movement")  # fmt: skip
+    with tempfile.TemporaryDirectory() as folder:
+        for key, label in UPDATE_WORKLOADS:
+            path = Path(folder) / f"{key}.npz"
+            save_workload(key, path)
+            for transfer in TRANSFERS:
+                counted = count(UPDATE_DRIVER, ENTRY_POINTS["update"],
+                                [str(args.movements), transfer, str(path)])  # fmt: skip
+                per = counted["instructions"] / args.movements
+                results[f"update_{transfer}_{key}"] = {
+                    **counted,
+                    "count": args.movements,
+                    "per_call": per,
+                    "readings": label,
+                }
+                print(f"PolygonSLAM.update, {label}, {transfer:>12}: {per:12,.0f} "
+                      "instructions per movement")  # fmt: skip
     counted = count(STEP_DRIVER, ENTRY_POINTS["step"], [str(args.steps)])
     per = counted["instructions"] / args.steps
     results["step_khepera"] = {**counted, "count": args.steps, "per_call": per}
@@ -182,11 +233,16 @@ def markdown_callgrind(record: dict[str, Any]) -> str:
     step = counts["step_khepera"]
     sentence = (
         f"{measured_sentence(record['measured'], 'benchmarks/results/bench_callgrind.json')} "
-        "Instructions per 4-landmark movement: "
-        + ", ".join(
-            f"{counts[f'update_{transfer}_4']['per_call']:,.0f} {transfer}"
-            for transfer in TRANSFERS
-            if f"update_{transfer}_4" in counts
+        "Instructions per 4-landmark movement, "
+        + "; ".join(
+            f"on {label}: "
+            + ", ".join(
+                f"{counts[f'update_{transfer}_{key}']['per_call']:,.0f} {transfer}"
+                for transfer in TRANSFERS
+                if f"update_{transfer}_{key}" in counts
+            )
+            for key, label in UPDATE_WORKLOADS
+            if any(f"update_{transfer}_{key}" in counts for transfer in TRANSFERS)
         )
         + "; per Khepera env "
         f"step (native part, {step['count']} steps): {step['per_call']:,.0f}, of which:"

@@ -18,7 +18,10 @@ import gymnasium as gym
 import numpy as np
 
 import bearing_env
+from bearing_env.benchmarks.bench_readings import RECORDED_TASKS, SYNTHETIC_LABEL
+from bearing_env.benchmarks.bench_slam import row_case
 from bearing_env.benchmarks.bench_timing import (
+    SINGLE_ACTION_BLOCK,
     ppo_label,
     vector_label,
 )
@@ -41,14 +44,19 @@ DEFAULT_JSON = Path("outputs") / "bench_env.json"
 #: ``ratio_to_cartpole``, ``numba_imported``, ...); formats 1 and 2 timed the first step
 #: alone (``warm_first_step_s``, ``cold_first_step_s``), which :func:`startup_section`
 #: reports as an older format. No target ``j`` (a compile time) any more.
-JSON_FORMAT = 3
+#: 4: the slam rows replay readings recorded from env episodes (``readings``, ``label``,
+#: ``primary``; the synthetic ones are secondary) and give the median, min and max over
+#: runs (``steps_per_s_min``, ``ratio_to_cartpole_max``, ...); target ``e`` reads the
+#: recorded Khepera-v1 row. Formats 1 to 3 timed the synthetic readings alone.
+JSON_FORMAT = 4
 TARGETS: dict[str, str] = {
     "a": "single env, Khepera: env.step >= 20% of CartPole-v1",
     "b": "batched env, 64 envs x 4 landmarks: total steps/s >= 50% of CartPole-v1",
     "i": "batched env, 256 envs x 4 landmarks: total steps/s >= 60% of CartPole-v1",
     "c": "single env, 64 landmarks >= 1/16 of the 4-landmark rate",
     "d": "PPO on the batched env >= 2x PPO on SubprocVecEnv (same n_envs)",
-    "e": "PolygonSLAM.update, 4 landmarks, conservative: >= 60% of CartPole-v1",
+    "e": "PolygonSLAM.update on recorded Khepera-v1 readings (4 landmarks), conservative: "
+    ">= 60% of CartPole-v1",
     "f": "a fresh process that imports bearing_env, makes BearingSLAM-Khepera-v1 and steps "
     "once: <= 1.5x the same script with CartPole-v1 (no bearing_env import), side by side",
     "g": "GreedyOneStep planning per move (median): <= 0.5 ms",
@@ -109,6 +117,22 @@ def startup_section(results: dict[str, Any]) -> tuple[dict[str, Any] | None, str
     return startup, None
 
 
+def khepera_update_row(results: dict[str, Any]) -> tuple[dict[str, Any] | None, str | None]:
+    """(the slam section's conservative row on recorded Khepera-v1 readings, None), or
+    (None, why not): no slam section, or one of an older results file (formats 1 to 3:
+    synthetic readings only)."""
+    rows = results.get("slam")
+    if not rows:
+        return None, "needs the slam section"
+    for row in rows:
+        if row.get("readings") == "khepera" and row["transfer"] == "conservative":
+            return row, None
+    return None, (
+        f"older results file (format {results.get('format', '1 to 3')}): its update() rows "
+        "replayed synthetic readings, not recorded Khepera-v1 ones"
+    )
+
+
 def evaluate_targets(results: dict[str, Any]) -> list[dict[str, Any]]:
     single = {row["name"]: row for row in results.get("single", [])}
     vector = results.get("vector", [])
@@ -143,12 +167,11 @@ def evaluate_targets(results: dict[str, Any]) -> list[dict[str, Any]]:
     else:
         targets.append(_target("c", many["steps_per_s"] / few["steps_per_s"]))
 
-    slam = {(row["transfer"], row["n_landmarks"]): row for row in results.get("slam", [])}
-    update_4 = slam.get(("conservative", 4))
-    if update_4 is None:
-        targets.append(_target("e", None, "needs the slam section's 4-landmark row"))
+    update_khepera, why_not = khepera_update_row(results)
+    if update_khepera is None:
+        targets.append(_target("e", None, why_not))
     else:
-        targets.append(_target("e", update_4["ratio_to_cartpole"]))
+        targets.append(_target("e", update_khepera["ratio_to_cartpole"]))
     startup, why_not = startup_section(results)
     if startup is None:
         targets.append(_target("f", None, why_not))
@@ -246,6 +269,17 @@ SENSOR_ROW_CASES: dict[str, tuple[str, str]] = {
 }
 
 
+def slam_spread(row: dict[str, Any]) -> str:
+    """A slam row's min and max over its runs (the row's figures are the medians); empty
+    for a row of an older results file (one run)."""
+    if "ratio_to_cartpole_min" not in row:
+        return ""
+    return (
+        f"{row['runs']} runs: {row['steps_per_s_min']:,.0f} to {row['steps_per_s_max']:,.0f} /s, "
+        f"{_pct(row['ratio_to_cartpole_min'])} to {_pct(row['ratio_to_cartpole_max'])}"
+    )
+
+
 def table_rows(results: dict[str, Any]) -> list[tuple[str, ...]]:
     """(section, case, steps/s, % nearest ref, ref, % start ref, relative) rows."""
     rows: list[tuple[str, ...]] = []
@@ -281,15 +315,8 @@ def table_rows(results: dict[str, Any]) -> list[tuple[str, ...]]:
     for row in results.get("vector", []):
         case = f"{vector_label(row)}, {row['num_envs']} envs"
         add("vector", case, row, _relative(row["ratio_to_sync"], "sync"))
-    slam_rows = results.get("slam", [])
-    for row in slam_rows:
-        base = next(
-            other["steps_per_s"]
-            for other in slam_rows
-            if other["transfer"] == row["transfer"] and other["n_landmarks"] == 4
-        )
-        case = f"update(), {row['transfer']}, {row['n_landmarks']} landmarks"
-        add("slam", case, row, f"{_times(row['steps_per_s'] / base)} 4-landmark rate")
+    for row in results.get("slam", []):
+        add("slam", row_case(row), row, slam_spread(row))
     for row in results.get("ppo", []):
         case = f"PPO {ppo_label(row)}, {row['n_envs']} envs"
         add("ppo", case, row, _relative(row["ratio_to_subproc"], "subproc"))
@@ -332,7 +359,7 @@ def table_notes(results: dict[str, Any]) -> list[str]:
             f"(median of {planning['moves']} moves; mean {planning['mean_s'] * 1e3:.3f} ms, "
             f"p90 {planning['p90_s'] * 1e3:.3f} ms).",
         ]
-    lines += ["", "Targets:"]
+    lines += ["", *figure_notes(results), "", "Targets:"]
     lines.extend("  " + format_target(target) for target in results["targets"])
     lines.append("")
     lines.append(
@@ -344,6 +371,24 @@ def table_notes(results: dict[str, Any]) -> list[str]:
             "PPO: env steps per wall-second of model.learn() after a warm-up learn() "
             "(process start-up and torch init excluded); the median of "
             f"{results['settings'].get('ppo_rounds', 1)} interleaved rounds per kind."
+        )
+    return lines
+
+
+def figure_notes(results: dict[str, Any]) -> list[str]:
+    """What the single and slam rows time."""
+    lines = []
+    if "single" in results:
+        lines.append(
+            f"single: seeded random actions sampled ahead of the timed loop (a block of "
+            f"{SINGLE_ACTION_BLOCK:,}, cycled): env.step and resets alone are timed."
+        )
+    if "slam" in results and any("readings" in row for row in results["slam"]):
+        lines.append(
+            "slam: update() on the readings of the random polygonal trajectory recorded from "
+            f"seeded {' and '.join(RECORDED_TASKS)} episodes (a fresh map per episode); "
+            f"[secondary]: {SYNTHETIC_LABEL}. Medians over runs, each against its run's "
+            "CartPole-v1; relative: min to max."
         )
     return lines
 
@@ -514,7 +559,7 @@ GOAL_NAMES: dict[str, str] = {
     "i": "batched vector env, 256 Khepera sub-envs",
     "c": "single env, 64 landmarks ÷ 4 landmarks",
     "d": "PPO on the batched env ÷ PPO on `SubprocVecEnv` (16 envs)",
-    "e": "`PolygonSLAM.update`, 4 landmarks, conservative",
+    "e": "`PolygonSLAM.update` on recorded Khepera-v1 readings, conservative",
     "f": "fresh process: import, make `BearingSLAM-Khepera-v1`, one step ÷ the same with "
     "CartPole-v1",
     "g": "`GreedyOneStep` planning per move (median)",

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from gymnasium.vector import AutoresetMode
 
-from bearing_env.benchmarks import bench_env, bench_report, bench_timing
+from bearing_env.benchmarks import bench_env, bench_readings, bench_report, bench_timing
 from bearing_env.train import cli
 from tests.extras import needs
 
@@ -111,10 +111,57 @@ def test_quick_single_and_vector(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert targets["b"]["met"] is None  # --quick measures 1 and 4 envs, not 64
     assert targets["d"]["met"] is None
 
+    assert {row["actions"] for row in results["single"]} == {"sampled ahead"}
     out = capsys.readouterr().out
     assert "CartPole-v1" in out and "khepera, 4 landmarks" in out and "Targets:" in out
+    assert "single: seeded random actions sampled ahead of the timed loop" in out
     assert str(path) in out
     assert [p.name for p in path.parent.iterdir()] == [path.name]  # no temp file left
+
+
+class CountingEnv(gym.Env[Any, Any]):
+    """Steps instantly; records each action and how many draws the bench's generator had
+    made when it came."""
+
+    action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
+    observation_space = gym.spaces.Box(-1.0, 1.0, (1,), dtype=np.float32)
+
+    def __init__(self, draws: list[int]) -> None:
+        self.draws, self.seen, self.actions = draws, [], []
+
+    def reset(self, *, seed: int | None = None, options: Any = None) -> tuple[Any, dict]:
+        return np.zeros(1, np.float32), {}
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict]:
+        self.seen.append(len(self.draws))
+        self.actions.append(np.array(action))
+        return np.zeros(1, np.float32), 0.0, len(self.actions) % 97 == 0, False, {}
+
+
+def test_single_env_actions_are_sampled_ahead_of_the_timed_loop(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    draws: list[int] = []
+    real_rng = np.random.default_rng
+
+    class Counting:
+        def __init__(self, seed: int) -> None:
+            self.rng = real_rng(seed)
+
+        def uniform(self, *args: Any, **kwargs: Any) -> Any:
+            draws.append(1)
+            return self.rng.uniform(*args, **kwargs)
+
+    monkeypatch.setattr(bench_timing.np.random, "default_rng", Counting)
+    env = CountingEnv(draws)
+    block = bench_timing.SINGLE_ACTION_BLOCK
+    steps, _, resets = bench_timing.run_single_env(env, 0.0, min_steps=2 * block + 10)
+    assert steps == 2 * block + 10 and resets == steps // 97
+    assert set(env.seen) == {1}  # one draw, before the first (warm-up) step
+    timed = np.array(env.actions[1:])  # after the warm-up step
+    np.testing.assert_array_equal(timed[:block], timed[block : 2 * block])
+    expected = real_rng(0).uniform(-1.0, 1.0, (block, 2)).astype(np.float32)
+    np.testing.assert_array_equal(timed[:block], expected)
 
 
 @needs("train", "stable_baselines3", "torch")
@@ -207,8 +254,9 @@ def test_targets_from_results() -> None:
             fake_figure(550.0, kind="batched", num_envs=256),
         ],
         "slam": [
-            fake_figure(450.0, transfer="conservative", n_landmarks=4),
-            fake_figure(900.0, transfer="paper", n_landmarks=4),
+            fake_figure(450.0, readings="khepera", transfer="conservative", n_landmarks=4),
+            fake_figure(900.0, readings="khepera", transfer="paper", n_landmarks=4),
+            fake_figure(700.0, readings="synthetic_4", transfer="conservative", n_landmarks=4),
         ],
         "startup": {"ratio_to_cartpole": 1.4},
         "planning": {"median_s": 0.4e-3},
@@ -221,7 +269,8 @@ def test_targets_from_results() -> None:
     assert targets["i"]["met"] is False and targets["i"]["value"] == pytest.approx(0.55)
     assert targets["c"]["met"] is False and targets["c"]["value"] == pytest.approx(0.05)
     assert targets["d"]["met"] is True and targets["d"]["value"] == pytest.approx(3.0)
-    # the conservative row, not the paper one (90%)
+    # the conservative row on recorded Khepera-v1 readings, not the paper one (90%) nor
+    # the synthetic one (70%)
     assert targets["e"]["met"] is False and targets["e"]["value"] == pytest.approx(0.45)
     assert targets["f"]["met"] is True and targets["f"]["value"] == 1.4
     assert targets["g"]["met"] is True
@@ -304,13 +353,42 @@ def test_ppo_rounds_are_interleaved_and_the_median_counts(tmp_path: Path) -> Non
 def test_quick_slam(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     results, _ = run_quick(tmp_path, "--sections", "slam")
     check_common(results, {"slam"})
-    rows = {(row["transfer"], row["n_landmarks"]): row for row in results["slam"]}
-    assert set(rows) == {(t, n) for t in ("conservative", "paper") for n in (4, 64)}
-    for row in rows.values():
-        assert positive_finite(row["steps_per_s"]) and positive_finite(row["ratio_to_cartpole"])
+    rows = results["slam"]
+    transfers = ("conservative", "paper")
+    # The recorded readings first, then the synthetic ones (secondary).
+    assert [(row["readings"], row["transfer"]) for row in rows] == [
+        *((readings, t) for t in transfers for readings in ("khepera", "random8")),
+        *((readings, t) for t in transfers for readings in ("synthetic_4", "synthetic_64")),
+    ]
+    assert [row["primary"] for row in rows] == [True] * 4 + [False] * 4
+    assert {row["env_id"] for row in rows[:4]} == set(bench_readings.RECORDED_TASKS)
+    assert [row["n_landmarks"] for row in rows[:2]] == [4, 8]
+    assert {row["label"] for row in rows[4:]} == {bench_readings.SYNTHETIC_LABEL}
+    for row in rows:
+        assert row["runs"] == bench_timing.SLAM_RUNS == len(row["run_steps_per_s"])
+        for name in ("steps_per_s", "ratio_to_cartpole"):
+            low, median, high = (row[f"{name}{end}"] for end in ("_min", "", "_max"))
+            assert positive_finite(low) and low <= median <= high
+        assert row["cartpole_reference"] == "slam"
+    assert "slam" in {ref["label"] for ref in results["cartpole_references"]}
     targets = {target["id"]: target for target in results["targets"]}
-    assert targets["e"]["value"] == rows[("conservative", 4)]["ratio_to_cartpole"]
-    assert "update(), conservative, 4 landmarks" in capsys.readouterr().out
+    assert targets["e"]["value"] == rows[0]["ratio_to_cartpole"]  # Khepera-v1, conservative
+    out = capsys.readouterr().out
+    lines = [line for line in out.splitlines() if line.startswith("slam ")]
+    assert "update(), conservative, Khepera-v1 readings, 4 landmarks" in lines[0]
+    assert "Random8-v1 readings, 8 landmarks" in lines[1]
+    assert all("[secondary]" in line and "synthetic readings" in line for line in lines[4:])
+    assert not any("[secondary]" in line for line in lines[:4])
+    assert "5 runs:" in lines[0] and "actions sampled ahead" not in out
+
+
+def test_an_older_results_files_update_rows_do_not_stand_for_the_recorded_readings() -> None:
+    results = {"format": 3, "slam": [fake_figure(500.0, transfer="conservative", n_landmarks=4)]}
+    (target,) = [t for t in bench_report.evaluate_targets(results) if t["id"] == "e"]
+    assert target["met"] is None and "synthetic readings" in target["note"]
+    old_row = {**results["slam"][0], "cartpole_reference": "slam", "ratio_to_cartpole_start": 0.5}
+    (row,) = bench_report.table_rows({**results, "slam": [old_row]})
+    assert row[1] == "update(), conservative, 4 landmarks" and row[-1] == ""
 
 
 STARTUP_KEYS = {
@@ -476,16 +554,26 @@ def test_bench_slam_warms_everything_it_times_before_timing(
     monkeypatch.setattr(
         bench_slam,
         "updates_per_second",
-        lambda n, t, s: (events.append(f"{t} {n}"), real_rate(n, t, s))[1],
+        lambda w, t, s: (events.append(f"{t} {w.key}"), real_rate(w, t, s))[1],
     )
-    bench_slam.main(["--seconds", "0.01"])
-    assert events[:2] == ["warm_up", "cartpole"]
-    measured = [(t, n) for t in bench_slam.MEASURED_TRANSFERS for n in bench_slam.LANDMARK_COUNTS]
-    assert events[2:] == [f"{t} {n}" for t, n in measured]
-    # The warm-up's untimed pass (20 readings a map) updated every measured map.
-    warm_up_updates = updates[: len(measured) * 20]
-    assert sorted(set(warm_up_updates)) == sorted(measured)
-    assert "update()" in capsys.readouterr().out
+    bench_slam.main(["--seconds", "0.02", "--runs", "2"])
+    assert events[0] == "warm_up"
+    keys = ["khepera", "random8", *(f"synthetic_{n}" for n in bench_slam.LANDMARK_COUNTS)]
+    transfers = bench_slam.MEASURED_TRANSFERS
+    one_run = [
+        "cartpole",
+        *(f"{t} {key}" for t in transfers for key in keys[:2]),
+        *(f"{t} {key}" for t in transfers for key in keys[2:]),
+    ]
+    assert events[1:] == one_run * 2  # each run: CartPole-v1, then every figure once
+    # The warm-up's untimed pass updated every measured map before anything was timed.
+    counts = [4, 8, *bench_slam.LANDMARK_COUNTS]
+    measured = {(t, n) for t in transfers for n in counts}
+    per_transfer = sum(workload.movements for workload in bench_slam.workloads())
+    warm_up_updates = updates[: len(transfers) * per_transfer]
+    assert set(warm_up_updates) == measured
+    out = capsys.readouterr().out
+    assert "update()" in out and "median of 2 runs" in out
 
 
 def test_targets_print_in_their_own_units() -> None:

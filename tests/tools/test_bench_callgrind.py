@@ -50,16 +50,46 @@ def test_the_command_counts_the_update_and_the_step(tmp_path: Path) -> None:
         "bearing-env bench-callgrind --movements 20 --steps 20 --json " + str(out)
     )
     results = record["counts"]
+    transfers = ("conservative", "paper", "conservative_global")
     assert set(results) == {
-        "update_conservative_4", "update_paper_4", "update_conservative_global_4", "step_khepera"
-    }  # fmt: skip
+        *(f"update_{t}_{key}" for key in ("khepera", "synthetic_4") for t in transfers),
+        "step_khepera",
+    }
+    assert results["update_paper_khepera"]["readings"] == "recorded Khepera-v1 readings"
     for counted in results.values():
         assert counted["per_call"] == counted["instructions"] / counted["count"] > 1000
         names = [f["function"] for f in counted["functions"]]
         assert names and all(not n.startswith(bench_callgrind.NANOBIND_WRAPPERS) for n in names)
     # The conservative transfer costs more than the paper's, per movement.
-    assert results["update_conservative_4"]["per_call"] > results["update_paper_4"]["per_call"]
+    for key in ("khepera", "synthetic_4"):
+        assert (
+            results[f"update_conservative_{key}"]["per_call"]
+            > results[f"update_paper_{key}"]["per_call"]
+        )
     assert results["step_khepera"]["functions"][0]["function"] == "bearing::env::step_rows"
+
+
+def test_the_update_driver_replays_the_recorded_readings_episode_by_episode(
+    tmp_path: Path,
+) -> None:
+    # The driver, run here without valgrind, on the saved Khepera-v1 workload: as many
+    # updates as asked, a fresh map at each episode, the env's map settings.
+    import subprocess
+    import sys
+
+    import numpy as np
+
+    path = tmp_path / "khepera.npz"
+    bench_callgrind.save_workload("khepera", path)
+    data = np.load(path)
+    assert data["start"].shape == data["end"].shape == (160, 4)
+    assert data["episodes"].tolist() == [k // 20 for k in range(160)]
+    assert json.loads(str(data["settings"]))["epsilon"] == pytest.approx(np.deg2rad(2.0))
+    out = subprocess.run(
+        [sys.executable, "-c", bench_callgrind.UPDATE_DRIVER, "170", "paper", str(path)],
+        capture_output=True, text=True, check=True,
+    ).stdout  # fmt: skip
+    assert out.strip() == "170"
 
 
 def test_the_page_table_lists_the_steps_functions_below_the_step_itself() -> None:
@@ -71,13 +101,17 @@ def test_the_page_table_lists_the_steps_functions_below_the_step_itself() -> Non
     record = {
         "measured": {"command": "bearing-env bench-callgrind", "commit": "abc1234def",
                      "date": "2026-12-03", "machine": "2-core x86_64 machine"},
-        "counts": {"update_conservative_4": {"per_call": 61_168.3},
-                   "update_paper_4": {"per_call": 26_694.4}, "step_khepera": step},
+        "counts": {"update_conservative_khepera": {"per_call": 81_168.3},
+                   "update_paper_khepera": {"per_call": 36_694.4},
+                   "update_conservative_synthetic_4": {"per_call": 61_168.3},
+                   "update_paper_synthetic_4": {"per_call": 26_694.4}, "step_khepera": step},
     }  # fmt: skip
     text = bench_callgrind.markdown_callgrind(record)
     assert (
-        "61,168 conservative, 26,694 paper" in text and "(native part, 400 steps): 140,335" in text
+        "on recorded Khepera-v1 readings: 81,168 conservative, 36,694 paper; on synthetic" in text
     )
+    assert "repeated layout): 61,168 conservative, 26,694 paper" in text
+    assert "(native part, 400 steps): 140,335" in text
     rows = [line for line in text.splitlines() if line.startswith("| `")]
     assert rows[0] == "| `part0` | 90% |" and len(rows) == bench_callgrind.PAGE_FUNCTIONS
     assert "step_rows" not in "".join(rows) and "update_rows" not in "".join(rows)

@@ -90,6 +90,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "bearing-env compare --policies greedy pretrained:ppo_generalist": ("parse", ()),
     "bearing-env bench": ("parse", ()),
     "bearing-env bench --sections startup": ("parse", ()),
+    "bearing-env bench --sections slam": ("parse", ()),
     "bearing-env bench --sections throughput": ("parse", ()),
     "bearing-env figures --out docs/figures": ("parse", ()),
     "bearing-env hyperparams ppo": ("run", ()),
