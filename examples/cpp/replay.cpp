@@ -130,11 +130,12 @@ int main(int argc, char** argv) {
         settings.epsilon = std::strtod(argv[2], nullptr);
         // The names of the codes, in the order of their values (slam/state.hpp).
         if (argc > 3) {
-            settings.transfer =
-                code_of(argv[3], {"conservative", "paper", "conservative_global"}, "transfer");
+            settings.transfer = static_cast<slam::Transfer>(
+                code_of(argv[3], {"conservative", "paper", "conservative_global"}, "transfer"));
         }
         if (argc > 4)
-            settings.fusion = code_of(argv[4], {"intersect", "relaxed", "robust"}, "fusion");
+            settings.fusion = static_cast<slam::Fusion>(
+                code_of(argv[4], {"intersect", "relaxed", "robust"}, "fusion"));
         slam::MapBatch maps(1, log.landmarks, settings);
         for (size_t move = 0; move < log.start.size(); ++move) {
             maps.update(log.start[move], log.end[move]);

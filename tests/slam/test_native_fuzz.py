@@ -117,11 +117,12 @@ CALLS: Counter[str] = Counter()
 RETURNS: Counter[str] = Counter()
 
 
-def result(entry: Callable[..., T], *args: Any) -> T | None:
-    """entry(*args), or None when it refuses the input (an entry point returning a value)."""
+def result(entry: Callable[..., T], *args: Any, **kwargs: Any) -> T | None:
+    """entry(*args, **kwargs), or None when it refuses the input (an entry point returning a
+    value)."""
     CALLS[entry.__name__] += 1
     try:
-        value = entry(*args)
+        value = entry(*args, **kwargs)
     except REFUSALS:
         return None
     RETURNS[entry.__name__] += 1
@@ -757,10 +758,10 @@ def test_params_of_any_settings(
 ) -> None:
     transfer, edge_samples, on_inconsistency, fusion, max_outliers = codes
     with_robot, likely, estimate_bound = flags
-    params = result(
-        _core.Params, epsilon, transfer, edge_samples, on_inconsistency, fusion,
-        max_outliers, with_robot, risk, likely, estimate_bound,
-    )  # fmt: skip
+    drawn = {"with_robot": with_robot, "likely": likely, "estimate_bound": estimate_bound}
+    drawn.update(epsilon=epsilon, transfer=transfer, edge_samples=edge_samples)
+    drawn.update(on_inconsistency=on_inconsistency, fusion=fusion, max_outliers=max_outliers)
+    params = result(_core.Params, **drawn, risk=risk)
     if params is not None:
         assert math.isfinite(params.epsilon) and params.epsilon > 0.0
         assert 1 <= params.edge_samples <= kernels.MAX_EDGE_SAMPLES
@@ -1329,15 +1330,20 @@ def test_reports_and_potentials_of_any_state(name: str, data: st.DataObject) -> 
         assert not np.any(np.isnan(out))
 
 
+AXES = ("maps", "m", "w", "levels", "h", "base_capacity", "probe_capacity", "N", "slots",
+        "values", "rows", "obs")  # fmt: skip
+
+
 @fuzz(
     schema=st.sampled_from(("State", "BatchState", "Report", "Settings", "Nothing")),
-    lengths=st.dictionaries(
-        st.sampled_from(("maps", "m", "w", "levels", "h", "base_capacity", "probe_capacity",
-                         "N", "slots", "values", "rows", "obs", "CAPACITY", "other")),
-        st.integers(-3, 6),
-    ),
-)  # fmt: skip
-def test_new_arrays_of_any_lengths(schema: str, lengths: dict[str, int]) -> None:
+    lengths=st.fixed_dictionaries({axis: st.integers(0, 6) for axis in AXES}),
+    changes=st.dictionaries(st.sampled_from((*AXES, "CAPACITY", "other")), st.integers(-3, 6)),
+    drop=st.lists(st.sampled_from(AXES), max_size=2),
+)
+def test_new_arrays_of_any_lengths(
+    schema: str, lengths: dict[str, int], changes: dict[str, int], drop: list[str]
+) -> None:
+    lengths = {axis: n for axis, n in {**lengths, **changes}.items() if axis not in drop}
     arrays = result(_core.new_arrays, schema, lengths)
     if arrays is None:
         return

@@ -64,6 +64,7 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "make native": ("make", ()),
     "make format": ("make", ()),
     "make wheel": ("make", ()),
+    "make stubs": ("make", ()),
     "bearing-env train": ("parse", ("--algo", "ppo")),
     "bearing-env train --algo ppo --env BearingSLAM-Khepera-v1 --seeds 0 1 2 --workers 2 "
     "--eval-freq 250000 --output runs/ppo_khepera": ("parse", ()),
