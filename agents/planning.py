@@ -17,7 +17,6 @@ from numpy.typing import NDArray
 
 from bearing_env import _core
 from bearing_env.envs.config import AREA_FLOOR
-from bearing_env.numerics import wrap_angle
 from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
 
 FloatArray = NDArray[np.float64]
@@ -51,9 +50,20 @@ def bearings_from(
     points: NDArray[np.complex128],
 ) -> NDArray[np.float64]:
     """Noise-free bearings (..., n) of ``points`` (n,) in FL from ``position`` facing
-    ``heading`` (scalars, or arrays of one shape for many poses)."""
-    angles = np.angle(points - np.asarray(position)[..., None]) - np.asarray(heading)[..., None]
-    return wrap_angle(angles)
+    ``heading`` (scalars, or arrays of one shape for many poses): the native kernel's
+    atan2, so that a planner scores the same bits on every machine and in the native
+    scoring (numpy's own atan2 differs from libm's in the last bit on some CPUs)."""
+    differences = np.asarray(points, dtype=np.complex128) - np.asarray(position)[..., None]
+    headings = np.asarray(heading, dtype=np.float64)[..., None]
+    shape = np.broadcast_shapes(differences.shape, headings.shape)
+    differences, headings = np.broadcast_to(differences, shape), np.broadcast_to(headings, shape)
+    out = np.empty(shape, dtype=np.float64)
+    _core._bearings_of(
+        np.ascontiguousarray(differences).reshape(-1),
+        np.ascontiguousarray(headings).reshape(-1),
+        out.reshape(-1),
+    )
+    return out
 
 
 #: A visibility prediction: simulated bearings (S + (n,)) from positions and headings
@@ -94,11 +104,16 @@ def simulate_potentials(
         sensor: the visibility prediction (None: the panoramic camera sees every landmark).
 
     Every moving candidate is fused into its own copy of the map, all in one batched
-    update; the bearings are computed here, so the update skips its input checks.
+    update; the bearings are computed here, so the update skips its input checks. Without
+    a sensor, the whole scoring is one native call (:func:`_simulate_natively`).
     """
+    headings = np.ascontiguousarray(headings, dtype=np.float64)
+    distances = np.ascontiguousarray(distances, dtype=np.float64)
+    if sensor is None:
+        return _simulate_natively(
+            slam, start, landmarks, headings, distances, area_cap, min_distance, log_area, scratch
+        )
     current = uncertainty_potential(slam.areas, area_cap, log_area)
-    headings = np.asarray(headings, dtype=np.float64)
-    distances = np.asarray(distances, dtype=np.float64)
     potentials = np.full(headings.size, current)
     moving = np.flatnonzero(distances >= min_distance)
     if moving.size == 0:
@@ -121,6 +136,36 @@ def simulate_potentials(
     # Bearings made here are finite float arrays of the batch's shape: no checks needed.
     trials.update_trusted(bearings_start, bearings_end, robot=False)  # scores need areas only
     potentials[moving] = uncertainty_potential(trials.areas, area_cap, log_area)
+    return potentials
+
+
+def _simulate_natively(
+    slam: PolygonSLAM,
+    start: complex,
+    landmarks: NDArray[np.complex128],
+    headings: FloatArray,
+    distances: FloatArray,
+    area_cap: float,
+    min_distance: float,
+    log_area: bool,
+    scratch: dict[int, BatchedPolygonSLAM] | None,
+) -> FloatArray:
+    """:func:`simulate_potentials` without a sensor, in one native call (the same bits):
+    the candidates' copies of the map go to a scratch batch of one map per candidate,
+    kept in ``scratch`` under the candidate count."""
+    batch, count = slam.batch, headings.size
+    trials = None if scratch is None else scratch.get(count)
+    if trials is None or not trials.same_settings(batch):
+        trials = batch.empty_like(max(count, 1))
+        if scratch is not None:
+            scratch[count] = trials
+    potentials = np.empty(count, dtype=np.float64)
+    _core._simulate_potentials(
+        batch._kernel_state(), slam.index, batch._kernel_params(False), complex(start),
+        np.ascontiguousarray(landmarks, dtype=np.complex128), headings, distances,
+        float(area_cap), AREA_FLOOR, float(min_distance), bool(log_area),
+        trials._kernel_state(), potentials,
+    )  # fmt: skip
     return potentials
 
 

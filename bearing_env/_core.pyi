@@ -657,6 +657,28 @@ def _potentials_of_rows(
 ) -> None:
     """potential_of of every row of areas (rows, m) into out."""
 
+def _bearings_of(differences: object, headings: object, out: object) -> None:
+    """out[k] = wrap(angle(differences[k]) - headings[k]), with libm's atan2."""
+
+def _simulate_potentials(
+    maps: MapState,
+    row: int,
+    params: Params,
+    start: complex,
+    landmarks: object,
+    headings: object,
+    distances: object,
+    area_cap: float,
+    floor: float,
+    min_distance: float,
+    log_area: bool,
+    trials: MapState,
+    out: object,
+) -> None:
+    """
+    The potential after each candidate move, simulated on copies of map row in trials' first maps (agents/planning.py's simulate_potentials without a sensor).
+    """
+
 def _move_ends(start: complex, headings: object, distances: object, out: object) -> None:
     """
     out[k]: where candidate k ends, start + distances[k] * (cos + i sin)(headings[k]).

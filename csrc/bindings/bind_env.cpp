@@ -499,6 +499,41 @@ void bind_env(nb::module_& m) {
         "rows"_a, "log_area"_a, "floor"_a, "cap"_a, "out"_a,
         "potential_of of every row of areas (rows, m) into out.");
     m.def(
+        "_bearings_of",
+        [](nb::handle differences, nb::handle headings, nb::handle out) {
+            auto d = view_of<const cplx, 1>(differences, "differences");
+            auto h = view_of<const double, 1>(headings, "headings", {d.shape[0]});
+            auto o = view_of<double, 1>(out, "out", {d.shape[0]});
+            env::bearings_of(d, h, o);
+        },
+        "differences"_a, "headings"_a, "out"_a,
+        "out[k] = wrap(angle(differences[k]) - headings[k]), with libm's atan2.");
+    m.def(
+        "_simulate_potentials",
+        [](const bindings::PyMapState& maps, int64_t row, const slam::Params& params,
+           std::complex<double> start, nb::handle landmarks, nb::handle headings,
+           nb::handle distances, double area_cap, double floor, double min_distance, bool log_area,
+           const bindings::PyMapState& trials, nb::handle out) {
+            if (row < 0 || row >= maps.maps) value_error("row is not a map of maps");
+            bindings::require_copyable(maps, trials, "_simulate_potentials");
+            bindings::check_state_for(trials.views, params);
+            env::Candidates c{{start.real(), start.imag()},
+                              view_of<const cplx, 1>(landmarks, "landmarks", {maps.mapped + 2}),
+                              view_of<const double, 1>(headings, "headings"),
+                              {}};
+            const int64_t count = c.headings.shape[0];
+            c.distances = view_of<const double, 1>(distances, "distances", {count});
+            auto o = view_of<double, 1>(out, "out", {count});
+            if (trials.maps < count) value_error("trials must hold a map per candidate");
+            nb::gil_scoped_release release;
+            env::simulate_potentials(maps.views, row, params, c,
+                                     {area_cap, floor, min_distance, log_area}, trials.views, o);
+        },
+        "maps"_a, "row"_a, "params"_a, "start"_a, "landmarks"_a, "headings"_a, "distances"_a,
+        "area_cap"_a, "floor"_a, "min_distance"_a, "log_area"_a, "trials"_a, "out"_a,
+        "The potential after each candidate move, simulated on copies of map row in trials' "
+        "first maps (agents/planning.py's simulate_potentials without a sensor).");
+    m.def(
         "_move_ends",
         [](std::complex<double> start, nb::handle headings, nb::handle distances, nb::handle out) {
             auto h = view_of<const double, 1>(headings, "headings");

@@ -46,22 +46,7 @@ using bearing::bindings::view_of;
 namespace slam = bearing::slam;
 namespace schema = bearing::schema;
 
-// A batch's state as the native update takes it: checked views of the arrays of a State,
-// and the State (its arrays stay alive).
-struct PyMapState {
-    nb::object state;
-    slam::MapState views;
-    schema::Sizes sizes;  // its axes: maps, m (mapped landmarks), w, levels, h
-    int64_t maps = 0, mapped = 0;
-
-    explicit PyMapState(nb::handle source) : state(nb::borrow(source)) {
-        bearing::bindings::Kept kept;  // (the State keeps its arrays alive)
-        sizes = bearing::bindings::map_sizes();
-        views = bearing::bindings::parse_map_state(source, "state", sizes, kept);
-        maps = sizes.at("maps");
-        mapped = sizes.at("m");
-    }
-};
+using bearing::bindings::PyMapState;
 
 void require(bool ok, const std::string& message) {
     if (!ok) value_error(message);
@@ -87,15 +72,7 @@ void update_maps_binding(nb::handle bearings_start, nb::handle bearings_end, nb:
 }
 
 void copy_maps_binding(const PyMapState& from, nb::handle rows, const PyMapState& to) {
-    require(from.views.vertices.data != to.views.vertices.data,
-            "copy_maps needs two different states (from_state and to_state)");
-    bool same = from.mapped == to.mapped;
-    for (const char* axis : {"w", "base_capacity", "levels", "probe_capacity", "h"}) {
-        same = same && from.sizes.at(axis) == to.sizes.at(axis);
-    }
-    require(same, "copy_maps needs states of the same landmarks and fusion arrays: from has " +
-                      std::to_string(from.mapped) + " mapped landmarks, to " +
-                      std::to_string(to.mapped));
+    bearing::bindings::require_copyable(from, to, "copy_maps");
     auto r = bearing::bindings::rows_of(rows, from.maps, false);
     require(r.shape[0] <= to.maps, "rows has " + std::to_string(r.shape[0]) +
                                        " entries, more than to's " + std::to_string(to.maps) +

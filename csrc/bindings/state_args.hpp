@@ -56,6 +56,40 @@ inline slam::MapState map_state_of(nb::handle obj, schema::Sizes& sizes, Kept& k
     return parse_map_state(source, "maps", sizes, kept);
 }
 
+// A batch's state as the native update takes it: checked views of the arrays of a State,
+// and the State (its arrays stay alive).
+struct PyMapState {
+    nb::object state;
+    slam::MapState views;
+    schema::Sizes sizes;  // its axes: maps, m (mapped landmarks), w, levels, h
+    int64_t maps = 0, mapped = 0;
+
+    explicit PyMapState(nb::handle source) : state(nb::borrow(source)) {
+        Kept kept;  // (the State keeps its arrays alive)
+        sizes = map_sizes();
+        views = parse_map_state(source, "state", sizes, kept);
+        maps = sizes.at("maps");
+        mapped = sizes.at("m");
+    }
+};
+
+// `to` can take copies of `from`'s maps (`what` in messages): another state, of the same
+// landmarks and fusion arrays.
+inline void require_copyable(const PyMapState& from, const PyMapState& to, const char* what) {
+    if (from.views.vertices.data == to.views.vertices.data) {
+        value_error(std::string(what) + " needs two different states");
+    }
+    bool same = from.mapped == to.mapped;
+    for (const char* axis : {"w", "base_capacity", "levels", "probe_capacity", "h"}) {
+        same = same && from.sizes.at(axis) == to.sizes.at(axis);
+    }
+    if (!same) {
+        value_error(
+            std::string(what) + " needs states of the same landmarks and fusion arrays: from has " +
+            std::to_string(from.mapped) + " mapped landmarks, to " + std::to_string(to.mapped));
+    }
+}
+
 // What the fusion of `params` needs of the map state's optional arrays (checked before
 // an update: the MapState binding's update_maps and the env step).
 inline void check_state_for(const slam::MapState& s, const slam::Params& p) {

@@ -2,8 +2,11 @@
 #include <bearing_core/env/planning.hpp>
 
 #include <cmath>
+#include <vector>
 
+#include <bearing_core/core/pymath.hpp>
 #include <bearing_core/env/kernels.hpp>
+#include <bearing_core/slam/update.hpp>
 
 namespace bearing::env {
 
@@ -18,6 +21,68 @@ void move_ends(cplx start, View1<const double> headings, View1<const double> dis
                View1<cplx> out) {
     for (int64_t k = 0; k < headings.shape[0]; ++k) {
         out[k] = start + distances[k] * cplx(std::cos(headings[k]), std::sin(headings[k]));
+    }
+}
+
+namespace {
+
+// The bearing of target from a robot at `from` facing heading (bearings_of's).
+double bearing_from(cplx from, double heading, cplx target) {
+    const cplx d = target - from;
+    return wrap(std::atan2(d.im, d.re) - heading);
+}
+
+}  // namespace
+
+void bearings_of(View1<const cplx> differences, View1<const double> headings, View1<double> out) {
+    for (int64_t k = 0; k < differences.shape[0]; ++k) {
+        out[k] = wrap(std::atan2(differences[k].im, differences[k].re) - headings[k]);
+    }
+}
+
+void simulate_potentials(const slam::MapState& maps, int64_t row, const slam::Params& params,
+                         const Candidates& candidates, const Scoring& scoring,
+                         const slam::MapState& trials, View1<double> out) {
+    const int64_t m = maps.counts.shape[1], n = m + 2, count = candidates.headings.shape[0];
+    const double current =
+        potential_of(maps.areas.row(row), m, scoring.log_area, scoring.floor, scoring.area_cap);
+    std::vector<int64_t> moving;
+    for (int64_t k = 0; k < count; ++k) {
+        out[k] = current;
+        if (candidates.distances[k] >= scoring.min_distance) moving.push_back(k);
+    }
+    const auto size = static_cast<int64_t>(moving.size());
+    if (size == 0) return;
+    // The readings at both ends of each moving candidate (an unknown landmark is read at
+    // the start's bearing twice: no region).
+    std::vector<double> start(static_cast<size_t>(size * n)), end(start.size());
+    std::vector<int64_t> rows(static_cast<size_t>(size), row), trial_rows(moving.size());
+    for (int64_t i = 0; i < size; ++i) {
+        const int64_t k = moving[static_cast<size_t>(i)];
+        const double heading = candidates.headings[k];
+        const cplx to =
+            candidates.start + candidates.distances[k] * cplx(std::cos(heading), std::sin(heading));
+        for (int64_t j = 0; j < n; ++j) {
+            const cplx landmark = candidates.landmarks[j];
+            const bool known = std::isfinite(landmark.re) && std::isfinite(landmark.im);
+            const cplx target = known ? landmark : cplx(0.0, 0.0);
+            const double before = bearing_from(candidates.start, heading, target);
+            start[static_cast<size_t>(i * n + j)] = before;
+            end[static_cast<size_t>(i * n + j)] =
+                known ? bearing_from(to, heading, target) : before;
+        }
+        trial_rows[static_cast<size_t>(i)] = i;
+    }
+    slam::copy_maps(maps, {rows.data(), {size}}, trials);
+    std::vector<int8_t> frame_status(moving.size()), landmark_status(moving.size() * m);
+    std::vector<int64_t> n_bad(moving.size());
+    const slam::Outputs outputs{
+        {frame_status.data(), {size}}, {landmark_status.data(), {size, m}}, {n_bad.data(), {size}}};
+    slam::update_maps({start.data(), {size, n}}, {end.data(), {size, n}},
+                      {trial_rows.data(), {size}}, params, trials, outputs, 1);
+    for (int64_t i = 0; i < size; ++i) {
+        out[moving[static_cast<size_t>(i)]] =
+            potential_of(trials.areas.row(i), m, scoring.log_area, scoring.floor, scoring.area_cap);
     }
 }
 

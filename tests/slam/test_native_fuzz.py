@@ -104,7 +104,7 @@ FUZZED: frozenset[str] = frozenset(
         "report_rows_into", "potentials", "move_and_read", "append_positions", "capped",
         "potential_of", "_write_shape", "decode_continuous", "_known", "encode_map",
         "encode_map_into", "encode_window", "encode_levels", "_potentials_of_rows",
-        "_move_ends",
+        "_move_ends", "_bearings_of", "_simulate_potentials",
     }
 )  # fmt: skip
 
@@ -1474,6 +1474,44 @@ def test_known_and_move_ends_of_any_points(
     out = np.zeros(out_length(data.draw, headings.size), dtype=np.complex128)
     if completes(_core._move_ends, start, headings, distances, out):
         assert distances.size == headings.size == out.size
+
+
+@fuzz(data=st.data())
+def test_bearings_of_any_points(data: st.DataObject) -> None:
+    size = data.draw(st.integers(0, 5))
+    differences = np.array(data.draw(st.lists(hard_complexes, min_size=size, max_size=size)))
+    headings = np.array(
+        data.draw(st.lists(hard_floats, min_size=size, max_size=size + 1)), dtype=np.float64
+    )
+    out = np.zeros(out_length(data.draw, size))
+    if completes(_core._bearings_of, differences.astype(np.complex128), headings, out):
+        angles = out[np.isfinite(differences) & np.isfinite(headings)]
+        assert np.all((-np.pi <= angles) & (angles < np.pi))
+
+
+@fuzz(fusion=st.sampled_from(FUSIONS), data=st.data())
+def test_simulate_potentials_of_any_state(fusion: str, data: st.DataObject) -> None:
+    state = state_copy(fusion)
+    corrupt_state(data.draw, state)
+    maps = result(_core.MapState, state)
+    trials = _core.MapState(state_copy(fusion))
+    if maps is None:
+        return
+    count = data.draw(st.integers(0, MAPS + 1))
+    landmarks = np.array(
+        data.draw(st.lists(hard_complexes, min_size=LANDMARKS, max_size=LANDMARKS + 1)),
+        dtype=np.complex128,
+    )
+    headings = np.array(data.draw(st.lists(hard_floats, min_size=count, max_size=count)))
+    distances = np.array(data.draw(st.lists(hard_floats, min_size=count, max_size=count)))
+    out = np.zeros(out_length(data.draw, count))
+    row = data.draw(st.one_of(st.integers(0, MAPS - 1), hard_ints))
+    if completes(
+        _core._simulate_potentials, maps, row, params_of(fusion), data.draw(hard_complexes),
+        landmarks, headings.astype(np.float64), distances.astype(np.float64), 4.0, 1e-3, 1e-9,
+        data.draw(st.booleans()), trials, out,
+    ):  # fmt: skip
+        assert out.size == count
 
 
 def map_state_forms(world: Fresh, inputs: Any) -> dict[str, Any]:

@@ -5,6 +5,7 @@
 
 #include <bearing_core/core/complex.hpp>
 #include <bearing_core/core/views.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::env {
 
@@ -14,5 +15,37 @@ void potentials_of_rows(View2<const double> rows, bool log_area, double floor, d
 // out[k] = start + distances[k] * (cos(headings[k]) + i sin(headings[k])).
 void move_ends(cplx start, View1<const double> headings, View1<const double> distances,
                View1<cplx> out);
+
+// out[k]: the bearing of a point at differences[k] (point - position) from a robot facing
+// headings[k], wrap(atan2 - heading) (agents/planning.py's bearings_from).
+void bearings_of(View1<const cplx> differences, View1<const double> headings, View1<double> out);
+
+// What simulate_potentials scores: candidate k turns to headings[k] and travels
+// distances[k] (FL units) from `start`; the map's landmarks are at `landmarks` (n, FL; NaN
+// where unknown: parallel readings, no region).
+struct Candidates {
+    cplx start;
+    View1<const cplx> landmarks;    // (n,) L1 = 0, L2 = 1 first
+    View1<const double> headings;   // (K,)
+    View1<const double> distances;  // (K,)
+};
+
+// How a simulated map is scored: the env's uncertainty potential, and the shortest move
+// that updates the map.
+struct Scoring {
+    double area_cap = 0.0;
+    double floor = 0.0;
+    double min_distance = 0.0;
+    bool log_area = true;
+};
+
+// agents/planning.py's simulate_potentials without a visibility prediction, in one call,
+// the same bits: the potential after each candidate move into out (K,), each moving
+// candidate fused into its own copy of map `row` of `maps` (noise-free readings of the
+// landmarks from `start` and from the move's end), the copies in `trials`' first maps.
+// The caller checks that trials holds K maps of maps' shape, row, and the sizes.
+void simulate_potentials(const slam::MapState& maps, int64_t row, const slam::Params& params,
+                         const Candidates& candidates, const Scoring& scoring,
+                         const slam::MapState& trials, View1<double> out);
 
 }  // namespace bearing::env
