@@ -103,9 +103,10 @@ def simulate_potentials(
             (see :meth:`PolygonSLAM.replicate`) instead of made anew for each decision.
         sensor: the visibility prediction (None: the panoramic camera sees every landmark).
 
-    Every moving candidate is fused into its own copy of the map, all in one batched
-    update; the bearings are computed here, so the update skips its input checks. Without
-    a sensor, the whole scoring is one native call (:func:`_simulate_natively`).
+    Every moving candidate is fused into its own copy of the map, copies, updates and
+    potentials in one native call; the bearings are computed here (with a sensor, in
+    Python), so the update skips its input checks. Without a sensor, the readings too are
+    computed natively (:func:`_simulate_natively`).
     """
     headings = np.ascontiguousarray(headings, dtype=np.float64)
     distances = np.ascontiguousarray(distances, dtype=np.float64)
@@ -113,11 +114,8 @@ def simulate_potentials(
         return _simulate_natively(
             slam, start, landmarks, headings, distances, area_cap, min_distance, log_area, scratch
         )
-    current = uncertainty_potential(slam.areas, area_cap, log_area)
-    potentials = np.full(headings.size, current)
+    count = headings.size
     moving = np.flatnonzero(distances >= min_distance)
-    if moving.size == 0:
-        return potentials
     headings, distances = headings[moving], distances[moving]
     known = np.isfinite(landmarks)
     targets = np.where(known, landmarks, 0.0)
@@ -125,18 +123,31 @@ def simulate_potentials(
     _move_ends(complex(start), headings, distances, ends)
     bearings_start = bearings_from(start, headings, targets)
     bearings_end = np.where(known, bearings_from(ends, headings, targets), bearings_start)
-    if sensor is not None:
-        bearings_start = sensor(bearings_start, np.full(headings.shape, start), headings)
-        bearings_end = sensor(bearings_end, ends, headings)
-    if scratch is None:
-        trials = slam.replicate(moving.size)
-    else:
-        trials = slam.replicate(moving.size, into=scratch.get(moving.size))
-        scratch[moving.size] = trials
-    # Bearings made here are finite float arrays of the batch's shape: no checks needed.
-    trials.update_trusted(bearings_start, bearings_end, robot=False)  # scores need areas only
-    potentials[moving] = uncertainty_potential(trials.areas, area_cap, log_area)
+    bearings_start = sensor(bearings_start, np.full(headings.shape, start), headings)
+    bearings_end = sensor(bearings_end, ends, headings)
+    trials = _scratch_batch(slam, count, scratch)
+    potentials = np.empty(count, dtype=np.float64)
+    # Bearings made here are finite float arrays of the batch's shape (or NaN, a miss).
+    _core._score_readings(
+        slam.batch._kernel_state(), slam.index, slam.batch._kernel_params(False), moving,
+        np.ascontiguousarray(bearings_start, dtype=np.float64),
+        np.ascontiguousarray(bearings_end, dtype=np.float64), float(area_cap), AREA_FLOOR,
+        bool(log_area), trials._kernel_state(), potentials,
+    )  # fmt: skip
     return potentials
+
+
+def _scratch_batch(
+    slam: PolygonSLAM, count: int, scratch: dict[int, BatchedPolygonSLAM] | None
+) -> BatchedPolygonSLAM:
+    """A batch of ``count`` maps of ``slam``'s settings for the candidates' copies: the one
+    kept in ``scratch`` under ``count``, or a new one (kept there)."""
+    trials = None if scratch is None else scratch.get(count)
+    if trials is None or not trials.same_settings(slam.batch):
+        trials = slam.batch.empty_like(max(count, 1))
+        if scratch is not None:
+            scratch[count] = trials
+    return trials
 
 
 def _simulate_natively(
@@ -154,11 +165,7 @@ def _simulate_natively(
     the candidates' copies of the map go to a scratch batch of one map per candidate,
     kept in ``scratch`` under the candidate count."""
     batch, count = slam.batch, headings.size
-    trials = None if scratch is None else scratch.get(count)
-    if trials is None or not trials.same_settings(batch):
-        trials = batch.empty_like(max(count, 1))
-        if scratch is not None:
-            scratch[count] = trials
+    trials = _scratch_batch(slam, count, scratch)
     potentials = np.empty(count, dtype=np.float64)
     _core._simulate_potentials(
         batch._kernel_state(), slam.index, batch._kernel_params(False), complex(start),

@@ -679,6 +679,23 @@ def _simulate_potentials(
     The potential after each candidate move, simulated on copies of map row in trials' first maps (agents/planning.py's simulate_potentials without a sensor).
     """
 
+def _score_readings(
+    maps: MapState,
+    row: int,
+    params: Params,
+    moving: object,
+    start: object,
+    end: object,
+    area_cap: float,
+    floor: float,
+    log_area: bool,
+    trials: MapState,
+    out: object,
+) -> None:
+    """
+    The potential after each candidate into out: moving[i] fused from readings start[i], end[i] into its own copy of map row (trials' map i); the others the map's own.
+    """
+
 def _move_ends(start: complex, headings: object, distances: object, out: object) -> None:
     """
     out[k]: where candidate k ends, start + distances[k] * (cos + i sin)(headings[k]).

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <complex>
 #include <limits>
 #include <map>
@@ -533,6 +534,37 @@ void bind_env(nb::module_& m) {
         "area_cap"_a, "floor"_a, "min_distance"_a, "log_area"_a, "trials"_a, "out"_a,
         "The potential after each candidate move, simulated on copies of map row in trials' "
         "first maps (agents/planning.py's simulate_potentials without a sensor).");
+    m.def(
+        "_score_readings",
+        [](const bindings::PyMapState& maps, int64_t row, const slam::Params& params,
+           nb::handle moving, nb::handle start, nb::handle end, double area_cap, double floor,
+           bool log_area, const bindings::PyMapState& trials, nb::handle out) {
+            if (row < 0 || row >= maps.maps) value_error("row is not a map of maps");
+            bindings::require_copyable(maps, trials, "_score_readings");
+            bindings::check_state_for(trials.views, params);
+            auto o = view_of<double, 1>(out, "out");
+            const env::Readings r{
+                bindings::rows_of(moving, o.shape[0], true, "moving"),
+                view_of<const double, 2>(start, "start", {bindings::ANY_LENGTH, maps.mapped + 2}),
+                view_of<const double, 2>(end, "end", {bindings::ANY_LENGTH, maps.mapped + 2})};
+            if (r.start.shape[0] != r.moving.shape[0] || r.end.shape[0] != r.moving.shape[0]) {
+                value_error("start and end must have a row per moving candidate");
+            }
+            if (trials.maps < r.moving.shape[0]) value_error("trials must hold a map per move");
+            for (const auto& bearings : {r.start, r.end}) {
+                if (std::any_of(bearings.data, bearings.data + bearings.size(),
+                                [](double b) { return std::isinf(b); })) {
+                    value_error("start and end must be finite bearings or NaN (a missed reading)");
+                }
+            }
+            nb::gil_scoped_release release;
+            env::score_readings(maps.views, row, params, r, {area_cap, floor, 0.0, log_area},
+                                trials.views, o);
+        },
+        "maps"_a, "row"_a, "params"_a, "moving"_a, "start"_a, "end"_a, "area_cap"_a, "floor"_a,
+        "log_area"_a, "trials"_a, "out"_a,
+        "The potential after each candidate into out: moving[i] fused from readings start[i], "
+        "end[i] into its own copy of map row (trials' map i); the others the map's own.");
     m.def(
         "_move_ends",
         [](std::complex<double> start, nb::handle headings, nb::handle distances, nb::handle out) {

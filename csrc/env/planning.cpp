@@ -40,23 +40,41 @@ void bearings_of(View1<const cplx> differences, View1<const double> headings, Vi
     }
 }
 
+void score_readings(const slam::MapState& maps, int64_t row, const slam::Params& params,
+                    const Readings& readings, const Scoring& scoring, const slam::MapState& trials,
+                    View1<double> out) {
+    const int64_t m = maps.counts.shape[1], size = readings.moving.shape[0];
+    const double current =
+        potential_of(maps.areas.row(row), m, scoring.log_area, scoring.floor, scoring.area_cap);
+    for (int64_t k = 0; k < out.shape[0]; ++k) out[k] = current;
+    if (size == 0) return;
+    std::vector<int64_t> rows(static_cast<size_t>(size), row), trial_rows(rows.size());
+    for (int64_t i = 0; i < size; ++i) trial_rows[static_cast<size_t>(i)] = i;
+    slam::copy_maps(maps, {rows.data(), {size}}, trials);
+    std::vector<int8_t> frame_status(rows.size()), landmark_status(rows.size() * m);
+    std::vector<int64_t> n_bad(rows.size());
+    const slam::Outputs outputs{
+        {frame_status.data(), {size}}, {landmark_status.data(), {size, m}}, {n_bad.data(), {size}}};
+    slam::update_maps(readings.start, readings.end, {trial_rows.data(), {size}}, params, trials,
+                      outputs, 1);
+    for (int64_t i = 0; i < size; ++i) {
+        out[readings.moving[i]] =
+            potential_of(trials.areas.row(i), m, scoring.log_area, scoring.floor, scoring.area_cap);
+    }
+}
+
 void simulate_potentials(const slam::MapState& maps, int64_t row, const slam::Params& params,
                          const Candidates& candidates, const Scoring& scoring,
                          const slam::MapState& trials, View1<double> out) {
-    const int64_t m = maps.counts.shape[1], n = m + 2, count = candidates.headings.shape[0];
-    const double current =
-        potential_of(maps.areas.row(row), m, scoring.log_area, scoring.floor, scoring.area_cap);
+    const int64_t n = maps.counts.shape[1] + 2, count = candidates.headings.shape[0];
     std::vector<int64_t> moving;
     for (int64_t k = 0; k < count; ++k) {
-        out[k] = current;
         if (candidates.distances[k] >= scoring.min_distance) moving.push_back(k);
     }
     const auto size = static_cast<int64_t>(moving.size());
-    if (size == 0) return;
     // The readings at both ends of each moving candidate (an unknown landmark is read at
     // the start's bearing twice: no region).
     std::vector<double> start(static_cast<size_t>(size * n)), end(start.size());
-    std::vector<int64_t> rows(static_cast<size_t>(size), row), trial_rows(moving.size());
     for (int64_t i = 0; i < size; ++i) {
         const int64_t k = moving[static_cast<size_t>(i)];
         const double heading = candidates.headings[k];
@@ -71,19 +89,10 @@ void simulate_potentials(const slam::MapState& maps, int64_t row, const slam::Pa
             end[static_cast<size_t>(i * n + j)] =
                 known ? bearing_from(to, heading, target) : before;
         }
-        trial_rows[static_cast<size_t>(i)] = i;
     }
-    slam::copy_maps(maps, {rows.data(), {size}}, trials);
-    std::vector<int8_t> frame_status(moving.size()), landmark_status(moving.size() * m);
-    std::vector<int64_t> n_bad(moving.size());
-    const slam::Outputs outputs{
-        {frame_status.data(), {size}}, {landmark_status.data(), {size, m}}, {n_bad.data(), {size}}};
-    slam::update_maps({start.data(), {size, n}}, {end.data(), {size, n}},
-                      {trial_rows.data(), {size}}, params, trials, outputs, 1);
-    for (int64_t i = 0; i < size; ++i) {
-        out[moving[static_cast<size_t>(i)]] =
-            potential_of(trials.areas.row(i), m, scoring.log_area, scoring.floor, scoring.area_cap);
-    }
+    const Readings readings{
+        {moving.data(), {size}}, {start.data(), {size, n}}, {end.data(), {size, n}}};
+    score_readings(maps, row, params, readings, scoring, trials, out);
 }
 
 }  // namespace bearing::env

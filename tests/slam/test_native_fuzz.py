@@ -104,7 +104,7 @@ FUZZED: frozenset[str] = frozenset(
         "report_rows_into", "potentials", "move_and_read", "append_positions", "capped",
         "potential_of", "_write_shape", "decode_continuous", "_known", "encode_map",
         "encode_map_into", "encode_window", "encode_levels", "_potentials_of_rows",
-        "_move_ends", "_bearings_of", "_simulate_potentials",
+        "_move_ends", "_bearings_of", "_simulate_potentials", "_score_readings",
     }
 )  # fmt: skip
 
@@ -1506,6 +1506,13 @@ def test_simulate_potentials_of_any_state(fusion: str, data: st.DataObject) -> N
     distances = np.array(data.draw(st.lists(hard_floats, min_size=count, max_size=count)))
     out = np.zeros(out_length(data.draw, count))
     row = data.draw(st.one_of(st.integers(0, MAPS - 1), hard_ints))
+    moving = data.draw(map_rows(max(count, 1)))[:count]
+    readings = data.draw(bearings(moving.size, LANDMARKS))
+    if completes(
+        _core._score_readings, maps, row, params_of(fusion), moving, readings, readings.copy(),
+        4.0, 1e-3, data.draw(st.booleans()), trials, np.zeros(out_length(data.draw, count)),
+    ):  # fmt: skip
+        assert np.unique(moving).size == moving.size
     if completes(
         _core._simulate_potentials, maps, row, params_of(fusion), data.draw(hard_complexes),
         landmarks, headings.astype(np.float64), distances.astype(np.float64), 4.0, 1e-3, 1e-9,

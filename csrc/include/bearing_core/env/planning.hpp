@@ -39,6 +39,21 @@ struct Scoring {
     bool log_area = true;
 };
 
+// The readings of the moving candidates: candidate moving[i] reads start[i] and end[i]
+// (n each; NaN for a missed landmark).
+struct Readings {
+    View1<const int64_t> moving;  // (K',) candidate indices
+    View2<const double> start;    // (K', n)
+    View2<const double> end;      // (K', n)
+};
+
+// The potential after each candidate into out (K,): the map's own potential for a
+// candidate that does not move; moving candidate moving[i] fused into its own copy of map
+// `row` of `maps` (trials' map i) from its readings. The caller checks the sizes.
+void score_readings(const slam::MapState& maps, int64_t row, const slam::Params& params,
+                    const Readings& readings, const Scoring& scoring, const slam::MapState& trials,
+                    View1<double> out);
+
 // agents/planning.py's simulate_potentials without a visibility prediction, in one call,
 // the same bits: the potential after each candidate move into out (K,), each moving
 // candidate fused into its own copy of map `row` of `maps` (noise-free readings of the
