@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from bearing_env import _core
 from bearing_env.envs.config import AREA_FLOOR
 from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
+from bearing_env.slam.kernels import PARALLEL_MIN_MAPS, threads
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -176,6 +177,39 @@ def _simulate_natively(
     return potentials
 
 
+def _scratch_of(
+    maps: BatchedPolygonSLAM, size: int, batches: dict[tuple[str, int], BatchedPolygonSLAM]
+) -> BatchedPolygonSLAM:
+    """The beam's batch of ``size`` expansions (of ``maps``' settings), kept in ``batches``."""
+    trials = batches.get(("trials", size))
+    if trials is None or not trials.same_settings(maps):
+        trials = batches["trials", size] = maps.empty_like(size)
+    return trials
+
+
+def _score_rows(
+    maps: BatchedPolygonSLAM,
+    rows: NDArray[np.int64],
+    b1: FloatArray,
+    b2: FloatArray,
+    area_cap: float,
+    trials: BatchedPolygonSLAM,
+) -> FloatArray:
+    """The potential after each expansion: ``trials``' map i a copy of ``maps``' map
+    rows[i] fused from the readings b1[i], b2[i] (copies, updates and potentials in one
+    native call, split over threads for a large batch)."""
+    n = maps.n_landmarks
+    potentials = np.empty(rows.size, dtype=np.float64)
+    _core._score_rows(
+        maps._kernel_state(), rows.astype(np.int64), maps._kernel_params(False),
+        np.ascontiguousarray(b1.reshape(-1, n), dtype=np.float64),
+        np.ascontiguousarray(b2.reshape(-1, n), dtype=np.float64), float(area_cap),
+        AREA_FLOOR, True, trials._kernel_state(), potentials,
+        threads() if rows.size >= PARALLEL_MIN_MAPS else 1,
+    )  # fmt: skip
+    return potentials
+
+
 def landmark_positions_fl(slam: PolygonSLAM) -> NDArray[np.complex128]:
     """The map's landmark positions in FL (n,): L1 = 0, L2 = 1, then the estimates (NaN
     where not initialised)."""
@@ -235,8 +269,8 @@ def beam_search(
 
     Candidates are ``(turns[k], lengths[k])`` (turn relative to the heading, length in
     metres); only the ``first_allowed`` ones may start a plan. Each depth's expansions
-    are one batched update (:meth:`BatchedPolygonSLAM.update_trusted`: the bearings are
-    made here) on copies of the beam's maps; ``scratch``: the caller's batches of copies
+    are one native call (:func:`_score_rows`: the bearings are made here) on copies of the
+    beam's maps; ``scratch``: the caller's batches of copies
     by role and size, kept between calls and refilled in place
     (:meth:`BatchedPolygonSLAM.take`) instead of made anew at each depth. ``sensor``
     predicts the readings' misses (its landmarks are the worlds'; None: every landmark
@@ -271,15 +305,9 @@ def beam_search(
             b1, b2 = sensor(b1, starts, heading_grid), sensor(b2, ends, heading_grid)
         rows = np.arange(n_nodes)[:, None, None] * n_worlds + np.arange(n_worlds)[None, None, :]
         rows = np.broadcast_to(rows, step.shape).reshape(-1)
-        trials = maps.take(rows.astype(np.int64), into=batches.get(("trials", rows.size)))
-        batches["trials", rows.size] = trials
-        n = slam.n_landmarks
-        trials.update_trusted(
-            np.ascontiguousarray(b1.reshape(-1, n), dtype=np.float64),
-            np.ascontiguousarray(b2.reshape(-1, n), dtype=np.float64),
-            robot=False,
-        )
-        potentials = uncertainty_potential(trials.areas, area_cap).reshape(n_nodes, n_k, n_worlds)
+        trials = _scratch_of(maps, rows.size, batches)
+        potentials = _score_rows(maps, rows, b1, b2, area_cap, trials)
+        potentials = potentials.reshape(n_nodes, n_k, n_worlds)
         scores = potentials.mean(axis=2)  # (nodes, K)
         node_firsts = np.where(firsts[:, None] < 0, ks[None, :], firsts[:, None])
         order = np.argsort(scores, axis=None, kind="stable")

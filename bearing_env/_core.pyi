@@ -696,6 +696,23 @@ def _score_readings(
     The potential after each candidate into out: moving[i] fused from readings start[i], end[i] into its own copy of map row (trials' map i); the others the map's own.
     """
 
+def _score_rows(
+    maps: MapState,
+    rows: object,
+    params: Params,
+    start: object,
+    end: object,
+    area_cap: float,
+    floor: float,
+    log_area: bool,
+    trials: MapState,
+    out: object,
+    threads: int = 1,
+) -> None:
+    """
+    trials' map i: a copy of map rows[i] fused from readings start[i], end[i]; out[i] its potential (Lookahead's beam expansions).
+    """
+
 def _move_ends(start: complex, headings: object, distances: object, out: object) -> None:
     """
     out[k]: where candidate k ends, start + distances[k] * (cos + i sin)(headings[k]).

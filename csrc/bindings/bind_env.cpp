@@ -566,6 +566,34 @@ void bind_env(nb::module_& m) {
         "The potential after each candidate into out: moving[i] fused from readings start[i], "
         "end[i] into its own copy of map row (trials' map i); the others the map's own.");
     m.def(
+        "_score_rows",
+        [](const bindings::PyMapState& maps, nb::handle rows, const slam::Params& params,
+           nb::handle start, nb::handle end, double area_cap, double floor, bool log_area,
+           const bindings::PyMapState& trials, nb::handle out, int64_t threads) {
+            bindings::require_copyable(maps, trials, "_score_rows");
+            bindings::check_state_for(trials.views, params);
+            auto r = bindings::rows_of(rows, maps.maps, false);
+            const int64_t size = r.shape[0], n = maps.mapped + 2;
+            auto s = view_of<const double, 2>(start, "start", {size, n});
+            auto e = view_of<const double, 2>(end, "end", {size, n});
+            auto o = view_of<double, 1>(out, "out", {size});
+            if (trials.maps < size) value_error("trials must hold a map per row");
+            if (threads < 1) value_error("threads must be at least 1");
+            for (const auto& bearings : {s, e}) {
+                if (std::any_of(bearings.data, bearings.data + bearings.size(),
+                                [](double b) { return std::isinf(b); })) {
+                    value_error("start and end must be finite bearings or NaN (a missed reading)");
+                }
+            }
+            nb::gil_scoped_release release;
+            env::score_rows(maps.views, r, params, s, e, {area_cap, floor, 0.0, log_area},
+                            trials.views, o, threads);
+        },
+        "maps"_a, "rows"_a, "params"_a, "start"_a, "end"_a, "area_cap"_a, "floor"_a, "log_area"_a,
+        "trials"_a, "out"_a, "threads"_a = 1,
+        "trials' map i: a copy of map rows[i] fused from readings start[i], end[i]; out[i] "
+        "its potential (Lookahead's beam expansions).");
+    m.def(
         "_move_ends",
         [](std::complex<double> start, nb::handle headings, nb::handle distances, nb::handle out) {
             auto h = view_of<const double, 1>(headings, "headings");

@@ -40,6 +40,25 @@ void bearings_of(View1<const cplx> differences, View1<const double> headings, Vi
     }
 }
 
+void score_rows(const slam::MapState& maps, View1<const int64_t> rows, const slam::Params& params,
+                View2<const double> start, View2<const double> end, const Scoring& scoring,
+                const slam::MapState& trials, View1<double> out, int64_t threads) {
+    const int64_t m = maps.counts.shape[1], size = rows.shape[0];
+    if (size == 0) return;
+    std::vector<int64_t> trial_rows(static_cast<size_t>(size));
+    for (int64_t i = 0; i < size; ++i) trial_rows[static_cast<size_t>(i)] = i;
+    slam::copy_maps(maps, rows, trials);
+    std::vector<int8_t> frame_status(trial_rows.size()), landmark_status(trial_rows.size() * m);
+    std::vector<int64_t> n_bad(trial_rows.size());
+    const slam::Outputs outputs{
+        {frame_status.data(), {size}}, {landmark_status.data(), {size, m}}, {n_bad.data(), {size}}};
+    slam::update_maps(start, end, {trial_rows.data(), {size}}, params, trials, outputs, threads);
+    for (int64_t i = 0; i < size; ++i) {
+        out[i] =
+            potential_of(trials.areas.row(i), m, scoring.log_area, scoring.floor, scoring.area_cap);
+    }
+}
+
 void score_readings(const slam::MapState& maps, int64_t row, const slam::Params& params,
                     const Readings& readings, const Scoring& scoring, const slam::MapState& trials,
                     View1<double> out) {
@@ -47,20 +66,11 @@ void score_readings(const slam::MapState& maps, int64_t row, const slam::Params&
     const double current =
         potential_of(maps.areas.row(row), m, scoring.log_area, scoring.floor, scoring.area_cap);
     for (int64_t k = 0; k < out.shape[0]; ++k) out[k] = current;
-    if (size == 0) return;
-    std::vector<int64_t> rows(static_cast<size_t>(size), row), trial_rows(rows.size());
-    for (int64_t i = 0; i < size; ++i) trial_rows[static_cast<size_t>(i)] = i;
-    slam::copy_maps(maps, {rows.data(), {size}}, trials);
-    std::vector<int8_t> frame_status(rows.size()), landmark_status(rows.size() * m);
-    std::vector<int64_t> n_bad(rows.size());
-    const slam::Outputs outputs{
-        {frame_status.data(), {size}}, {landmark_status.data(), {size, m}}, {n_bad.data(), {size}}};
-    slam::update_maps(readings.start, readings.end, {trial_rows.data(), {size}}, params, trials,
-                      outputs, 1);
-    for (int64_t i = 0; i < size; ++i) {
-        out[readings.moving[i]] =
-            potential_of(trials.areas.row(i), m, scoring.log_area, scoring.floor, scoring.area_cap);
-    }
+    std::vector<int64_t> rows(static_cast<size_t>(size), row);
+    std::vector<double> scores(rows.size());
+    score_rows(maps, {rows.data(), {size}}, params, readings.start, readings.end, scoring, trials,
+               {scores.data(), {size}}, 1);
+    for (int64_t i = 0; i < size; ++i) out[readings.moving[i]] = scores[static_cast<size_t>(i)];
 }
 
 void simulate_potentials(const slam::MapState& maps, int64_t row, const slam::Params& params,

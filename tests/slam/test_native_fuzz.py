@@ -105,6 +105,7 @@ FUZZED: frozenset[str] = frozenset(
         "potential_of", "_write_shape", "decode_continuous", "_known", "encode_map",
         "encode_map_into", "encode_window", "encode_levels", "_potentials_of_rows",
         "_move_ends", "_bearings_of", "_simulate_potentials", "_score_readings",
+        "_score_rows",
     }
 )  # fmt: skip
 
@@ -1513,6 +1514,14 @@ def test_simulate_potentials_of_any_state(fusion: str, data: st.DataObject) -> N
         4.0, 1e-3, data.draw(st.booleans()), trials, np.zeros(out_length(data.draw, count)),
     ):  # fmt: skip
         assert np.unique(moving).size == moving.size
+    rows = data.draw(map_rows(MAPS))
+    start = data.draw(bearings(rows.size, LANDMARKS))
+    scores = np.zeros(out_length(data.draw, rows.size))
+    if completes(
+        _core._score_rows, maps, rows, params_of(fusion), start, start.copy(), 4.0, 1e-3,
+        data.draw(st.booleans()), trials, scores, data.draw(st.sampled_from((1, 2, 0))),
+    ):  # fmt: skip
+        assert scores.size >= rows.size
     if completes(
         _core._simulate_potentials, maps, row, params_of(fusion), data.draw(hard_complexes),
         landmarks, headings.astype(np.float64), distances.astype(np.float64), 4.0, 1e-3, 1e-9,

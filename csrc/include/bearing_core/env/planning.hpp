@@ -47,6 +47,13 @@ struct Readings {
     View2<const double> end;      // (K', n)
 };
 
+// trials' map i becomes a copy of map rows[i] of `maps`, fused from the readings start[i]
+// and end[i] (n each; NaN for a missed landmark); out[i] its potential (Lookahead's beam
+// expansions). threads > 1 splits the update over that many threads (same results).
+void score_rows(const slam::MapState& maps, View1<const int64_t> rows, const slam::Params& params,
+                View2<const double> start, View2<const double> end, const Scoring& scoring,
+                const slam::MapState& trials, View1<double> out, int64_t threads);
+
 // The potential after each candidate into out (K,): the map's own potential for a
 // candidate that does not move; moving candidate moving[i] fused into its own copy of map
 // `row` of `maps` (trials' map i) from its readings. The caller checks the sizes.
