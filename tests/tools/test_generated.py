@@ -38,30 +38,40 @@ MAX_GAP = 3
 MIN_FIELDS = 6
 
 
-def declarations(text: str, name: str) -> list[int]:
-    """Where ``name`` is declared (not used): a Python field (``name:`` at a line's start),
-    a string literal, a C++ member (``Type name;`` or ``Type name = value;``) or an X-macro
-    row (``X(type, 3, name, ...)``); the offsets of the name."""
-    word = re.escape(name)
-    patterns = (
-        rf"(?m)^[ \t]*({word})[ \t]*:(?!:)",
-        rf"[\"']({word})[\"']",
-        rf"\b[A-Za-z_][\w:<>,]*[ \t]+({word})[ \t]*(?:;|=(?!=))",
-        rf"\b[A-Z_]+\(\s*[\w:<>]+\s*,\s*(?:\d+\s*,\s*)?({word})\s*,",
+#: What declares a name (group 1), not a use of it: a Python field (``name:`` at a line's
+#: start), a string literal, a C++ member (``Type name;`` or ``Type name = value;``) or an
+#: X-macro row (``X(type, 3, name, ...)``).
+DECLARATIONS = tuple(
+    re.compile(pattern)
+    for pattern in (
+        r"(?m)^[ \t]*([A-Za-z_]\w*)[ \t]*:(?!:)",
+        r"[\"']([A-Za-z_]\w*)[\"']",
+        r"\b[A-Za-z_][\w:<>,]*[ \t]+([A-Za-z_]\w*)[ \t]*(?:;|=(?!=))",
+        r"\b[A-Z_]+\(\s*[\w:<>]+\s*,\s*(?:\d+\s*,\s*)?([A-Za-z_]\w*)\s*,",
     )
-    return sorted({m.start(1) for pattern in patterns for m in re.finditer(pattern, text)})
+)
 
 
-def listings(text: str, fields: list[str]) -> list[int]:
+def declarations(text: str) -> list[tuple[int, str]]:
+    """Every declared name of ``text`` and its offset, in the text's order."""
+    return sorted(
+        {(m.start(1), m.group(1)) for pattern in DECLARATIONS for m in pattern.finditer(text)}
+    )
+
+
+def listings(
+    text: str, fields: list[str], declared: list[tuple[int, str]] | None = None
+) -> list[int]:
     """The lines where a listing of ``fields`` starts: their declarations in their order,
-    naming at least SHARE of them (at least 3), each within MAX_GAP lines of the one before."""
+    naming at least SHARE of them (at least 3), each within MAX_GAP lines of the one before
+    (``declared``: the text's :func:`declarations`, when the caller has them)."""
     needed = max(3, math.ceil(SHARE * len(fields)))
+    index_of = {name: k for k, name in enumerate(fields)}
     # (line, k) of every declaration of field k, in the text's order.
     named = [
-        (text.count("\n", 0, at), k)
-        for at, k in sorted(
-            (at, k) for k, name in enumerate(fields) for at in declarations(text, name)
-        )
+        (text.count("\n", 0, at), index_of[name])
+        for at, name in (declarations(text) if declared is None else declared)
+        if name in index_of
     ]
     found: list[int] = []
     start = 0
@@ -107,6 +117,7 @@ def test_every_struct_has_a_home() -> None:
 def test_no_struct_field_list_is_written_twice() -> None:
     where: dict[str, list[str]] = {}
     texts = {path: path.read_text(encoding="utf-8") for path in source_files()}
+    declared = {path: declarations(text) for path, text in texts.items()}
     for name, schema in _core.SCHEMAS.items():
         fields = [field[0] for field in schema]
         if len(fields) < MIN_FIELDS:
@@ -115,7 +126,7 @@ def test_no_struct_field_list_is_written_twice() -> None:
             relative = str(path.relative_to(ROOT))
             if (name, relative) in ALLOWED:
                 continue
-            for line in listings(text, fields):
+            for line in listings(text, fields, declared[path]):
                 where.setdefault(name, []).append(f"{relative}:{line}")
     homes = {name: [at.split(":")[0] for at in found] for name, found in where.items()}
     assert {name: sorted(set(files)) for name, files in homes.items()} == {
