@@ -19,32 +19,21 @@ namespace bearing::bindings {
 
 namespace nb = nanobind;
 
+// numpy's name of each element type the kernels take.
 template <class T>
 struct dtype_name;
-template <>
-struct dtype_name<double> {
-    static constexpr const char* value = "float64";
-};
-template <>
-struct dtype_name<float> {
-    static constexpr const char* value = "float32";
-};
-template <>
-struct dtype_name<int64_t> {
-    static constexpr const char* value = "int64";
-};
-template <>
-struct dtype_name<int8_t> {
-    static constexpr const char* value = "int8";
-};
-template <>
-struct dtype_name<bool> {
-    static constexpr const char* value = "bool";
-};
-template <>
-struct dtype_name<cplx> {
-    static constexpr const char* value = "complex128";
-};
+#define BEARING_BINDINGS_DTYPE(T, name)            \
+    template <>                                    \
+    struct dtype_name<T> {                         \
+        static constexpr const char* value = name; \
+    };
+BEARING_BINDINGS_DTYPE(double, "float64")
+BEARING_BINDINGS_DTYPE(float, "float32")
+BEARING_BINDINGS_DTYPE(int64_t, "int64")
+BEARING_BINDINGS_DTYPE(int8_t, "int8")
+BEARING_BINDINGS_DTYPE(bool, "bool")
+BEARING_BINDINGS_DTYPE(cplx, "complex128")
+#undef BEARING_BINDINGS_DTYPE
 
 template <class T>
 nb::dlpack::dtype dtype_of() {
