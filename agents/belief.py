@@ -42,22 +42,22 @@ import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
+from bearing_env.belief import median
+from bearing_env.belief import scale_sample as scale_sample
+from bearing_env.belief import triangulate_fr as triangulate_fr
 from bearing_env.envs.observations import (
     BEARING_FEATURES,
     ENTITY_FEATURES,
     ROBOT_FEATURES,
+    SPECS,
     EntityObservation,
     observation_slices,
-    spec_for,
 )
 from bearing_env.numerics import wrap
 from bearing_env.slam import PolygonSLAM
 
 from .base import Movement
 from .env_access import bearing_env_of
-
-#: Minimum bearing change (in units of epsilon) for a triangulation to give a scale sample.
-MIN_PARALLAX_EPSILONS = 4.0
 
 _PROGRESS = ROBOT_FEATURES.index("progress")
 _FRAME_CHANGED = ROBOT_FEATURES.index("last_frame_changed")
@@ -112,7 +112,7 @@ class ObservationReader:
         ]
         #: The landmark table's columns, for the kinds with a table (every kind's table
         #: starts with ENTITY_FEATURES).
-        spec = spec_for(base.config)
+        spec = SPECS[base.config.observations.observation]  # the kind's, features or not
         self.table_width = len(spec.features) if isinstance(spec, EntityObservation) else 0
 
     def read(self, observation: NDArray[np.float32] | Mapping[str, Any]) -> ObservationView:
@@ -149,42 +149,6 @@ class PoseBelief:
     heading: float
     #: Metres per FL unit; None until a movement gave a usable triangulation.
     metres_per_unit: float | None
-
-
-def triangulate_fr(bearing_start: float, bearing_end: float) -> complex | None:
-    """Position in FR (R1 = 0, R2 = 1) of a point seen at these bearings from R1 and R2.
-
-    None if the rays do not meet in front of both observation points.
-    """
-    denominator = math.sin(bearing_end - bearing_start)
-    if abs(denominator) < 1e-12:
-        return None
-    range_from_start = math.sin(bearing_end) / denominator
-    range_from_end = math.sin(bearing_start) / denominator
-    if range_from_start <= 0.0 or range_from_end <= 0.0:
-        return None
-    return range_from_start * complex(math.cos(bearing_start), math.sin(bearing_start))
-
-
-def scale_sample(
-    bearings_start: NDArray[np.float64],
-    bearings_end: NDArray[np.float64],
-    length: float,
-    epsilon: float,
-) -> float | None:
-    """Metres per FL unit from one movement of ``length`` metres (None if ill-conditioned)."""
-    points = []
-    for index in (0, 1):
-        if not (math.isfinite(bearings_start[index]) and math.isfinite(bearings_end[index])):
-            return None  # a missed reading of L1 or L2
-        parallax = abs(wrap(float(bearings_end[index] - bearings_start[index])))
-        if parallax < MIN_PARALLAX_EPSILONS * epsilon:
-            return None
-        point = triangulate_fr(float(bearings_start[index]), float(bearings_end[index]))
-        if point is None:
-            return None
-        points.append(point)
-    return length * abs(points[1] - points[0])
 
 
 class RobotBelief:
@@ -247,13 +211,7 @@ class RobotBelief:
         samples = self._scale_samples or self._blocked_samples
         if not samples:
             return None
-        # np.median's value (the middle sample, or the mean of the middle two), without
-        # its array overhead on a list of a few floats: it is read at every decision.
-        ordered = sorted(samples)
-        middle = len(ordered) // 2
-        if len(ordered) % 2:
-            return float(ordered[middle])
-        return float((ordered[middle - 1] + ordered[middle]) / 2)
+        return median(samples)
 
     def pose(self, slam: PolygonSLAM) -> PoseBelief | None:
         """The believed pose, or None before the first movement that changed frames."""

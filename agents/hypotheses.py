@@ -34,12 +34,12 @@ from functools import partial
 import numpy as np
 from numpy.typing import NDArray
 
+from bearing_env.belief import MIN_PARALLAX_EPSILONS
 from bearing_env.numerics import wrap_angle
 from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
 from bearing_env.validation import int_at_least
 
 from .base import ActionCodec, Movement
-from .belief import MIN_PARALLAX_EPSILONS
 from .planning import (
     ComplexArray,
     FloatArray,

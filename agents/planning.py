@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env import _core
+from bearing_env.belief import bearings_from as bearings_from
 from bearing_env.envs.config import AREA_FLOOR
 from bearing_env.slam import BatchedPolygonSLAM, PolygonSLAM
 from bearing_env.slam.kernels import PARALLEL_MIN_MAPS, threads
@@ -43,28 +44,6 @@ def uncertainty_potential(
 #: one native call (csrc/env/planning.cpp, the same bits as the numba loops they were).
 _potentials_of_rows = _core._potentials_of_rows
 _move_ends = _core._move_ends
-
-
-def bearings_from(
-    position: complex | NDArray[np.complex128],
-    heading: float | NDArray[np.float64],
-    points: NDArray[np.complex128],
-) -> NDArray[np.float64]:
-    """Noise-free bearings (..., n) of ``points`` (n,) in FL from ``position`` facing
-    ``heading`` (scalars, or arrays of one shape for many poses): the native kernel's
-    atan2, so that a planner scores the same bits on every machine and in the native
-    scoring (numpy's own atan2 differs from libm's in the last bit on some CPUs)."""
-    differences = np.asarray(points, dtype=np.complex128) - np.asarray(position)[..., None]
-    headings = np.asarray(heading, dtype=np.float64)[..., None]
-    shape = np.broadcast_shapes(differences.shape, headings.shape)
-    differences, headings = np.broadcast_to(differences, shape), np.broadcast_to(headings, shape)
-    out = np.empty(shape, dtype=np.float64)
-    _core._bearings_of(
-        np.ascontiguousarray(differences).reshape(-1),
-        np.ascontiguousarray(headings).reshape(-1),
-        out.reshape(-1),
-    )
-    return out
 
 
 #: A visibility prediction: simulated bearings (S + (n,)) from positions and headings

@@ -345,8 +345,10 @@ class SB3Policy:
         (:class:`ModelLoadError`)."""
         if self.task is not None:
             self.task.check(env)
-        if self.task is not None and self.task.slot_free and _longer_table(
-            self.model.observation_space, env.observation_space
+        if (
+            self.task is not None
+            and self.task.slot_free
+            and _longer_table(self.model.observation_space, env.observation_space)
         ):
             # A set policy's features do not depend on the table's length: it reads
             # the env's longer table as it is (the task check allowed the extra slots).

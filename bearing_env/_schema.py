@@ -216,6 +216,8 @@ class Settings(NamedTuple):
     """the observation's landmark slots (max_landmarks)"""
     shape_features: bool
     """the flat vector ends with the regions' shapes"""
+    appended: int
+    """columns after the blocks, left 0 (the planner features)"""
     width: float
     """the arena's width, metres"""
     height: float

@@ -42,8 +42,10 @@ NAMING_RULE = """\
   detected in a reading);
 - `observation` names an observation other than the flat vector: `Entities` (the landmark
   table, `observation="entities"`) or `Shapes` (the table with each region's shape,
-  `observation="shapes"`); such an id is what an rl-zoo3 hyperparameter file is keyed by,
-  so that its training and evaluation envs have the same observation space;
+  `observation="shapes"`), or `Planner` (the flat vector followed by the planner
+  features of 16 candidate moves, `planner_features=True`, on the discrete id with
+  `n_turns=8, n_move_lengths=2`); such an id is what an rl-zoo3 hyperparameter file is
+  keyed by, so that its training and evaluation envs have the same observation space;
 - `version` starts at 0 and goes up whenever a change alters what an agent faces (the
   task's settings, an env default it relies on, the dynamics or the reward), so scores
   reported under one id stay comparable; every id stays registered in every version, an
@@ -92,9 +94,7 @@ def split_id(task_id: str) -> tuple[str, int]:
 BASE_IDS: dict[str, str] = {kind: versioned_id(name) for kind, name in BASE_NAMES.items()}
 #: Every registered base id, all versions, and its action kind.
 BASE_ID_KINDS: dict[str, str] = {
-    versioned_id(name, version): kind
-    for version in VERSIONS
-    for kind, name in BASE_NAMES.items()
+    versioned_id(name, version): kind for version in VERSIONS for kind, name in BASE_NAMES.items()
 }
 
 #: The sensor of the ``Outliers`` tasks: 5% of bearings replaced by a random angle (the
@@ -257,8 +257,7 @@ def _random(n_landmarks: int) -> Task:
 
 #: The environment page's section on what a limited sensor can map at all (from a card).
 _OBSERVABILITY = (
-    "[what a forward camera can map at all]"
-    "(../environment.md#what-a-forward-camera-can-map-at-all)"
+    "[what a forward camera can map at all](../environment.md#what-a-forward-camera-can-map-at-all)"
 )
 
 #: What makes each camera task hard (the cards' "Description").
@@ -298,6 +297,66 @@ def _camera(degrees: int) -> Task:
     )
 
 
+def _random_table(observation: str) -> Task:
+    return Task(
+        id=versioned_id(f"BearingSLAM-Random3to16-{observation.capitalize()}"),
+        base_id=BASE_IDS["continuous"],
+        settings={
+            "scenario": "random",
+            "n_landmarks": [3, 16],
+            "max_landmarks": 16,
+            "observation": observation,
+        },
+        description=f"a new random layout of 3 to 16 landmarks every episode, the "
+        f'`"{observation}"` observation (a landmark table, for set and attention policies)',
+        purpose="The training task of the shipped generalist models: a policy for any "
+        "landmark count from 3 to 16, on a landmark table that set and attention "
+        "policies read.",
+        challenge="The landmark count changes every episode, so a policy must work on a "
+        "table of variable length.",
+    )
+
+
+#: The planner-features tasks' grid: GreedyOneStep's 8 turns x the shortest and longest
+#: lengths, K = 16 candidates.
+PLANNER_GRID: dict[str, Any] = {"n_turns": 8, "n_move_lengths": 2, "planner_features": True}
+_PLANNER_PURPOSE = (
+    " Here the actions are a grid of 16 candidate moves (8 turns, the shortest and the "
+    "longest length) and the observation ends with what a one-step planner predicts of "
+    "each, from the robot's own map and believed pose: the predicted decrease of the "
+    "potential, whether L1 and L2 stay in view, whether the move is predicted blocked "
+    "([the planner features](../environment.md#planner-features)). A policy chooses "
+    "among the candidates with what GreedyOneStep knows, and more: the map, and what it "
+    "learned over episodes."
+)
+
+
+def _planner(setting: str, settings: Mapping[str, Any], like: Task, description: str) -> Task:
+    return Task(
+        id=versioned_id(f"BearingSLAMDiscrete-{setting}-Planner"),
+        base_id=BASE_IDS["discrete"],
+        settings={**settings, **PLANNER_GRID},
+        description=f"{description}; 16 candidate moves with the planner's predictions",
+        purpose=like.purpose + _PLANNER_PURPOSE,
+        challenge=like.challenge
+        + " The predictions come from the robot's map and believed pose, so they are "
+        "wrong where those are: a policy that follows them blindly does as well as "
+        "GreedyOneStep, no better.",
+    )
+
+
+#: The planner-features tasks (the learned exploration's), carded with the rest.
+PLANNER_TASKS: tuple[Task, ...] = (
+    _planner(
+        "Khepera", {"scenario": "khepera"}, _khepera("continuous"), "the paper's Khepera arena"
+    ),
+    _planner(
+        "Random3to16",
+        {"scenario": "random", "n_landmarks": [3, 16], "max_landmarks": 16},
+        _random_table("entities"),
+        "a new random layout of 3 to 16 landmarks every episode, Khepera field",
+    ),
+)
 #: Every task, in the order of the tables.
 TASKS: tuple[Task, ...] = (
     _khepera("continuous"),
@@ -353,30 +412,12 @@ TASKS: tuple[Task, ...] = (
         "the map-based planners plan on a map they do not have yet, while a trained "
         "policy can learn where to go (the baselines below).",
     ),
+    *PLANNER_TASKS,
 )
+
 
 #: The tasks by id.
 TASKS_BY_ID: dict[str, Task] = {task.id: task for task in TASKS}
-
-
-def _random_table(observation: str) -> Task:
-    return Task(
-        id=versioned_id(f"BearingSLAM-Random3to16-{observation.capitalize()}"),
-        base_id=BASE_IDS["continuous"],
-        settings={
-            "scenario": "random",
-            "n_landmarks": [3, 16],
-            "max_landmarks": 16,
-            "observation": observation,
-        },
-        description=f"a new random layout of 3 to 16 landmarks every episode, the "
-        f'`"{observation}"` observation (a landmark table, for set and attention policies)',
-        purpose="The training task of the shipped generalist models: a policy for any "
-        "landmark count from 3 to 16, on a landmark table that set and attention "
-        "policies read.",
-        challenge="The landmark count changes every episode, so a policy must work on a "
-        "table of variable length.",
-    )
 
 
 #: The training tasks: registered like :data:`TASKS`, the ids the shipped rl-zoo3 files
@@ -411,9 +452,7 @@ def task_named(task_id: str) -> Task:
             if older is not None and older.version != VERSION
             else ""
         )
-        raise ValueError(
-            f"unknown task {task_id!r}{newer}; the tasks are {', '.join(TASKS_BY_ID)}"
-        )
+        raise ValueError(f"unknown task {task_id!r}{newer}; the tasks are {', '.join(TASKS_BY_ID)}")
     return TASKS_BY_ID[name]
 
 

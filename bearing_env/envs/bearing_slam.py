@@ -208,6 +208,18 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     theta in FL as (cos 2 theta, sin 2 theta) ((0, 0) when round). They are zeros for L1,
     L2, absent rows and landmarks without a region yet.
 
+    With `planner_features=True` the observation ends with what a one-step planner
+    predicts of each of the K moves of the discrete action grid (`n_turns` x
+    `n_move_lengths`; candidate k is `BearingSLAMDiscrete`'s action k), K rows of
+    `candidates.CANDIDATE_FEATURES`: `predicted` (1 once the robot has a map fix and an
+    FL scale to predict from, else this row is 0 but for `blocked`), `gain` (the
+    predicted decrease of the potential Phi below, the move simulated on a copy of the
+    robot's map from its believed pose), `sees_l1`, `sees_l2` (L1, L2 predicted in view
+    at both readings) and `blocked` (the last move was stopped and this one turns less
+    than 60 degrees). The flat Box gets `5 K` more elements; a Dict kind gets them as
+    `"candidates"`. They come from the robot's own map, readings and commands, never
+    ground truth (see `bearing_env.envs.candidates`).
+
     ## Rewards
 
     With `reward="log_area"` (default), the reward is the decrease of the potential
@@ -345,6 +357,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
     - `sensor_info`: False (default) or True: whether infos carry `seen` (which
       landmarks the last reading saw) and `blocked` (a wall or an obstacle stopped the
       move).
+    - `planner_features`: False (default) or True: whether the observation ends with the
+      planner features of the action grid's moves (see Observation Space); the
+      `-Planner` task ids set it with `n_turns=8, n_move_lengths=2`.
     - `render_mode`: `None`, `"human"` or `"rgb_array"`.
     - `config`: an `EnvConfig` (`bearing_env.envs.config`) holding all the settings
       above but `render_mode`, instead of the keywords (`EnvConfig.create(...)` takes

@@ -17,7 +17,7 @@ group           class                      fields
 ``task``        :class:`TaskSettings`      reward, target_area, max_moves, path_cost, ...
 ``actions``     :class:`ActionSettings`    move_length, n_turns, n_move_lengths
 ``observations``:class:`ObservationSettings` max_landmarks, observation, robot_map_info,
-                                           sensor_info
+                                           sensor_info, planner_features
 ==============  =========================  ===================================================
 
 **The groups' fields are the one home of the settings.** A field made by :func:`setting`
@@ -474,7 +474,9 @@ class ObservationSettings(SettingsGroup):
     map-based planners read; training runs that never read it can turn it off), and
     whether they carry what the sensor did (``info["seen"]``, which landmarks the last
     reading saw, and ``info["blocked"]``, whether a wall or an obstacle stopped the
-    move; off by default, which keeps the infos of the paper's settings as they were)."""
+    move; off by default, which keeps the infos of the paper's settings as they were),
+    and whether the observation ends with the planner features of the action grid's
+    moves (``bearing_env.envs.candidates``; off by default)."""
 
     max_landmarks: int = setting(
         DEFAULT_MAX_LANDMARKS,
@@ -485,6 +487,7 @@ class ObservationSettings(SettingsGroup):
     observation: str = setting("flat", attribute="observation_kind", read_only=FIXES_THE_SPACES)
     robot_map_info: bool = setting(True)
     sensor_info: bool = setting(False)
+    planner_features: bool = setting(False, read_only=FIXES_THE_SPACES)
 
     @classmethod
     def from_keywords(
@@ -499,6 +502,7 @@ class ObservationSettings(SettingsGroup):
             keywords["observation"],
             keywords["robot_map_info"],
             keywords["sensor_info"],
+            keywords["planner_features"],
         )
 
     def __post_init__(self) -> None:
@@ -509,6 +513,7 @@ class ObservationSettings(SettingsGroup):
         choice(self.observation, OBSERVATIONS, "observation")
         _normalise(self, "robot_map_info", flag(self.robot_map_info, "robot_map_info"))
         _normalise(self, "sensor_info", flag(self.sensor_info, "sensor_info"))
+        _normalise(self, "planner_features", flag(self.planner_features, "planner_features"))
 
 
 # ----------------------------------------------------------------------------------------

@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env import _core
-from bearing_env.envs import kernels, robot_map
+from bearing_env.envs import candidates, kernels, robot_map
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig
 from bearing_env.envs.kernels import Settings
 from bearing_env.envs.observations import FL_COORD_LIMIT
@@ -160,6 +160,7 @@ def kernel_settings(n_landmarks: int, config: EnvConfig) -> Settings:
         n=int(n_landmarks),
         n_slots=int(config.observations.max_landmarks),
         shape_features=config.observations.observation == "shapes",
+        appended=candidates.features_size(config),
         width=float(arena.width),
         height=float(arena.height),
         margin=float(arena.wall_margin),
@@ -364,6 +365,7 @@ def reset_rows(
     state.done[rows] = False
     state.start_bearings[rows] = np.nan
     state.start_positions[rows] = np.nan
+    state.beliefs.reset(rows)
     state.trajectory_length[rows] = 0
     state.append_positions(rows)
     rng_of = dict(zip(rows.tolist(), rngs, strict=True))
@@ -437,6 +439,13 @@ def step(
             rows, turns, lengths, inputs, state.trajectory, threads, outputs, with_map
         )
         if status == kernels.STEP_DONE:
+            if config.observations.planner_features:
+                state.beliefs.moved(
+                    rows, turns, lengths, state.frame_changed[rows], state.blocked[rows],
+                    (state.start_bearings[rows, :2], state.latest_bearings[rows, :2]),
+                    config.epsilon,
+                )  # fmt: skip
+                _write_candidates(state, group, report)
             return report, _robot_map_of(group, encoded)
         if status == kernels.STEP_NEEDS_NOISE:
             spent = state.noise_used[rows] + 2 * group.n > state.noise_filled[rows]
@@ -495,7 +504,19 @@ def report(state: BatchState, group: Group) -> tuple[kernels.Report, dict[str, A
     rows = _owned(group.rows, np.int64)
     report, encoded, outputs = _outputs(group, rows.size)
     _core.report_rows_into(rows, group.inputs, outputs, encoded is not None)
+    _write_candidates(state, group, report)
     return report, _robot_map_of(group, encoded)
+
+
+def _write_candidates(state: BatchState, group: Group, report: kernels.Report) -> None:
+    """The planner features at the end of the report's observations (``planner_features``;
+    the native step leaves their columns 0): one batched scoring of the group's maps."""
+    size = candidates.features_size(group.config)
+    if size:
+        candidates.write_features(
+            state, group.rows, group.batch, group.config, state.potentials[group.rows],
+            report.observations[:, -size:], group.reused,
+        )  # fmt: skip
 
 
 def _robot_map_of(group: Group, encoded: robot_map.Buffers | None) -> dict[str, Any] | None:

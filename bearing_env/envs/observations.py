@@ -29,6 +29,7 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from bearing_env import _core
+from bearing_env.envs import candidates
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig
 
 #: The robot block, first in the flat vector.
@@ -76,7 +77,10 @@ ELONGATION_LIMIT: float = _core.ELONGATION_LIMIT
 # The native step writes blocks of the sizes it was compiled with; the names above are
 # their columns, so the two must agree (a mismatch would shift every observation).
 if (len(ROBOT_FEATURES), len(LANDMARK_FEATURES), len(BEARING_FEATURES), len(SHAPE_FEATURES)) != (
-    _core.ROBOT_BLOCK, _core.LANDMARK_BLOCK, _core.BEARING_BLOCK, _core.SHAPE_BLOCK
+    _core.ROBOT_BLOCK,
+    _core.LANDMARK_BLOCK,
+    _core.BEARING_BLOCK,
+    _core.SHAPE_BLOCK,
 ):
     raise ImportError("the observation's feature names disagree with the native core's blocks")
 #: The landmark table's columns in the ``"shapes"`` kind.
@@ -260,14 +264,53 @@ class ShapeEntityObservation(EntityObservation):
 FLAT = FlatObservation()
 ENTITIES = EntityObservation()
 SHAPES = ShapeEntityObservation()
-ObservationSpec = FlatObservation | EntityObservation
+BaseSpec = FlatObservation | EntityObservation
 #: The spec of each ``config.observations.observation`` kind.
-SPECS: dict[str, ObservationSpec] = {spec.kind: spec for spec in (FLAT, ENTITIES, SHAPES)}
+SPECS: dict[str, BaseSpec] = {spec.kind: spec for spec in (FLAT, ENTITIES, SHAPES)}
+
+
+class WithCandidates:
+    """An observation kind followed by the planner features (``planner_features=True``,
+    :mod:`bearing_env.envs.candidates`): the flat vector ends with them, K candidates of
+    ``len(CANDIDATE_FEATURES)`` each; a ``Dict`` kind carries them as ``"candidates"``."""
+
+    def __init__(self, base: BaseSpec, size: int, bounds: tuple[Any, Any]) -> None:
+        self.base = base
+        self.kind = base.kind
+        #: The features' length (K * len(CANDIDATE_FEATURES)) and their (low, high).
+        self.size = size
+        self.bounds = bounds
+
+    def flat_size(self, max_landmarks: int) -> int:
+        return self.base.flat_size(max_landmarks) + self.size
+
+    def space(self, config: EnvConfig) -> spaces.Space[Any]:
+        base = self.base.space(config)
+        low, high = (np.asarray(bound, dtype=np.float32) for bound in self.bounds)
+        if isinstance(base, spaces.Box):
+            low, high = np.concatenate([base.low, low]), np.concatenate([base.high, high])
+            return spaces.Box(low, high, dtype=np.float32)
+        assert isinstance(base, spaces.Dict)
+        return spaces.Dict({**base.spaces, "candidates": spaces.Box(low, high, dtype=np.float32)})
+
+    def convert(self, flat: NDArray[np.float32], max_landmarks: int) -> Any:
+        """The base kind's observation of the vector's first part, with the features."""
+        if self.base.kind == FLAT.kind:  # (by kind: an unpickled spec is a copy)
+            return flat
+        observation = self.base.convert(flat[..., : -self.size], max_landmarks)
+        return {**observation, "candidates": np.array(flat[..., -self.size :], dtype=np.float32)}
+
+
+#: An env's observation spec: one kind's, or one with the planner features.
+ObservationSpec = BaseSpec | WithCandidates
 
 
 def spec_for(config: EnvConfig) -> ObservationSpec:
     """The observation spec of envs with ``config``."""
-    return SPECS[config.observations.observation]
+    base = SPECS[config.observations.observation]
+    if not config.observations.planner_features:
+        return base
+    return WithCandidates(base, candidates.features_size(config), candidates.feature_bounds(config))
 
 
 def entity_observations(flat: NDArray[np.float32], max_landmarks: int) -> dict[str, Any]:

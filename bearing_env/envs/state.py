@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from bearing_env import _core
 from bearing_env._schema import BatchArrays
+from bearing_env.belief import PoseBeliefs
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -49,6 +50,8 @@ class BatchState(BatchArrays):
     #: a noise block, bearing ``j``, is value ``k * n + j``.
     noise_generators: list[Any]
     noise_marks: list[Any]
+    #: What each robot believes of its pose between map fixes (for the planner features).
+    beliefs: PoseBeliefs
 
     @classmethod
     def empty(cls, num_rows: int, slots: int) -> BatchState:
@@ -60,6 +63,7 @@ class BatchState(BatchArrays):
             trajectory=np.zeros((num_rows, INITIAL_TRAJECTORY_SLOTS, 2)),
             noise_generators=[None] * num_rows,
             noise_marks=[None] * num_rows,
+            beliefs=PoseBeliefs(num_rows),
         )
         state.frame_unit[:] = 1.0
         state.start_bearings[:] = np.nan

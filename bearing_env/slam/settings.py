@@ -107,9 +107,7 @@ class MapSettings:
         if self.robust_set not in ROBUST_SETS:
             raise ValueError(f"robust_set must be one of {ROBUST_SETS}, got {self.robust_set!r}")
         if self.noise_bound not in NOISE_BOUNDS:
-            raise ValueError(
-                f"noise_bound must be one of {NOISE_BOUNDS}, got {self.noise_bound!r}"
-            )
+            raise ValueError(f"noise_bound must be one of {NOISE_BOUNDS}, got {self.noise_bound!r}")
 
 
 class HasMapSettings:

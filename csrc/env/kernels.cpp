@@ -335,8 +335,8 @@ void observe(View1<const int64_t> rows, const Inputs& inputs, const Report& repo
 
 int64_t observation_size(const Settings& settings) {
     const int64_t slots = settings.n_slots;
-    const int64_t size =
-        ROBOT_FEATURES + LANDMARK_FEATURES * (slots - 2) + BEARING_FEATURES * slots;
+    const int64_t size = ROBOT_FEATURES + LANDMARK_FEATURES * (slots - 2) +
+                         BEARING_FEATURES * slots + settings.appended;
     return settings.shape_features ? size + SHAPE_FEATURES * (slots - 2) : size;
 }
 

@@ -39,7 +39,7 @@ def test_every_group_field_is_one_setting_and_the_signatures_are_generated_from_
     ]
     assert [(spec.group, spec.field) for spec in SETTINGS] == fields
     keywords = [spec.keyword for spec in SETTINGS]
-    assert len(set(keywords)) == len(keywords) == 29
+    assert len(set(keywords)) == len(keywords) == 30
     expected = [spec.parameter() for spec in SETTINGS]
     assert list(inspect.signature(EnvConfig.create).parameters.values()) == expected
     discrete = list(inspect.signature(BearingSLAMDiscreteEnv).parameters.values())

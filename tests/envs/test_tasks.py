@@ -43,8 +43,9 @@ ALL_IDS = sorted([*ENV_IDS, *REGISTERED_TASKS_BY_ID])
 TRANSFER_OF_VERSION = {0: "conservative_global", 1: "conservative"}
 NAME = re.compile(
     r"^(?P<kind>BearingSLAM|BearingSLAMDiscrete)"
-    r"-(?P<setting>Khepera|FurnishedRoom|Random(?P<n>\d+))"
-    r"(?:-Camera(?P<camera>\d+))?(?:-(?P<fault>Outliers|Missed))?-v\d+$"
+    r"-(?P<setting>Khepera|FurnishedRoom|Random(?P<n>\d+)(?:to(?P<most>\d+))?)"
+    r"(?:-Camera(?P<camera>\d+))?(?:-(?P<fault>Outliers|Missed))?"
+    r"(?:-(?P<observation>Entities|Shapes|Planner))?-v\d+$"
 )
 SCENARIO_OF_SETTING = {"Khepera": "khepera", "FurnishedRoom": "furnished_room"}
 
@@ -156,7 +157,8 @@ def test_the_id_follows_the_naming_rule(task: Task) -> None:
         assert config.scenario == SCENARIO_OF_SETTING[match["setting"]]
     else:
         assert config.scenario == "random"
-        assert config.landmark_counts == (int(match["n"]), int(match["n"]))
+        most = int(match["most"] or match["n"])
+        assert config.landmark_counts == (int(match["n"]), most)
     fault = match["fault"]
     assert (config.noise.outlier_rate > 0) == (fault == "Outliers")
     assert (config.noise.detection_rate < 1) == (fault == "Missed")
@@ -164,6 +166,13 @@ def test_the_id_follows_the_naming_rule(task: Task) -> None:
     camera = match["camera"]
     assert config.field_of_view_deg == (360.0 if camera is None else float(camera))
     assert bool(config.obstacles) == (match["setting"] == "FurnishedRoom")
+    observation = match["observation"]
+    assert config.observation == (
+        "flat" if observation in (None, "Planner") else observation.lower()
+    )
+    assert config.planner_features == (observation == "Planner")
+    if observation == "Planner":  # GreedyOneStep's grid, on the discrete id
+        assert (config.n_turns, config.n_move_lengths, task.action_kind) == (8, 2, "discrete")
 
 
 @pytest.mark.parametrize("task_id", TASK_IDS)

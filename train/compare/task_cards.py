@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from bearing_env.envs.candidates import CANDIDATE_FEATURES, candidate_count
 from bearing_env.tasks import Task
 from bearing_env.train.common.errors import available
 from bearing_env.train.common.files import atomic_path, atomic_write_text
@@ -152,6 +153,12 @@ def settings_rows(config: Any, task: Task) -> list[list[str]]:
         ["`area_cap`", f"{_number(config.area_cap)} FL units²"],
         ["`observation`, `max_landmarks`", f"`{config.observation}`, {config.max_landmarks} slots"],
         [
+            "`planner_features`",
+            "on: the observation ends with 5 predictions per candidate move"
+            if config.planner_features
+            else "off",
+        ],
+        [
             "info (`robot_map_info`, `sensor_info`)",
             f"`robot_map` {'on' if config.robot_map_info else 'off'}, "
             f"`seen` and `blocked` {'on' if config.sensor_info else 'off'}",
@@ -210,15 +217,19 @@ def column_names(config: Any, key: str | None = None) -> list[str]:
     )
 
     m = config.max_landmarks
+    candidates = list(CANDIDATE_FEATURES) * candidate_count(config)
     if key == "robot":
         return list(ROBOT_FEATURES)
     if key == "landmarks":
         columns = ENTITY_FEATURES if config.observation == "entities" else SHAPE_ENTITY_FEATURES
         return list(columns) * m
+    if key == "candidates":
+        return candidates
     return [
         *ROBOT_FEATURES,
         *(list(LANDMARK_FEATURES) * (m - 2)),
         *(list(BEARING_FEATURES) * m),
+        *(candidates if config.planner_features else []),
     ]
 
 
@@ -282,6 +293,14 @@ def observation_text(config: Any, space: Any) -> str:
             f"landmarks L3 .. L{m} ({', '.join(LANDMARK_FEATURES)}), then {m} blocks of "
             f"{len(BEARING_FEATURES)} for the latest bearings of L1 .. L{m} "
             f"({', '.join(BEARING_FEATURES)})"
+        )
+    if config.planner_features:
+        where = '`"candidates"`' if config.observation in ("entities", "shapes") else "the end"
+        layout += (
+            f"; at {where}, {candidate_count(config)} blocks of {len(CANDIDATE_FEATURES)}, "
+            f"one per candidate move (action `k`): {', '.join(CANDIDATE_FEATURES)}, what a "
+            "one-step planner predicts from the robot's map and believed pose "
+            f"([the planner features]({ENV_PAGE}#planner-features))"
         )
     return (
         f"`{space_text(space)}`: {layout}. Only what the robot can know, never ground truth; slots "

@@ -37,6 +37,7 @@ enum ActionsStatus : int64_t { BEARING_CORE_ACTIONS_STATUS(BEARING_CORE_ENUM_MEM
     S(int64_t, n, 0, "landmarks of the group's rows")                                    \
     S(int64_t, n_slots, 0, "the observation's landmark slots (max_landmarks)")           \
     S(bool, shape_features, false, "the flat vector ends with the regions' shapes")      \
+    S(int64_t, appended, 0, "columns after the blocks, left 0 (the planner features)")   \
     S(double, width, 0.0, "the arena's width, metres")                                   \
     S(double, height, 0.0, "the arena's height, metres")                                 \
     S(double, margin, 0.0, "the wall margin, metres")                                    \
