@@ -193,3 +193,32 @@ def test_the_command_refuses_to_mix_runs_and_names_what_changed(
         with pytest.raises(SystemExit):
             distill_module.main(["--student", student, "--output", str(tmp_path / "o")])
         assert expected in capsys.readouterr().err
+
+
+def test_a_discrete_student_learns_the_teachers_choices(tmp_path: Path) -> None:
+    """The planner-features id's PPO student (``Discrete(16)``), freshly trained for one
+    rollout and exported, learns the teacher's candidate indices (cross-entropy)."""
+    from bearing_env.train.sb3 import train_cli
+
+    run = tmp_path / "init"
+    train_cli.main(
+        [
+            "--algo", "ppo", "--env", "BearingSLAMDiscrete-Khepera-Planner-v1",
+            "--output", str(run), "--vec-env", "dummy", "--n-envs", "2", "--timesteps", "64",
+            "--hyperparams", "n_steps=32", "batch_size=32", "n_epochs=1",
+            "--eval-freq", "0", "--no-progress", "--no-tensorboard",
+            "--export", str(run / "export" / "model"),
+        ]
+    )  # fmt: skip
+    output = tmp_path / "distilled"
+    result = distill(settings(output, student=str(run / "export" / "model.zip"), epochs=30))
+    for entry in result.iterations:
+        assert entry["loss_after"] < 0.7 * entry["loss_before"], entry
+    dataset = Dataset.load(output / DATASET_NAME)
+    labels = dataset.actions[:, 0]
+    assert dataset.actions.shape[1] == 1 and np.array_equal(labels, np.round(labels))
+    assert labels.min() >= 0 and labels.max() < 16 and np.unique(labels).size > 1
+    student = SB3Policy(None, output / MODEL_NAME)
+    env = student.make_env()
+    observation, info = env.reset(seed=1)
+    assert env.action_space.contains(student.act(observation, info))

@@ -6,13 +6,15 @@ labels over the states the learner itself visits:
 
 1. iteration 0: the teacher acts; every state it visits is labelled with its action;
 2. the student's actor is trained to output the teacher's action on all the labels so
-   far (squared error of the Gaussian policy's mean, the turn taken as an angle:
-   :func:`action_error`; the value network and the log standard deviation are left as
-   they are, so PPO can fine-tune the result);
+   far (a continuous policy: squared error of the Gaussian policy's mean, the turn taken
+   as an angle, :func:`action_error`; a discrete one: the cross-entropy of its choice
+   against the teacher's action, :func:`choice_error`; the value network and the log
+   standard deviation are left as they are, so PPO can fine-tune the result);
 3. iterations 1, 2, ...: the *student* acts (deterministically), the teacher labels the
    states it reaches, and step 2 runs again on the grown dataset.
 
-The student is any continuous-action SB3 actor-critic model with a task record (a
+The student is any SB3 actor-critic model (a ``Box`` or ``Discrete`` action) with a
+task record (a
 ``.zip`` that ``bearing-env train --export`` wrote, or ``pretrained:NAME``); its episodes
 run in its own task's env, which the teacher sees as well (a privileged teacher reads the
 true world). Observations are stored raw and normalised with the student's frozen
@@ -215,8 +217,8 @@ def load_student(settings: DistillSettings, resume: bool) -> SB3Policy:
     the given model; its task is the ``.json`` record beside it.
 
     Raises:
-        ValueError: a model that is not a continuous-action actor-critic, or that has no
-            task record or no ``VecNormalize`` statistics.
+        ValueError: a model that is not an actor-critic with a ``Box`` or ``Discrete``
+            action, or that has no task record or no ``VecNormalize`` statistics.
     """
     saved = settings.output / MODEL_NAME
     path = saved if resume and saved.is_file() else init_model_path(settings.student, "--student")
@@ -228,9 +230,9 @@ def load_student(settings: DistillSettings, resume: bool) -> SB3Policy:
             f"({student.model_path.with_suffix('.json').name}): distill a model exported "
             "with bearing-env train --export, or pretrained:NAME"
         )
-    if not isinstance(student.model.action_space, spaces.Box):
+    if not isinstance(student.model.action_space, spaces.Box | spaces.Discrete):
         raise ValueError(
-            f"distill trains continuous-action models; {settings.student} outputs "
+            f"distill trains models with Box or Discrete actions; {settings.student} outputs "
             f"{student.model.action_space}"
         )
     if not hasattr(student.model.policy, "action_net"):
@@ -253,10 +255,16 @@ def play_episode(
     labels = EpisodeLabels([], [], [capped_total_area(info, area_cap)])
     done = False
     while not done:
-        label = np.asarray(teacher.act(observation, info), np.float32).reshape(-1)
+        taught = teacher.act(observation, info)
+        label = np.asarray(taught, np.float32).reshape(-1)
         labels.observations.append(_as_keyed(observation))
         labels.actions.append(label)
-        action = student.act(observation, info) if student_acts else label
+        # A discrete teacher's index is stepped as it is; a continuous action as labelled.
+        action = (
+            student.act(observation, info)
+            if student_acts
+            else (taught if _discrete(student) else label)
+        )
         observation, _, terminated, truncated, info = env.step(action)
         labels.areas.append(capped_total_area(info, area_cap))
         done = bool(terminated or truncated)
@@ -275,11 +283,31 @@ def _actor_parameters(policy: Any) -> list[Any]:
 
 
 def _mean_actions(student: SB3Policy, observations: Any) -> Any:
+    """The actor's output on raw observations: the Gaussian's mean (a ``Box`` action) or
+    the choice's logits (``Discrete``)."""
     policy = student.model.policy
     assert student.obs_normalizer is not None  # load_student refuses a model without
     normalised = student.obs_normalizer.normalize_obs(observations)
     tensor, _ = policy.obs_to_tensor(normalised)
-    return policy.get_distribution(tensor).distribution.mean
+    distribution = policy.get_distribution(tensor).distribution
+    return distribution.logits if _discrete(student) else distribution.mean
+
+
+def _discrete(student: SB3Policy) -> bool:
+    return isinstance(student.model.action_space, spaces.Discrete)
+
+
+def imitation_error(student: SB3Policy, output: Any, target: Any) -> Any:
+    """Per label: :func:`choice_error` of a discrete student, else :func:`action_error`."""
+    return choice_error(output, target) if _discrete(student) else action_error(output, target)
+
+
+def choice_error(logits: Any, target: Any) -> Any:
+    """The cross-entropy of the student's choice against the teacher's action index
+    (stored as a float in a column of one), per label."""
+    import torch
+
+    return torch.nn.functional.cross_entropy(logits, target[:, 0].long(), reduction="none")
 
 
 def action_error(mean: Any, target: Any) -> Any:
@@ -293,7 +321,7 @@ def action_error(mean: Any, target: Any) -> Any:
 
 
 def imitation_loss(student: SB3Policy, dataset: Dataset, batch_size: int = 4096) -> float:
-    """Mean squared error between the student's mean action and the teacher's labels."""
+    """The mean :func:`imitation_error` of the student on the teacher's labels."""
     import torch
 
     total = 0.0
@@ -302,7 +330,7 @@ def imitation_loss(student: SB3Policy, dataset: Dataset, batch_size: int = 4096)
             index = np.arange(start, min(start + batch_size, len(dataset)))
             mean = _mean_actions(student, dataset.observation_batch(index))
             target = torch.as_tensor(dataset.actions[index], device=mean.device)
-            total += float(action_error(mean, target).sum())
+            total += float(imitation_error(student, mean, target).sum())
     return total / max(len(dataset), 1)
 
 
@@ -323,7 +351,7 @@ def fit_student(
             index = order[start : start + settings.batch_size]
             mean = _mean_actions(student, dataset.observation_batch(index))
             target = torch.as_tensor(dataset.actions[index], device=mean.device)
-            loss = action_error(mean, target).mean()
+            loss = imitation_error(student, mean, target).mean()
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()
