@@ -43,8 +43,8 @@ inline env::Settings settings_of(nb::handle obj, Kept& kept) {
     }
     constexpr int64_t MAX_APPENDED = int64_t{1} << 31;
     if (s.appended < 0 || s.appended > MAX_APPENDED) {
-        value_error("settings.appended must be in [0, " + std::to_string(MAX_APPENDED) +
-                    "], got " + std::to_string(s.appended));
+        value_error("settings.appended must be in [0, " + std::to_string(MAX_APPENDED) + "], got " +
+                    std::to_string(s.appended));
     }
     return s;
 }
