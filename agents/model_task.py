@@ -50,6 +50,7 @@ from .env_access import bearing_env_of
 #: The env settings that make a model's task (see the module doc for why these).
 TASK_SETTINGS: tuple[str, ...] = (
     "observation",
+    "planner_features",
     "max_landmarks",
     "area_cap",
     "scenario",

@@ -73,7 +73,7 @@ def test_hyperparams_rejects_an_algorithm_without_a_file(tmp_path) -> None:
     result = hyperparams_command("td3", tmp_path)
     assert result.returncode == 2
     assert "'td3'" in result.stderr
-    assert "dqn, ppo, ppo_attention, ppo_entities, ppo_shapes, sac" in result.stderr
+    assert "dqn, ppo, ppo_attention, ppo_candidates, ppo_entities, ppo_shapes, sac" in result.stderr
 
 
 def test_compare_help_names_every_policy_kind() -> None:

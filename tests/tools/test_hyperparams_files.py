@@ -72,7 +72,7 @@ def algo_of(name: str) -> str:
 
 def test_every_shipped_file_and_default_id_has_its_entries() -> None:
     assert {name for name, _ in ENTRIES} == {
-        "dqn", "ppo", "ppo_attention", "ppo_entities", "ppo_shapes", "sac",
+        "dqn", "ppo", "ppo_attention", "ppo_candidates", "ppo_entities", "ppo_shapes", "sac",
     }  # fmt: skip
     for algo, env_id in DEFAULT_ENV_IDS.items():
         assert (algo, env_id) in ENTRIES

@@ -330,7 +330,7 @@ def test_a_documented_enjoy_command_plays_the_trained_model_on_its_task(
 
 
 #: The shipped files whose entries are keyed by a task id (its kwargs carry the settings).
-TASK_KEYED_FILES = ("ppo_entities", "ppo_attention", "ppo_shapes")
+TASK_KEYED_FILES = ("ppo_entities", "ppo_attention", "ppo_shapes", "ppo_candidates")
 
 
 def plain_command(name: str) -> DocumentedCommand:
