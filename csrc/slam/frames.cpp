@@ -142,16 +142,21 @@ int64_t sample_hypotheses(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2
         for (int64_t j = 0; j < m2; ++j) inverses[i][j] = 1.0 / (s2[j] - s1[i]);
     }
     int64_t extreme[MAX_SAMPLES + 1];
+    // Each hull's sort starts from the previous column's (row's) order: neighbouring
+    // samples have nearby images, so it is nearly sorted already (the same order).
+    int64_t order[MAX_SAMPLES];
+    for (int64_t i = 0; i < m1; ++i) order[i] = i;
     // column_extreme[i][j]: h1 = s1[i] gives a hull vertex among the pairs with h2 = s2[j].
     bool column_extreme[MAX_SAMPLES][MAX_SAMPLES] = {};
     for (int64_t j = 0; j < m2; ++j) {
         for (int64_t i = 0; i < m1; ++i) column[i] = inverses[i][j];
-        const int64_t count = small_hull_indices(column, m1, extreme, 0.0);
+        const int64_t count = small_hull_indices(column, m1, extreme, 0.0, order);
         for (int64_t v = 0; v < count; ++v) column_extreme[extreme[v]][j] = true;
     }
+    for (int64_t j = 0; j < m2; ++j) order[j] = j;
     int64_t k = 0;
     for (int64_t i = 0; i < m1; ++i) {
-        const int64_t count = small_hull_indices(inverses[i], m2, extreme, 0.0);
+        const int64_t count = small_hull_indices(inverses[i], m2, extreme, 0.0, order);
         for (int64_t v = 0; v < count; ++v) {
             const int64_t j = extreme[v];
             if (column_extreme[i][j]) {
