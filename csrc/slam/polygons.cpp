@@ -66,16 +66,17 @@ inline bool separated(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q, cp
     return lo_q > hi_p || lo_p > hi_q;
 }
 
-// convex_hull's temporaries: its candidates' indices and sides, its task stack and the
-// copy of its hull (about 490 KB at MAX_HULL_POINTS points: too much for a thread's stack).
+// convex_hull's temporaries: its candidates' indices (the upper side's gathered apart
+// first), its task stack and the copy of its hull (about 490 KB at MAX_HULL_POINTS points:
+// too much for a thread's stack).
 struct HullWorkspace {
-    ScratchArray<int64_t> index, task_start, task_end, chain_from, chain_to, task_far;
-    ScratchArray<double> sides;
+    ScratchArray<int64_t> index, upper, task_start, task_end, chain_from, chain_to, task_far;
     ScratchArray<cplx> candidates;
 };
 
-// The monotone chain's temporaries (hull_indices' sort order, and the chain that
-// small_convex_hull and small_hull_indices read back).
+// The monotone chain's temporaries (hull_indices' sort order and the merge's second
+// buffer, the chain's points, and the chain that small_convex_hull and
+// small_hull_indices read back).
 struct ChainWorkspace {
     ScratchArray<int64_t> order, merged, run_start, chosen;
     ScratchArray<cplx> chain;
@@ -97,29 +98,35 @@ ChainWorkspace& chain_workspace() {
 // The first of the lowest-x (then lowest-y) points and the first of the highest-x (then
 // highest-y) points: the ends of the lower and upper chains.
 inline void extreme_points(const cplx* points, int64_t n_points, int64_t& first, int64_t& last) {
+    cplx lo = points[first], hi = points[last];
     for (int64_t i = 1; i < n_points; ++i) {
         const cplx p = points[i];
-        const cplx lo = points[first], hi = points[last];
-        if (p.re < lo.re || (p.re == lo.re && p.im < lo.im)) first = i;
-        if (p.re > hi.re || (p.re == hi.re && p.im > hi.im)) last = i;
+        if (p.re < lo.re || (p.re == lo.re && p.im < lo.im)) {
+            first = i;
+            lo = p;
+        }
+        if (p.re > hi.re || (p.re == hi.re && p.im > hi.im)) {
+            last = i;
+            hi = p;
+        }
     }
 }
 
 // Sort the points' indices into `index` by side of a -> b: the lower side (right of it)
-// first, n_lower of them, then the upper side, n_upper; the rest are on the line. Returns
+// first, n_lower of them, then the upper side, n_upper (gathered in `upper` first, in the
+// same pass); the rest are on the line. Returns
 // the slot of the lower side's farthest candidate (-1 if it has none).
 // The lower chain's task (a -> b) would find that candidate by its scan, whose expression
 // bx * (p.im - ay) - by * (p.re - ax), with ax, ay = a and bx, by = b - a, is
 // cross(b - a, p - a) operation for operation, over these candidates, in this order (the
 // first minimum wins, as in the scan). Each point's side is computed once (numba
 // evaluated the same expression again for the upper side: the same value).
-inline int64_t split_sides(const cplx* points, int64_t n_points, cplx a, cplx b, double* sides,
+inline int64_t split_sides(const cplx* points, int64_t n_points, cplx a, cplx b, int64_t* upper,
                            int64_t* index, int64_t& n_lower, int64_t& n_upper) {
     int64_t far_lower = -1;
     double min_lower = 0.0;
     for (int64_t i = 0; i < n_points; ++i) {
         const double side = cross(b - a, points[i] - a);
-        sides[i] = side;
         if (side < 0.0) {
             if (side < min_lower) {
                 min_lower = side;
@@ -127,14 +134,12 @@ inline int64_t split_sides(const cplx* points, int64_t n_points, cplx a, cplx b,
             }
             index[n_lower] = i;
             n_lower += 1;
-        }
-    }
-    for (int64_t i = 0; i < n_points; ++i) {
-        if (sides[i] > 0.0) {
-            index[n_lower + n_upper] = i;
+        } else if (side > 0.0) {
+            upper[n_upper] = i;
             n_upper += 1;
         }
     }
+    std::copy(upper, upper + n_upper, index + n_lower);
     return far_lower;
 }
 
@@ -268,7 +273,7 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
     int64_t* const index = work.index.at_least(n_points);
     int64_t n_lower = 0, n_upper = 0;
     const int64_t far_lower =
-        split_sides(points, n_points, a, b, work.sides.at_least(n_points), index, n_lower, n_upper);
+        split_sides(points, n_points, a, b, work.upper.at_least(n_points), index, n_lower, n_upper);
     const int64_t size = 2 * n_points + 4;
     const HullTasks tasks{work.task_start.at_least(size), work.task_end.at_least(size),
                           work.chain_from.at_least(size), work.chain_to.at_least(size),
