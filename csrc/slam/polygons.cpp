@@ -435,7 +435,8 @@ int64_t monotone_chain(const cplx* points, int64_t n_points, const int64_t* orde
     return std::max(k, int64_t{1});
 }
 
-// Below this many points, numba's insertion sort costs less than finding and merging runs.
+// Up to this many points, numba's insertion sort costs less than finding and merging runs,
+// or than checking for NaN before sorting from a seed (the paper transfer's 4 samples).
 constexpr int64_t SMALL_SORT = 8;
 
 // small_hull_indices' hull into `out` of `capacity` (2 * n_points suffices: when rounding
@@ -453,7 +454,7 @@ int64_t hull_indices(const cplx* points, int64_t n_points, int64_t* out, double 
     check_capacity("small_hull_indices chain", 2 * n_points - 1, capacity);
     ChainWorkspace& work = chain_workspace();
     const int64_t* order = nullptr;
-    if ((seed == nullptr && n_points <= SMALL_SORT) || any_nan(points, n_points)) {
+    if (n_points <= SMALL_SORT || any_nan(points, n_points)) {
         int64_t* const sorted = seed != nullptr ? seed : work.order.at_least(n_points);
         insertion_sort(points, n_points, sorted);
         order = sorted;
