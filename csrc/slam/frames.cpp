@@ -138,20 +138,39 @@ int64_t sample_hypotheses(const cplx* a1, int64_t n1, const cplx* a2, int64_t n2
         Inverses() {}  // NOLINT: deliberately uninitialised (16 KB)
     } inverse_buffer;
     auto& inverses = inverse_buffer.rows;
+    double zero = 0.0;  // stays 0 if every image is finite, else NaN (inf - inf is NaN)
     for (int64_t i = 0; i < m1; ++i) {
-        for (int64_t j = 0; j < m2; ++j) inverses[i][j] = 1.0 / (s2[j] - s1[i]);
+        for (int64_t j = 0; j < m2; ++j) {
+            const cplx image = 1.0 / (s2[j] - s1[i]);
+            inverses[i][j] = image;
+            zero += (image.re - image.re) + (image.im - image.im);
+        }
     }
     int64_t extreme[MAX_SAMPLES + 1];
+    // Each hull's sort starts from the previous column's (row's) order: neighbouring
+    // samples have nearby images, so it is nearly sorted already (the same order).
+    int64_t order[MAX_SAMPLES];
+    for (int64_t i = 0; i < m1; ++i) order[i] = i;
     // column_extreme[i][j]: h1 = s1[i] gives a hull vertex among the pairs with h2 = s2[j].
     bool column_extreme[MAX_SAMPLES][MAX_SAMPLES] = {};
+    // in_some_column[i]: some column_extreme[i][j]. A row without gives no pair, and its
+    // hull is skipped, unless an image is not finite (then the hull may raise
+    // CapacityError, where numba's kernel overran its buffer, and must still be run).
+    bool in_some_column[MAX_SAMPLES] = {};
     for (int64_t j = 0; j < m2; ++j) {
         for (int64_t i = 0; i < m1; ++i) column[i] = inverses[i][j];
-        const int64_t count = small_hull_indices(column, m1, extreme, 0.0);
-        for (int64_t v = 0; v < count; ++v) column_extreme[extreme[v]][j] = true;
+        const int64_t count = small_hull_indices(column, m1, extreme, 0.0, order);
+        for (int64_t v = 0; v < count; ++v) {
+            column_extreme[extreme[v]][j] = true;
+            in_some_column[extreme[v]] = true;
+        }
     }
+    for (int64_t j = 0; j < m2; ++j) order[j] = j;
+    const bool all_finite = zero == 0.0;
     int64_t k = 0;
     for (int64_t i = 0; i < m1; ++i) {
-        const int64_t count = small_hull_indices(inverses[i], m2, extreme, 0.0);
+        if (!in_some_column[i] && all_finite) continue;
+        const int64_t count = small_hull_indices(inverses[i], m2, extreme, 0.0, order);
         for (int64_t v = 0; v < count; ++v) {
             const int64_t j = extreme[v];
             if (column_extreme[i][j]) {

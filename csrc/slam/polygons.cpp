@@ -66,18 +66,20 @@ inline bool separated(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q, cp
     return lo_q > hi_p || lo_p > hi_q;
 }
 
-// convex_hull's temporaries: its candidates' indices and sides, its task stack and the
-// copy of its hull (about 490 KB at MAX_HULL_POINTS points: too much for a thread's stack).
+// convex_hull's temporaries: its candidates' indices (the upper side's gathered apart
+// first), its task stack and the copy of its hull (about 490 KB at MAX_HULL_POINTS points:
+// too much for a thread's stack).
 struct HullWorkspace {
-    ScratchArray<int64_t> index, task_start, task_end, chain_from, chain_to, task_far;
-    ScratchArray<double> sides;
+    ScratchArray<int64_t> index, upper, task_start, task_end, chain_from, chain_to, task_far;
     ScratchArray<cplx> candidates;
 };
 
-// The monotone chain's temporaries (hull_indices' sort order, and the chain that
-// small_convex_hull and small_hull_indices read back).
+// The monotone chain's temporaries (hull_indices' sort order and the merge's second
+// buffer, the chain's points, and the chain that small_convex_hull and
+// small_hull_indices read back).
 struct ChainWorkspace {
-    ScratchArray<int64_t> order, chosen;
+    ScratchArray<int64_t> order, merged, run_start, chosen;
+    ScratchArray<cplx> chain;
 };
 
 HullWorkspace& hull_workspace() {
@@ -96,29 +98,35 @@ ChainWorkspace& chain_workspace() {
 // The first of the lowest-x (then lowest-y) points and the first of the highest-x (then
 // highest-y) points: the ends of the lower and upper chains.
 inline void extreme_points(const cplx* points, int64_t n_points, int64_t& first, int64_t& last) {
+    cplx lo = points[first], hi = points[last];
     for (int64_t i = 1; i < n_points; ++i) {
         const cplx p = points[i];
-        const cplx lo = points[first], hi = points[last];
-        if (p.re < lo.re || (p.re == lo.re && p.im < lo.im)) first = i;
-        if (p.re > hi.re || (p.re == hi.re && p.im > hi.im)) last = i;
+        if (p.re < lo.re || (p.re == lo.re && p.im < lo.im)) {
+            first = i;
+            lo = p;
+        }
+        if (p.re > hi.re || (p.re == hi.re && p.im > hi.im)) {
+            last = i;
+            hi = p;
+        }
     }
 }
 
 // Sort the points' indices into `index` by side of a -> b: the lower side (right of it)
-// first, n_lower of them, then the upper side, n_upper; the rest are on the line. Returns
+// first, n_lower of them, then the upper side, n_upper (gathered in `upper` first, in the
+// same pass); the rest are on the line. Returns
 // the slot of the lower side's farthest candidate (-1 if it has none).
 // The lower chain's task (a -> b) would find that candidate by its scan, whose expression
 // bx * (p.im - ay) - by * (p.re - ax), with ax, ay = a and bx, by = b - a, is
 // cross(b - a, p - a) operation for operation, over these candidates, in this order (the
 // first minimum wins, as in the scan). Each point's side is computed once (numba
 // evaluated the same expression again for the upper side: the same value).
-inline int64_t split_sides(const cplx* points, int64_t n_points, cplx a, cplx b, double* sides,
+inline int64_t split_sides(const cplx* points, int64_t n_points, cplx a, cplx b, int64_t* upper,
                            int64_t* index, int64_t& n_lower, int64_t& n_upper) {
     int64_t far_lower = -1;
     double min_lower = 0.0;
     for (int64_t i = 0; i < n_points; ++i) {
         const double side = cross(b - a, points[i] - a);
-        sides[i] = side;
         if (side < 0.0) {
             if (side < min_lower) {
                 min_lower = side;
@@ -126,14 +134,12 @@ inline int64_t split_sides(const cplx* points, int64_t n_points, cplx a, cplx b,
             }
             index[n_lower] = i;
             n_lower += 1;
-        }
-    }
-    for (int64_t i = 0; i < n_points; ++i) {
-        if (sides[i] > 0.0) {
-            index[n_lower + n_upper] = i;
+        } else if (side > 0.0) {
+            upper[n_upper] = i;
             n_upper += 1;
         }
     }
+    std::copy(upper, upper + n_upper, index + n_lower);
     return far_lower;
 }
 
@@ -267,7 +273,7 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
     int64_t* const index = work.index.at_least(n_points);
     int64_t n_lower = 0, n_upper = 0;
     const int64_t far_lower =
-        split_sides(points, n_points, a, b, work.sides.at_least(n_points), index, n_lower, n_upper);
+        split_sides(points, n_points, a, b, work.upper.at_least(n_points), index, n_lower, n_upper);
     const int64_t size = 2 * n_points + 4;
     const HullTasks tasks{work.task_start.at_least(size), work.task_end.at_least(size),
                           work.chain_from.at_least(size), work.chain_to.at_least(size),
@@ -286,16 +292,21 @@ int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out) {
 
 namespace {
 
-// Andrew's monotone chain as numba's small_hull_indices runs it, into `out` of `capacity`
-// (2 * n_points suffices: when rounding makes the lower and upper chains disagree on
-// nearly collinear points, both keep a point, and the chain holds up to 2 * n_points - 1
-// indices before its last is dropped).
-int64_t hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol,
-                     int64_t capacity) {
-    if (n_points <= 0) return 0;
-    check_capacity("small_hull_indices points", n_points, MAX_HULL_POINTS);
-    int64_t* const order = chain_workspace().order.at_least(n_points);
-    for (int64_t i = 0; i < n_points; ++i) {  // insertion sort by (x, y)
+// Whether point a comes before point b in the monotone chain's order: by x, then y, then
+// index. For points without NaN this is a strict total order, and numba's stable
+// insertion sort by (x, y) puts equal points in index order: so any sort by it gives
+// numba's order exactly.
+inline bool comes_before(const cplx* points, int64_t a, int64_t b) {
+    const cplx p = points[a], q = points[b];
+    if (p.re != q.re) return p.re < q.re;
+    if (p.im != q.im) return p.im < q.im;
+    return a < b;
+}
+
+// numba's insertion sort by (x, y), kept for points with a NaN (whose comparisons are no
+// order, so only this loop gives numba's result).
+void insertion_sort(const cplx* points, int64_t n_points, int64_t* order) {
+    for (int64_t i = 0; i < n_points; ++i) {
         const cplx p = points[i];
         int64_t j = i;
         while (j > 0) {
@@ -306,25 +317,156 @@ int64_t hull_indices(const cplx* points, int64_t n_points, int64_t* out, double 
         }
         order[j] = i;
     }
+}
+
+// Split 0..n_points into maximal runs, each ascending or descending in comes_before
+// order, written ascending into order (a descending run reversed); run_start gets each
+// run's first slot and, last, n_points. Returns the number of runs. The points a hull
+// sees come in few runs: a quickhull's output is its lower chain (ascending) then its
+// upper chain (descending), and samples along a boundary trace a closed curve.
+int64_t find_runs(const cplx* points, int64_t n_points, int64_t* order, int64_t* run_start) {
+    int64_t runs = 0;
+    for (int64_t i = 0; i < n_points;) {
+        int64_t j = i + 1;
+        if (j < n_points && comes_before(points, j, i)) {
+            while (j + 1 < n_points && comes_before(points, j + 1, j)) j += 1;
+            j += 1;
+            for (int64_t v = i; v < j; ++v) order[v] = i + j - 1 - v;
+        } else {
+            while (j < n_points && comes_before(points, j - 1, j)) j += 1;
+            for (int64_t v = i; v < j; ++v) order[v] = v;
+        }
+        run_start[runs] = i;
+        runs += 1;
+        i = j;
+    }
+    run_start[runs] = n_points;
+    return runs;
+}
+
+// Merge from[lo:mid] and from[mid:hi] (each ascending in comes_before order) into to[lo:hi].
+inline void merge_runs(const cplx* points, const int64_t* from, int64_t lo, int64_t mid, int64_t hi,
+                       int64_t* to) {
+    int64_t a = lo, b = mid, k = lo;
+    while (a < mid && b < hi)
+        to[k++] = comes_before(points, from[b], from[a]) ? from[b++] : from[a++];
+    while (a < mid) to[k++] = from[a++];
+    while (b < hi) to[k++] = from[b++];
+}
+
+// Whether any coordinate of points[:n_points] is NaN.
+bool any_nan(const cplx* points, int64_t n_points) {
+    for (int64_t i = 0; i < n_points; ++i) {
+        if (std::isunordered(points[i].re, points[i].im)) return true;  // either is NaN
+    }
+    return false;
+}
+
+// Insertion sort of order[:n_points] (a permutation of 0..n_points - 1) by comes_before:
+// cheap when order is nearly sorted already, as the previous row's order is for the
+// next row of sample_hypotheses' images.
+void sort_from(const cplx* points, int64_t n_points, int64_t* order) {
+    for (int64_t i = 1; i < n_points; ++i) {
+        const int64_t index = order[i];
+        int64_t j = i;
+        while (j > 0 && comes_before(points, index, order[j - 1])) {
+            order[j] = order[j - 1];
+            j -= 1;
+        }
+        order[j] = index;
+    }
+}
+
+// The indices of points[:n_points] in numba's order (see comes_before), by merging the
+// input's runs pairwise; returns the array that holds them (work.order or work.merged).
+int64_t* merge_sort_runs(const cplx* points, int64_t n_points, ChainWorkspace& work) {
+    int64_t* order = work.order.at_least(n_points);
+    int64_t* run_start = work.run_start.at_least(n_points + 1);
+    int64_t runs = find_runs(points, n_points, order, run_start);
+    int64_t* merged = work.merged.at_least(n_points);
+    while (runs > 1) {
+        int64_t kept = 0;
+        for (int64_t r = 0; r < runs; r += 2) {
+            const int64_t lo = run_start[r];
+            if (r + 1 < runs) {
+                merge_runs(points, order, lo, run_start[r + 1], run_start[r + 2], merged);
+            } else {
+                std::copy(order + lo, order + n_points, merged + lo);
+            }
+            run_start[kept] = lo;
+            kept += 1;
+        }
+        run_start[kept] = n_points;
+        runs = kept;
+        std::swap(order, merged);
+    }
+    return order;
+}
+
+// Andrew's monotone chain as numba's small_hull_indices runs it, over points[:n_points]
+// taken in `order` (sorted as numba sorts them), into `out`. The chain's points are kept
+// beside their indices (`stack`, 2 * n_points slots), read without indirection. With
+// EXACT, tol is 0 and within_chord is its sign test.
+template <bool EXACT>
+int64_t monotone_chain(const cplx* points, int64_t n_points, const int64_t* order, double tol,
+                       int64_t* out, cplx* stack) {
+    const auto pops = [tol](cplx a, cplx b, cplx c) {
+        if constexpr (EXACT) return cross(b - a, c - a) <= 0.0;
+        return within_chord(a, b, c, tol);
+    };
     int64_t k = 0;
     for (int64_t j = 0; j < n_points; ++j) {  // lower chain
         const cplx p = points[order[j]];
-        while (k >= 2 && within_chord(points[out[k - 2]], points[out[k - 1]], p, tol)) k -= 1;
-        check_capacity("small_hull_indices chain", k + 1, capacity);
+        while (k >= 2 && pops(stack[k - 2], stack[k - 1], p)) k -= 1;
         out[k] = order[j];
+        stack[k] = p;
         k += 1;
     }
     const int64_t lower = k + 1;
     for (int64_t j = n_points - 2; j > -1; --j) {  // upper chain
         const cplx p = points[order[j]];
-        while (k >= lower && within_chord(points[out[k - 2]], points[out[k - 1]], p, tol)) k -= 1;
-        check_capacity("small_hull_indices chain", k + 1, capacity);
+        while (k >= lower && pops(stack[k - 2], stack[k - 1], p)) k -= 1;
         out[k] = order[j];
+        stack[k] = p;
         k += 1;
     }
     k -= 1;  // the last point repeats the first
     if (k == 2 && points[out[0]] == points[out[1]]) return 1;
     return std::max(k, int64_t{1});
+}
+
+// Up to this many points, numba's insertion sort costs less than finding and merging runs,
+// or than checking for NaN before sorting from a seed (the paper transfer's 4 samples).
+constexpr int64_t SMALL_SORT = 8;
+
+// small_hull_indices' hull into `out` of `capacity` (2 * n_points suffices: when rounding
+// makes the lower and upper chains disagree on nearly collinear points, both keep a
+// point; each point is pushed once per chain at most, so the chain holds at most
+// 2 * n_points - 1 indices before its last is dropped). `seed`, if not null, holds a
+// permutation of 0..n_points - 1 to start the sort from, and is left sorted; else the
+// input's runs are merged (a quickhull's output is two: its lower chain, ascending, then
+// its upper chain, descending). The same order either way (comes_before), unless a
+// point has a NaN: then numba's own insertion sort, as for a few points.
+int64_t hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol,
+                     int64_t capacity, int64_t* seed = nullptr) {
+    if (n_points <= 0) return 0;
+    check_capacity("small_hull_indices points", n_points, MAX_HULL_POINTS);
+    check_capacity("small_hull_indices chain", 2 * n_points - 1, capacity);
+    ChainWorkspace& work = chain_workspace();
+    const int64_t* order = nullptr;
+    if (n_points <= SMALL_SORT || any_nan(points, n_points)) {
+        int64_t* const sorted = seed != nullptr ? seed : work.order.at_least(n_points);
+        insertion_sort(points, n_points, sorted);
+        order = sorted;
+    } else if (seed != nullptr) {
+        sort_from(points, n_points, seed);
+        order = seed;
+    } else {
+        order = merge_sort_runs(points, n_points, work);
+    }
+    cplx* const stack = work.chain.at_least(2 * n_points);
+    if (tol == 0.0) return monotone_chain<true>(points, n_points, order, tol, out, stack);
+    return monotone_chain<false>(points, n_points, order, tol, out, stack);
 }
 
 }  // namespace
@@ -344,9 +486,10 @@ int64_t small_convex_hull(const cplx* points, int64_t n_points, cplx* out, doubl
     return k;
 }
 
-int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol) {
+int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol,
+                           int64_t* order) {
     int64_t* const chosen = chain_workspace().chosen.at_least(CHAIN_SLOTS);
-    const int64_t k = hull_indices(points, n_points, chosen, tol, CHAIN_SLOTS);
+    const int64_t k = hull_indices(points, n_points, chosen, tol, CHAIN_SLOTS, order);
     check_capacity("small_hull_indices output", k, n_points + 1);
     std::copy(chosen, chosen + k, out);
     return k;

@@ -24,7 +24,11 @@ inline constexpr int64_t MAX_HULL_POINTS = MAX_CLOUD + SCRATCH;
 // most MAX_HULL_POINTS, else CapacityError.
 int64_t convex_hull(const cplx* points, int64_t n_points, cplx* out);
 int64_t small_convex_hull(const cplx* points, int64_t n_points, cplx* out, double tol);
-int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol);
+// order, if given, holds a permutation of 0..n_points - 1 that the hull's sort by
+// position starts from (the same result, sooner when it is nearly sorted: the previous
+// call's on similar points), and is left holding the sorted one.
+int64_t small_hull_indices(const cplx* points, int64_t n_points, int64_t* out, double tol,
+                           int64_t* order = nullptr);
 std::pair<double, cplx> area_centroid(const cplx* poly, int64_t n);
 bool contains_point(const cplx* poly, int64_t n, cplx point, double relative);
 double polygon_distance(const cplx* p, int64_t n_p, const cplx* q, int64_t n_q);
