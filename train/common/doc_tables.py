@@ -367,6 +367,24 @@ def khepera_seeds(results: Mapping[str, Any]) -> str:
     return evaluation_markdown(results, KHEPERA_SEEDS, heading=False)
 
 
+#: The learned exploration designs on the planner features, one ``bearing-env evaluate``
+#: results file each.
+PLANNER_DESIGNS = "docs/compare/results/planner_*.json"
+
+
+def planner_designs(results: Mapping[str, Any]) -> str:
+    """Each design's training seeds against the baselines on its task (``bearing-env
+    evaluate``'s tables under a heading per design, from ``PLANNER_DESIGNS``)."""
+    from bearing_env.train.compare.evaluation_report import evaluation_markdown
+
+    sections = []
+    for name, evaluation in results.items():
+        source = PLANNER_DESIGNS.replace("*", name.removeprefix("planner_"))
+        body = evaluation_markdown(evaluation, source, heading=False)
+        sections.append(f"### `{evaluation['model']['name']}`\n\n{body.rstrip()}\n")
+    return "\n".join(sections)
+
+
 def _blocks() -> dict[str, Block]:
     from bearing_env.train.compare import task_cards
     from bearing_env.train.studies import figures, observability, robust_eval
@@ -400,6 +418,7 @@ def _blocks() -> dict[str, Block]:
         ),
         "transfer-fused-area": Block("docs/compare/results/transfer_*.json", transfer_fused_area),
         "khepera-seeds": Block(KHEPERA_SEEDS, khepera_seeds),
+        "planner-designs": Block(PLANNER_DESIGNS, planner_designs),
     }
 
 
