@@ -8,9 +8,9 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <initializer_list>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include <bearing_core/core/complex.hpp>
 #include <bearing_core/core/views.hpp>
@@ -142,9 +142,9 @@ Extent extent_of(const View<T, D>& view, const char* name) {
 // No array a kernel writes shares memory with another of its arguments: the kernels read
 // their inputs while they write their outputs, so an overlap would change the result
 // midway. ValueError naming both.
-inline void require_apart(std::initializer_list<Extent> arrays) {
-    for (const Extent* a = arrays.begin(); a != arrays.end(); ++a) {
-        for (const Extent* b = a + 1; b != arrays.end(); ++b) {
+inline void require_apart(const std::vector<Extent>& arrays) {
+    for (auto a = arrays.begin(); a != arrays.end(); ++a) {
+        for (auto b = a + 1; b != arrays.end(); ++b) {
             if (!(a->written || b->written) || a->bytes == 0 || b->bytes == 0) continue;
             const auto* a_begin = static_cast<const char*>(a->data);
             const auto* b_begin = static_cast<const char*>(b->data);
