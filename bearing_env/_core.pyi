@@ -339,7 +339,7 @@ def contains_points(
 
 def relaxed_region(
     state: MapState, row: int, j: int, slots: object, use_base: bool, max_outliers: int, out: object
-) -> tuple:
+) -> tuple[int, int]:
     """
     (n, q): landmark j's q-relaxed region over the window slots, into out[:n].
     """

@@ -1,9 +1,9 @@
 // One line binds a kernel: def(m, "name", &kernel, "a"_a, "b"_a, doc). Each argument is
 // taken as the kernel's parameter type says: a View<T, D> from a numpy array checked by
-// view_of under its nb::arg name, a cplx from any Python number, a bool from Python's or
-// numpy's, anything else as
-// nanobind casts it. Then no array the kernel writes may share memory with another of its
-// arrays, and the kernel (or the library's checked entry point) checks the rest.
+// view_of under its nb::arg name, a struct of arrays by read_struct, a cplx from any Python
+// number, a bool from Python's or numpy's, anything else as nanobind casts it. Then no
+// array the kernel writes may share memory with another of its arrays, and the kernel (or
+// the library's checked entry point) checks the rest.
 #pragma once
 
 #include <nanobind/nanobind.h>
@@ -20,6 +20,7 @@
 
 #include <bearing_core/core/complex.hpp>
 #include "bindings/arrays.hpp"
+#include "bindings/structs.hpp"
 
 namespace bearing::bindings {
 // A bool argument: Python's or numpy's (numba takes both).
@@ -68,22 +69,29 @@ namespace bearing::bindings {
 
 // How a kernel's parameter of type P comes from Python: nanobind casts a Py, and
 // from(py, name) makes the P.
-template <class P>
+template <class P, class = void>
 struct Param {
     using Py = P;
-    static constexpr bool array = false;
     static P from(P value, const char*) { return value; }
 };
 template <>
 struct Param<bool> {
     using Py = Bool;
-    static constexpr bool array = false;
     static bool from(Bool value, const char*) { return value.value; }
+};
+// A struct of arrays (its schema's for_each_field and field_docs): read_struct's views.
+template <class S>
+struct Param<S, std::void_t<decltype(field_docs(std::declval<const S&>()))>> {
+    using Py = nb::handle;
+    static S from(nb::handle obj, const char* name) {
+        schema::Sizes sizes{{"CAPACITY", slam::CAPACITY}};
+        Kept kept;  // (the caller's arguments stay alive through the call)
+        return read_struct<S>(obj, name, sizes, kept, false);
+    }
 };
 template <class T, int D>
 struct Param<View<T, D>> {
     using Py = nb::handle;
-    static constexpr bool array = true;
     static View<T, D> from(nb::handle obj, const char* name) { return view_of<T, D>(obj, name); }
 };
 
@@ -97,10 +105,10 @@ void add_name(std::vector<const char*>& names, const Extra& extra) {
 
 // The array arguments' memory, for require_apart.
 template <class P>
-void add_extent(std::vector<Extent>& extents, const P& value, const char* name) {
-    if constexpr (Param<P>::array) {
-        extents.push_back(extent_of(value, name));
-    }
+void add_extent(std::vector<Extent>&, const P&, const char*) {}
+template <class T, int D>
+void add_extent(std::vector<Extent>& extents, const View<T, D>& view, const char* name) {
+    extents.push_back(extent_of(view, name));
 }
 
 template <bool Release, class R, class... P, size_t... I, class... Extra>
@@ -140,3 +148,13 @@ void def_released(nb::module_& m, const char* name, R (*kernel)(P...), const Ext
 }
 
 }  // namespace bearing::bindings
+
+// The IntEnum Type of the module `m`, its members (also at module level) from the enum's
+// X-macro LIST (E(member, value) per member).
+#define BEARING_BINDINGS_ENUM_VALUE(member, number) .value(#member, Enum::member)
+#define BEARING_BINDINGS_ENUM(m, Type, LIST)                                             \
+    {                                                                                    \
+        using Enum = Type;                                                               \
+        nb::enum_<Enum>(m, #Type, nb::is_arithmetic()) LIST(BEARING_BINDINGS_ENUM_VALUE) \
+            .export_values();                                                            \
+    }

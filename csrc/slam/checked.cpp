@@ -2,13 +2,19 @@
 // then runs the kernel of polygons.cpp, frames.cpp or local_bound.cpp.
 #include <bearing_core/slam/checked.hpp>
 
+#include <algorithm>
 #include <memory>
 #include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include <bearing_core/core/checks.hpp>
 #include <bearing_core/slam/common.hpp>
+#include <bearing_core/slam/fusion.hpp>
 #include <bearing_core/slam/local_bound.hpp>
 #include <bearing_core/slam/polygons.hpp>
+#include <bearing_core/slam/robust.hpp>
 #include <bearing_core/slam/scratch.hpp>
 #include <bearing_core/slam/update.hpp>
 
@@ -30,6 +36,23 @@ void check_edge_samples(int64_t edge_samples, const char* name) {
         invalid_argument(std::string(name) + " must be in [1, " + std::to_string(MAX_EDGE_SAMPLES) +
                          "], got " + std::to_string(edge_samples));
     }
+}
+
+// A vertex count the kernels read a region of the state with (from an array a user can
+// write, as the update's own check of a map does): within the region's `slots`.
+void check_region_count(int64_t n, int64_t slots, const char* name) {
+    if (n < 0 || n > slots) {
+        invalid_argument(std::string("state.") + name + " holds " + std::to_string(n) +
+                         ", outside [0, " + std::to_string(slots) + "]: a corrupt state");
+    }
+}
+
+// Map `row` and landmark slot `j` of the state `s`.
+void check_map_and_slot(const MapState& s, int64_t row, int64_t j) {
+    const int64_t maps = s.vertices.shape[0], mapped = s.vertices.shape[1];
+    require(0 <= row && row < maps, "row must be a map index in [0, " + std::to_string(maps) + ")");
+    require(0 <= j && j < mapped,
+            "j must be a landmark slot in [0, " + std::to_string(mapped) + ")");
 }
 
 }  // namespace
@@ -215,6 +238,204 @@ std::pair<int64_t, int64_t> sub_square_growths(In target, In a1, In a2, int64_t 
         }
     }
     return {sub->m1, sub->m2};
+}
+
+void check_state(const MapState& s, const char* label) {
+    const std::string state(label);
+    for (const auto& [axis, array, length] :
+         {std::tuple{"base_capacity", "base_vertices", s.base_vertices.shape[2]},
+          std::tuple{"probe_capacity", "probe_vertices", s.probe_vertices.shape[2]}}) {
+        if (length != CAPACITY && length != 0) {
+            invalid_argument(state + "'s " + axis + " (the last axis of " + state + "." + array +
+                             ") must be " + std::to_string(CAPACITY) + " or 0, not " +
+                             std::to_string(length));
+        }
+    }
+    if (s.window_vertices.shape[1] > MAX_WINDOW) {
+        invalid_argument(state + ".window_vertices has a window of " +
+                         std::to_string(s.window_vertices.shape[1]) +
+                         " movements, more than MAX_WINDOW (" + std::to_string(MAX_WINDOW) + ")");
+    }
+    if (s.vertices.shape[1] + 2 > MAX_LANDMARKS) {
+        invalid_argument(state + ".vertices has " + std::to_string(s.vertices.shape[1]) +
+                         " mapped landmarks, more than " + std::to_string(MAX_LANDMARKS - 2) +
+                         " (MAX_LANDMARKS - 2)");
+    }
+}
+
+void check_state_for(const MapState& s, const Params& p) {
+    if (p.fusion == FUSION_RELAXED) {
+        require(s.window_vertices.shape[1] >= 1,
+                "state has no relaxed window (window_vertices axis 1 is 0), but params.fusion "
+                "is FUSION_RELAXED");
+        require(s.base_vertices.shape[2] == CAPACITY,
+                "state.base_vertices has no vertex slots, but params.fusion is FUSION_RELAXED");
+    }
+    if (p.fusion == FUSION_ROBUST) {
+        require(s.level_vertices.shape[2] >= 1,
+                "state has no robust levels (level_vertices axis 2 is 0), but params.fusion "
+                "is FUSION_ROBUST");
+        require(!p.estimate_bound || s.probe_vertices.shape[2] == CAPACITY,
+                "state.probe_vertices has no vertex slots, but params.estimate_bound is set");
+        require(!p.estimate_bound || s.history_bearings.shape[1] >= 1,
+                "state has no bearing history (history_bearings axis 1 is 0), but "
+                "params.estimate_bound is set");
+    }
+}
+
+void check_copyable(const MapState& from, const MapState& to, const char* what) {
+    require(from.vertices.data != to.vertices.data,
+            std::string(what) + " needs two different states");
+    const auto axes = [](const MapState& s) {
+        return std::vector<int64_t>{s.vertices.shape[1],       s.window_vertices.shape[1],
+                                    s.base_vertices.shape[2],  s.level_vertices.shape[2],
+                                    s.probe_vertices.shape[2], s.history_bearings.shape[1]};
+    };
+    if (axes(from) != axes(to)) {
+        invalid_argument(std::string(what) +
+                         " needs states of the same landmarks and fusion arrays: from has " +
+                         std::to_string(from.vertices.shape[1]) + " mapped landmarks, to " +
+                         std::to_string(to.vertices.shape[1]));
+    }
+}
+
+void check_rows(View1<const int64_t> rows, int64_t size, bool distinct, const char* name) {
+    thread_local std::unique_ptr<bool[]> seen;  // check_indices' table, reused
+    thread_local int64_t seen_size = 0;
+    if (distinct && seen_size < size) {
+        seen.reset(new bool[static_cast<size_t>(size)]);
+        seen_size = size;
+    }
+    const int64_t status =
+        slam::check_indices(rows.data, rows.shape[0], size, distinct, seen.get());
+    for (int64_t k = 0; k < rows.shape[0] && status == INDEX_OUT_OF_RANGE; ++k) {
+        if (rows[k] < 0 || rows[k] >= size) {
+            invalid_argument(std::string(name) + " holds " + std::to_string(rows[k]) +
+                             " at position " + std::to_string(k) + ", outside [0, " +
+                             std::to_string(size) + ")");
+        }
+    }
+    require(status != INDEX_REPEATED, std::string(name) + " must not repeat a row");
+}
+
+void update_maps(View2<const double> bearings_start, View2<const double> bearings_end,
+                 View1<const int64_t> rows, const Params& params, const MapState& state,
+                 const Outputs& out, int64_t threads) {
+    require(threads >= 1, "threads must be at least 1, not " + std::to_string(threads));
+    // Threads write their maps concurrently: a map in two blocks would race.
+    check_rows(rows, state.vertices.shape[0], threads > 1);
+    const int64_t size = rows.shape[0], mapped = state.vertices.shape[1];
+    for (const auto& [bearings, name] :
+         {std::pair{bearings_start, "bearings_start"}, std::pair{bearings_end, "bearings_end"}}) {
+        check_axis(bearings, 0, size, name);
+        check_axis(bearings, 1, mapped + 2, name);
+    }
+    check_axis(out.frame_status, 0, size, "out.frame_status");
+    check_axis(out.landmark_status, 0, size, "out.landmark_status");
+    check_axis(out.landmark_status, 1, mapped, "out.landmark_status");
+    check_axis(out.n_bad, 0, size, "out.n_bad");
+    check_state_for(state, params);
+    slam::update_maps(bearings_start, bearings_end, rows, params, state, out, threads);
+}
+
+void copy_maps(const MapState& from, View1<const int64_t> rows, const MapState& to) {
+    check_copyable(from, to, "copy_maps");
+    check_rows(rows, from.vertices.shape[0], false);
+    require(rows.shape[0] <= to.vertices.shape[0],
+            "rows has " + std::to_string(rows.shape[0]) + " entries, more than to's " +
+                std::to_string(to.vertices.shape[0]) + " maps");
+    slam::copy_maps(from, rows, to);
+}
+
+int64_t check_indices(View1<const int64_t> indices, int64_t size, bool distinct) {
+    require(!distinct || size >= 0, "size must not be negative, got " + std::to_string(size));
+    const int64_t n = indices.shape[0];
+    if (!distinct) return slam::check_indices(indices.data, n, size, false, nullptr);
+    // The kernel's table of seen indices needs a slot per index in range only up to the
+    // largest one given, not `size` slots (a huge size would allocate and clear that
+    // much): with `limit` for `size`, an index is in range exactly when it was before.
+    int64_t limit = 0;
+    for (int64_t k = 0; k < n; ++k) {
+        if (indices(k) >= 0 && indices(k) < size) limit = std::max(limit, indices(k) + 1);
+    }
+    constexpr int64_t MAX_TABLE = int64_t{1} << 20;
+    if (limit <= MAX_TABLE) {
+        std::unique_ptr<bool[]> seen(new bool[static_cast<size_t>(limit)]);
+        return slam::check_indices(indices.data, n, limit, true, seen.get());
+    }
+    // Sparse large indices: the kernel's answer (the first problem in order) from a sorted
+    // copy of the indices before the first one out of range.
+    int64_t stop = 0;
+    while (stop < n && indices(stop) >= 0 && indices(stop) < size) ++stop;
+    std::vector<int64_t> sorted(indices.data, indices.data + stop);
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return INDEX_REPEATED;
+    return stop < n ? INDEX_OUT_OF_RANGE : INDEX_OK;
+}
+
+void contains_points(View3<const cplx> vertices, View2<const int64_t> counts,
+                     View1<const int64_t> rows, View2<const cplx> points, double relative,
+                     View2<bool> out) {
+    check_axis(counts, 0, vertices.shape[0], "counts");
+    check_axis(counts, 1, vertices.shape[1], "counts");
+    check_axis(points, 0, rows.shape[0], "points");
+    check_axis(points, 1, counts.shape[1], "points");
+    check_shape(out, points, "out");
+    for (int64_t i = 0; i < rows.shape[0]; ++i) {
+        if (rows(i) < 0 || rows(i) >= vertices.shape[0]) {
+            invalid_argument("rows must be map indices in [0, " +
+                             std::to_string(vertices.shape[0]) + "), got " +
+                             std::to_string(rows(i)));
+        }
+        for (int64_t j = 0; j < counts.shape[1]; ++j) {
+            if (counts(rows(i), j) > vertices.shape[2]) {
+                invalid_argument("counts must not exceed vertices' last axis (" +
+                                 std::to_string(vertices.shape[2]) + "), got " +
+                                 std::to_string(counts(rows(i), j)));
+            }
+        }
+    }
+    slam::contains_points(vertices, counts, rows, points, relative, out);
+}
+
+std::pair<int64_t, int64_t> relaxed_region(const MapState& s, int64_t row, int64_t j,
+                                           View1<const int64_t> slots, bool use_base,
+                                           int64_t max_outliers, Out out) {
+    check_map_and_slot(s, row, j);
+    const int64_t w = s.window_vertices.shape[1], k = slots.shape[0];
+    require(1 <= k && k <= w, "slots must hold 1.." + std::to_string(w) + " window slots");
+    for (int64_t i = 0; i < k; ++i) {
+        require(0 <= slots(i) && slots(i) < w, "slots must index the window");
+    }
+    require(0 <= max_outliers && max_outliers < MAX_WINDOW, "max_outliers out of range");
+    require(out.shape[0] >= SCRATCH, "out must hold SCRATCH points");
+    for (int64_t i = 0; i < k; ++i) {
+        check_region_count(s.window_counts(row, slots(i), j), s.window_vertices.shape[3],
+                           "window_counts");
+    }
+    if (use_base) {
+        check_region_count(s.base_counts(row, j), s.base_vertices.shape[2], "base_counts");
+    }
+    Scratch& scratch = thread_buffers().scratch;  // reused, not zeroed per call
+    for (int64_t i = 0; i < k; ++i) scratch.slots[i] = slots(i);
+    const auto [n, q] = slam::relaxed_region(s, row, j, k, use_base, max_outliers, scratch);
+    for (int64_t v = 0; v < n; ++v) out(v) = scratch.acc[v];
+    return {n, q};
+}
+
+void update_levels(const MapState& s, int64_t row, int64_t j, In fresh) {
+    check_map_and_slot(s, row, j);
+    const int64_t levels = s.level_vertices.shape[2];
+    require(levels > 0, "the state has no robust levels (fusion must be 'robust')");
+    require(3 <= fresh.shape[0] && fresh.shape[0] <= CAPACITY,
+            "fresh must have 3.." + std::to_string(CAPACITY) + " vertices");
+    require(s.n_regions(row, j) >= 0, "state.n_regions is negative: a corrupt state");
+    for (int64_t k = 0; k < levels; ++k) {
+        check_region_count(s.level_counts(row, j, k), s.level_vertices.shape[3], "level_counts");
+    }
+    Scratch& scratch = thread_buffers().scratch;  // reused, not zeroed per call
+    for (int64_t v = 0; v < fresh.shape[0]; ++v) scratch.fresh[v] = fresh(v);
+    slam::update_levels(s, row, j, fresh.shape[0], scratch);
 }
 
 }  // namespace bearing::slam::checked

@@ -12,6 +12,7 @@
 #include <bearing_core/core/complex.hpp>
 #include <bearing_core/core/views.hpp>
 #include <bearing_core/slam/frames.hpp>
+#include <bearing_core/slam/state.hpp>
 
 namespace bearing::slam::checked {
 
@@ -54,5 +55,40 @@ std::pair<int64_t, int64_t> transfer_polygon(In target, In a1, In a2, int64_t tr
 // [point][piece of L1][piece of L2]); returns (m1, m2).
 std::pair<int64_t, int64_t> sub_square_growths(In target, In a1, In a2, int64_t per_edge,
                                                View1<double> out);
+
+// ---- The map state and the batch helpers (state.hpp, update.hpp, fusion.hpp, robust.hpp).
+
+// The state `s` (`label` in messages) fits the update's buffers: vertex axes of CAPACITY
+// or 0 (base_vertices, probe_vertices), a window of at most MAX_WINDOW movements and at
+// most MAX_LANDMARKS - 2 mapped landmarks. (Its arrays' shapes agree by its schema.)
+void check_state(const MapState& s, const char* label);
+// What the fusion of `p` needs of the state's optional arrays.
+void check_state_for(const MapState& s, const Params& p);
+// `to` can take copies of `from`'s maps (`what` in messages): another state, of the same
+// landmarks and fusion arrays.
+void check_copyable(const MapState& from, const MapState& to, const char* what);
+// The indices `rows` (argument `name`) are in [0, size), none repeated if `distinct`.
+void check_rows(View1<const int64_t> rows, int64_t size, bool distinct, const char* name = "rows");
+
+// update_maps (update.hpp) with its arguments checked: the rows, the bearings (rows, n),
+// the outputs' rows and the state's arrays for params.
+void update_maps(View2<const double> bearings_start, View2<const double> bearings_end,
+                 View1<const int64_t> rows, const Params& params, const MapState& state,
+                 const Outputs& out, int64_t threads);
+void copy_maps(const MapState& from, View1<const int64_t> rows, const MapState& to);
+// check_indices (update.hpp) of any size: its table of seen indices is as long as the
+// largest index given needs, not `size`.
+int64_t check_indices(View1<const int64_t> indices, int64_t size, bool distinct);
+void contains_points(View3<const cplx> vertices, View2<const int64_t> counts,
+                     View1<const int64_t> rows, View2<const cplx> points, double relative,
+                     View2<bool> out);
+// The relaxed fusion's region of landmark j of map `row` over the window slots `slots`,
+// with the bases if use_base: (n, q), the region in out[:n] (SCRATCH).
+std::pair<int64_t, int64_t> relaxed_region(const MapState& s, int64_t row, int64_t j,
+                                           View1<const int64_t> slots, bool use_base,
+                                           int64_t max_outliers, Out out);
+// Fuse the region `fresh` (3..CAPACITY vertices) into landmark j's robust levels of map
+// `row`.
+void update_levels(const MapState& s, int64_t row, int64_t j, In fresh);
 
 }  // namespace bearing::slam::checked
