@@ -103,18 +103,7 @@ void bind_sim(nb::module_& m) {
         "vertices"_a, "starts"_a,
         "Whether a sensor at (x, y) facing heading sees the target (field of view, range, "
         "line of sight).");
-    def(
-        m, "inside_polygon",
-        +[](double x, double y, Vertices vertices, int64_t first, int64_t last) {
-            bearing::check_axis(vertices, 1, 2, "vertices");
-            if (first < last && (first < 0 || last > vertices.shape[0])) {
-                bearing::invalid_argument("first and last must lie in [0, " +
-                                          std::to_string(vertices.shape[0]) + "], got " +
-                                          std::to_string(first) + " and " + std::to_string(last));
-            }
-            return sim::inside_polygon(x, y, vertices, first, last);
-        },
-        "x"_a, "y"_a, "vertices"_a, "first"_a, "last"_a,
+    def(m, "inside_polygon", &sim::inside_polygon, "x"_a, "y"_a, "vertices"_a, "first"_a, "last"_a,
         "Whether (x, y) lies inside the polygon vertices[first:last] (even-odd rule).");
     def(m, "_segment_distance", &sim::segment_distance, "x"_a, "y"_a, "ax"_a, "ay"_a, "bx"_a,
         "by"_a);

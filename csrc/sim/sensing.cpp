@@ -115,6 +115,11 @@ bool visible(double x, double y, double heading, double target_x, double target_
 }
 
 bool inside_polygon(double x, double y, View2<const double> vertices, int64_t first, int64_t last) {
+    check_axis(vertices, 1, 2, "vertices");
+    if (first < last && (first < 0 || last > vertices.shape[0])) {
+        invalid_argument("first and last must lie in [0, " + std::to_string(vertices.shape[0]) +
+                         "], got " + std::to_string(first) + " and " + std::to_string(last));
+    }
     bool inside = false;
     for (int64_t k = first; k < last; ++k) {
         const int64_t following = k + 1 < last ? k + 1 : first;

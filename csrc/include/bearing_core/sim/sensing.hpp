@@ -53,6 +53,8 @@ bool line_of_sight(double x, double y, double target_x, double target_y,
                    const Obstacles& obstacles);
 bool visible(double x, double y, double heading, double target_x, double target_y, double half_fov,
              double max_range, const Obstacles& obstacles);
+// Whether (x, y) lies inside the polygon vertices[first:last] (std::invalid_argument if
+// that range leaves the vertices).
 bool inside_polygon(double x, double y, View2<const double> vertices, int64_t first, int64_t last);
 double segment_distance(double x, double y, double ax, double ay, double bx, double by);
 double clearance(double x, double y, const Obstacles& obstacles);
