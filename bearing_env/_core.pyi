@@ -9,16 +9,16 @@ import enum
 class CapacityError(RuntimeError):
     pass
 
-def cross(a: object, b: object) -> float:
+def cross(a: complex, b: complex) -> float:
     """2-D cross product a.x * b.y - a.y * b.x."""
 
-def dot(a: object, b: object) -> float:
+def dot(a: complex, b: complex) -> float:
     """2-D dot product."""
 
 def wrap(angle: float) -> float:
     """An angle wrapped to [-pi, pi)."""
 
-def scale_of(poly: object, n: int) -> tuple:
+def scale_of(poly: object, n: int) -> tuple[float, float]:
     """(bounding-box size, largest coordinate magnitude) of poly[:n]."""
 
 def tolerance_of(size: float, magnitude: float) -> float:
@@ -37,10 +37,10 @@ def small_convex_hull(points: object, n_points: int, out: object, tol: float) ->
 def small_hull_indices(points: object, n_points: int, out: object, tol: float) -> int:
     """small_convex_hull as indices (int64 out, n_points + 1)."""
 
-def area_centroid(poly: object, n: int) -> tuple:
+def area_centroid(poly: object, n: int) -> tuple[float, complex]:
     """(area, centroid) of a convex polygon (the vertex mean if degenerate)."""
 
-def contains_point(poly: object, n: int, point: object, relative: float) -> bool:
+def contains_point(poly: object, n: int, point: complex, relative: float) -> bool:
     """
     Whether point lies in the convex polygon poly[:n], to within relative * its size.
     """
@@ -73,7 +73,7 @@ def offset_outward(poly: object, n: int, radius: float, out: object) -> int:
     Every edge of a convex polygon moved outward by radius, into out (n + 3).
     """
 
-def cone_region(a: float, b: float, epsilon: float, out: object) -> tuple:
+def cone_region(a: float, b: float, epsilon: float, out: object) -> tuple[int, int]:
     """
     (n, status): the FR region of a landmark seen at bearings a and b, into out (4).
     """
@@ -82,8 +82,8 @@ def boundary_samples(poly: object, n: int, per_edge: int, out: object) -> int:
     """per_edge evenly spaced points on each edge, vertices included."""
 
 def frame_plan(
-    a1: object, n1: int, a2: object, n2: int, conservative: object, edge_samples: int
-) -> tuple:
+    a1: object, n1: int, a2: object, n2: int, conservative: bool, edge_samples: int
+) -> tuple[int, int, float, float, float]:
     """(status, per_edge, distance, delta1, delta2) of a frame change."""
 
 def sample_hypotheses(
@@ -100,12 +100,14 @@ def transfer_region(
 
 def transfer_polygon(
     target: object, a1: object, a2: object, transfer: int, edge_samples: int, out: object
-) -> tuple:
+) -> tuple[int, int]:
     """
     (status, n): one FR region's change of frames as the update runs it, into out (SCRATCH).
     """
 
-def sub_square_growths(target: object, a1: object, a2: object, per_edge: int, out: object) -> tuple:
+def sub_square_growths(
+    target: object, a1: object, a2: object, per_edge: int, out: object
+) -> tuple[int, int]:
     """
     (m1, m2): the local bound of every target point and sub-square into out (float64, n_target * m1 * m2).
     """
@@ -337,7 +339,7 @@ def contains_points(
 
 def relaxed_region(
     state: MapState, row: int, j: int, slots: object, use_base: bool, max_outliers: int, out: object
-) -> tuple:
+) -> tuple[int, int]:
     """
     (n, q): landmark j's q-relaxed region over the window slots, into out[:n].
     """

@@ -8,9 +8,9 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <initializer_list>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include <bearing_core/core/complex.hpp>
 #include <bearing_core/core/views.hpp>
@@ -21,19 +21,15 @@ namespace nb = nanobind;
 
 // numpy's name of each element type the kernels take.
 template <class T>
-struct dtype_name;
-#define BEARING_BINDINGS_DTYPE(T, name)            \
-    template <>                                    \
-    struct dtype_name<T> {                         \
-        static constexpr const char* value = name; \
-    };
-BEARING_BINDINGS_DTYPE(double, "float64")
-BEARING_BINDINGS_DTYPE(float, "float32")
-BEARING_BINDINGS_DTYPE(int64_t, "int64")
-BEARING_BINDINGS_DTYPE(int8_t, "int8")
-BEARING_BINDINGS_DTYPE(bool, "bool")
-BEARING_BINDINGS_DTYPE(cplx, "complex128")
-#undef BEARING_BINDINGS_DTYPE
+constexpr const char* dtype_name() {
+    if constexpr (std::is_same_v<T, double>) return "float64";
+    if constexpr (std::is_same_v<T, float>) return "float32";
+    if constexpr (std::is_same_v<T, int64_t>) return "int64";
+    if constexpr (std::is_same_v<T, int8_t>) return "int8";
+    if constexpr (std::is_same_v<T, bool>) return "bool";
+    if constexpr (std::is_same_v<T, cplx>) return "complex128";
+    return "";  // (no other element type is bound)
+}
 
 template <class T>
 nb::dlpack::dtype dtype_of() {
@@ -51,16 +47,6 @@ nb::dlpack::dtype dtype_of() {
     throw nb::value_error(message.c_str());
 }
 
-// An expected shape's entry for an axis of any length.
-inline constexpr int64_t ANY_LENGTH = -1;
-
-template <int D>
-constexpr std::array<int64_t, D> any_shape() {
-    std::array<int64_t, D> shape{};
-    for (int d = 0; d < D; ++d) shape[d] = ANY_LENGTH;
-    return shape;
-}
-
 // A bool array's bytes are 0 or 1 (numpy writes no other, but a view of other bytes can
 // hold any; the kernels would read such a byte as neither true nor false).
 inline void check_bool_bytes(const bool* data, int64_t size, const char* name) {
@@ -76,11 +62,10 @@ inline void check_bool_bytes(const bool* data, int64_t size, const char* name) {
 // A view of the numpy array `obj` (argument `name`): dtype T, D dimensions, C-contiguous,
 // aligned for T, and writeable unless T is const; a read-only bool array (const bool)
 // holds only 0 and 1 (a state's bool arrays, read and written, are checked by their
-// parser, state_args.hpp). Entries
-// of `expect` other than ANY_LENGTH must match (0 included).
+// parser, read_struct). Its shape is the caller's to check (a kernel's checked entry point,
+// or the struct's schema).
 template <class T, int D>
-View<T, D> view_of(nb::handle obj, const char* name,
-                   const std::array<int64_t, D>& expect = any_shape<D>()) {
+View<T, D> view_of(nb::handle obj, const char* name) {
     using Element = std::remove_const_t<T>;
     // Read-only arrays are taken too (nb::ro); a view of a non-const T checks writeability
     // below, naming the argument.
@@ -90,7 +75,7 @@ View<T, D> view_of(nb::handle obj, const char* name,
                    nb::type_name(obj.type()).c_str());
     }
     if (array.dtype() != dtype_of<Element>()) {
-        type_error(std::string(name) + " must have dtype " + dtype_name<Element>::value);
+        type_error(std::string(name) + " must have dtype " + dtype_name<Element>());
     }
     if (static_cast<int>(array.ndim()) != D) {
         value_error(std::string(name) + " must have " + std::to_string(D) + " dimensions, not " +
@@ -106,10 +91,6 @@ View<T, D> view_of(nb::handle obj, const char* name,
             value_error(std::string(name) + " must be C-contiguous");
         }
         expected_stride *= view.shape[d];
-        if (expect[d] != ANY_LENGTH && view.shape[d] != expect[d]) {
-            value_error(std::string(name) + " has axis " + std::to_string(d) + " of length " +
-                        std::to_string(view.shape[d]) + ", expected " + std::to_string(expect[d]));
-        }
     }
     if constexpr (!std::is_const_v<T>) {
         if (array.size() > 0 && !nb::cast<bool>(obj.attr("flags").attr("writeable"))) {
@@ -142,9 +123,9 @@ Extent extent_of(const View<T, D>& view, const char* name) {
 // No array a kernel writes shares memory with another of its arguments: the kernels read
 // their inputs while they write their outputs, so an overlap would change the result
 // midway. ValueError naming both.
-inline void require_apart(std::initializer_list<Extent> arrays) {
-    for (const Extent* a = arrays.begin(); a != arrays.end(); ++a) {
-        for (const Extent* b = a + 1; b != arrays.end(); ++b) {
+inline void require_apart(const std::vector<Extent>& arrays) {
+    for (auto a = arrays.begin(); a != arrays.end(); ++a) {
+        for (auto b = a + 1; b != arrays.end(); ++b) {
             if (!(a->written || b->written) || a->bytes == 0 || b->bytes == 0) continue;
             const auto* a_begin = static_cast<const char*>(a->data);
             const auto* b_begin = static_cast<const char*>(b->data);

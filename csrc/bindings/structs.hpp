@@ -6,15 +6,13 @@
 
 #include <nanobind/nanobind.h>
 
-#include <memory>
 #include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
 #include <bearing_core/core/schema.hpp>
-#include <bearing_core/slam/state.hpp>
-#include <bearing_core/slam/update.hpp>
+#include <bearing_core/slam/checked.hpp>
 #include "bindings/arrays.hpp"
 
 namespace bearing::bindings {
@@ -97,7 +95,7 @@ nb::tuple new_struct(const schema::Sizes& sizes, Struct& out) {
         constexpr int D = std::tuple_size_v<decltype(view.shape)>;
         nb::list shape;
         for (int64_t length : schema::shape_of(rule, sizes)) shape.append(length);
-        nb::object array = numpy.attr("zeros")(nb::tuple(shape), dtype_name<Element>::value);
+        nb::object array = numpy.attr("zeros")(nb::tuple(shape), dtype_name<Element>());
         view = view_of<Element, D>(array, name);
         arrays.append(array);
     });
@@ -113,43 +111,20 @@ nb::tuple array_schema() {
     size_t k = 0;
     for_each_field(probe, [&](const char* name, const char* rule, const auto& view) {
         using Element = std::remove_const_t<std::remove_pointer_t<decltype(view.data)>>;
-        fields.append(nb::make_tuple(name, dtype_name<Element>::value, rule, docs[k++]));
+        fields.append(nb::make_tuple(name, dtype_name<Element>(), rule, docs[k++]));
     });
     return nb::tuple(fields);
 }
 
-// The int64 indices `obj` (argument `name`) into [0, size), none repeated if `distinct`.
-inline View1<const int64_t> rows_of(nb::handle obj, int64_t size, bool distinct,
-                                    const char* name = "rows") {
-    const auto rows = view_of<const int64_t, 1>(obj, name);
-    thread_local std::unique_ptr<bool[]> seen;  // check_indices' table, reused
-    thread_local int64_t seen_size = 0;
-    if (distinct && seen_size < size) {
-        seen.reset(new bool[static_cast<size_t>(size)]);
-        seen_size = size;
-    }
-    const int64_t status =
-        slam::check_indices(rows.data, rows.shape[0], size, distinct, seen.get());
-    for (int64_t k = 0; k < rows.shape[0] && status == slam::INDEX_OUT_OF_RANGE; ++k) {
-        if (rows[k] < 0 || rows[k] >= size) {
-            value_error(std::string(name) + " holds " + std::to_string(rows[k]) + " at position " +
-                        std::to_string(k) + ", outside [0, " + std::to_string(size) + ")");
-        }
-    }
-    if (status == slam::INDEX_REPEATED) value_error(std::string(name) + " must not repeat a row");
-    return rows;
-}
-
-// The Python type of a setting, as the schema names it.
+// The Python type of a setting, as the schema names it (an enum's IntEnum, bound before).
 template <class T>
-const char* python_type() {
-    if constexpr (std::is_same_v<T, bool>) {
-        return "bool";
-    } else if constexpr (std::is_floating_point_v<T>) {
-        return "float";
+nb::object python_type() {
+    if constexpr (std::is_enum_v<T>) {
+        return nb::type<T>().attr("__name__");
+    } else if constexpr (std::is_same_v<T, bool>) {
+        return nb::str("bool");
     } else {
-        static_assert(std::is_integral_v<T>, "an enum's Python name is given where it is bound");
-        return "int";
+        return nb::str(std::is_floating_point_v<T> ? "float" : "int");
     }
 }
 

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
+#include <bearing_core/core/checks.hpp>
 #include <bearing_core/core/pymath.hpp>
 
 namespace bearing::sim {
@@ -113,6 +115,11 @@ bool visible(double x, double y, double heading, double target_x, double target_
 }
 
 bool inside_polygon(double x, double y, View2<const double> vertices, int64_t first, int64_t last) {
+    check_axis(vertices, 1, 2, "vertices");
+    if (first < last && (first < 0 || last > vertices.shape[0])) {
+        invalid_argument("first and last must lie in [0, " + std::to_string(vertices.shape[0]) +
+                         "], got " + std::to_string(first) + " and " + std::to_string(last));
+    }
     bool inside = false;
     for (int64_t k = first; k < last; ++k) {
         const int64_t following = k + 1 < last ? k + 1 : first;
@@ -130,6 +137,22 @@ double segment_distance(double x, double y, double ax, double ay, double bx, dou
                          ? 0.0
                          : std::min(std::max(((x - ax) * ex + (y - ay) * ey) / squared, 0.0), 1.0);
     return std::hypot(x - ax - t * ex, y - ay - t * ey);
+}
+
+Obstacles Obstacles::checked(View2<const double> vertices, View1<const int64_t> starts,
+                             const char* vertices_name, const char* starts_name) {
+    check_axis(vertices, 1, 2, vertices_name);
+    const int64_t count = vertices.shape[0];
+    for (int64_t p = 0; p + 1 < starts.shape[0]; ++p) {
+        const int64_t first = starts[p], last = starts[p + 1];
+        if (first < last && (first < 0 || last > count)) {
+            invalid_argument(std::string(starts_name) + " indexes past the " +
+                             std::to_string(count) + " obstacle vertices (polygon " +
+                             std::to_string(p) + ": " + std::to_string(first) + " to " +
+                             std::to_string(last) + ")");
+        }
+    }
+    return {vertices, starts};
 }
 
 double clearance(double x, double y, const Obstacles& obstacles) {
@@ -151,6 +174,7 @@ double clearance(double x, double y, const Obstacles& obstacles) {
 void visible_rows(View3<const double> landmarks, View2<const double> positions,
                   View1<const double> headings, double half_fov, double max_range,
                   const Obstacles& obstacles, View2<bool> out) {
+    check_landmark_rows(landmarks, positions, headings, out);
     for (int64_t i = 0; i < landmarks.shape[0]; ++i) {
         for (int64_t j = 0; j < landmarks.shape[1]; ++j) {
             out(i, j) = visible(positions(i, 0), positions(i, 1), headings[i], landmarks(i, j, 0),

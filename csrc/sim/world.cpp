@@ -5,12 +5,15 @@
 #include <cmath>
 #include <limits>
 
+#include <bearing_core/core/checks.hpp>
 #include <bearing_core/core/pymath.hpp>
 
 namespace bearing::sim {
 
 void add_wrapped(View2<const double> true_bearings, View2<const double> offsets,
                  View2<double> out) {
+    check_shape(offsets, true_bearings, "offsets");
+    check_shape(out, true_bearings, "out");
     for (int64_t i = 0; i < true_bearings.shape[0]; ++i) {
         for (int64_t j = 0; j < true_bearings.shape[1]; ++j) {
             out(i, j) = wrap(true_bearings(i, j) + offsets(i, j));
@@ -21,6 +24,10 @@ void add_wrapped(View2<const double> true_bearings, View2<const double> offsets,
 void add_wrapped_with_outliers(View2<const double> true_bearings, View2<const double> offsets,
                                View2<const bool> is_outlier, View2<const double> replacement,
                                View2<double> out) {
+    check_shape(offsets, true_bearings, "offsets");
+    check_shape(is_outlier, true_bearings, "is_outlier");
+    check_shape(replacement, true_bearings, "replacement");
+    check_shape(out, true_bearings, "out");
     for (int64_t i = 0; i < true_bearings.shape[0]; ++i) {
         for (int64_t j = 0; j < true_bearings.shape[1]; ++j) {
             const double value =
@@ -66,6 +73,7 @@ Move obstructed_move(double x, double y, double heading, double length,
 
 void true_bearings_into(View3<const double> landmarks, View2<const double> positions,
                         View1<const double> headings, View2<double> out) {
+    check_landmark_rows(landmarks, positions, headings, out);
     for (int64_t i = 0; i < landmarks.shape[0]; ++i) {
         for (int64_t j = 0; j < landmarks.shape[1]; ++j) {
             out(i, j) = bearing(landmarks(i, j, 0), landmarks(i, j, 1), positions(i, 0),

@@ -91,7 +91,7 @@ FUZZED: frozenset[str] = frozenset(
         "polygon_distance", "longest_edge", "simplify", "drop_edges_outward", "clip_convex",
         "offset_outward", "cone_region", "boundary_samples", "frame_plan",
         "sample_hypotheses", "transfer_region", "transfer_polygon", "sub_square_growths",
-        # bind_slam_update.cpp
+        # bind_slam.cpp
         "MapState", "Params", "update_maps", "copy_maps", "check_indices", "none_infinite",
         "contains_points", "binomial_q", "relaxed_region", "update_levels",
         # bind_sim.cpp
@@ -610,7 +610,7 @@ def test_sub_square_growths_of_any_target_and_regions(
 
 
 # ----------------------------------------------------------------------------------------
-# bind_slam_update.cpp: the map update and its helpers
+# bind_slam.cpp: the map update and its helpers
 # ----------------------------------------------------------------------------------------
 
 #: The fuzzed map batches: a few maps of a few landmarks, after real movements.
@@ -1925,7 +1925,7 @@ BAD_ARGUMENTS: list[tuple[str, str, str, str, type[Exception], str]] = [
     ("geometry", "transfer_region", "cloud", "dtype", TypeError, "cloud"),
     ("geometry", "transfer_region", "hull", "read_only", ValueError, "hull"),
     ("geometry", "transfer_region", "out", "short", ValueError, "out"),
-    # bind_slam_update.cpp
+    # bind_slam.cpp
     ("update", "MapState", "state.counts", "dtype", TypeError, "state.counts"),
     ("update", "MapState", "state.vertices", "strided", ValueError, "state.vertices"),
     ("update", "MapState", "state.window_inlier", "ndim", ValueError, "state.window_inlier"),

@@ -49,7 +49,7 @@ BINDINGS = "a module part's registration list: one m.def per kernel, in the orde
 ALLOWED_LONG: dict[str, str] = {
     "csrc/bindings/bind_env.cpp:bind_env": BINDINGS,
     "csrc/bindings/bind_sim.cpp:bind_sim": BINDINGS,
-    "csrc/bindings/bind_slam_update.cpp:bind_slam_update": BINDINGS,
+    "csrc/bindings/bind_slam.cpp:bind_slam": BINDINGS,
 }
 
 #: Words that take parentheses but never name a function being defined.

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 
+#include <bearing_core/core/checks.hpp>
 #include <bearing_core/core/views.hpp>
 
 namespace bearing::sim {
@@ -15,12 +16,30 @@ namespace bearing::sim {
 // Rounding slack (metres) of the contact tests (sensing.CONTACT_SLACK).
 inline constexpr double CONTACT_SLACK = 1e-12;
 
-// Packed obstacles: vertices (V, 2) and starts (k + 1,). The bindings check that every
-// start lies in [0, V] and that they do not decrease.
+// Packed obstacles: vertices (V, 2) and starts (k + 1,).
 struct Obstacles {
     View2<const double> vertices;
     View1<const int64_t> starts;
+
+    // Obstacles whose polygons' vertex ranges stay in `vertices` (the kernels index it
+    // unchecked); std::invalid_argument naming the array otherwise.
+    static Obstacles checked(View2<const double> vertices, View1<const int64_t> starts,
+                             const char* vertices_name = "vertices",
+                             const char* starts_name = "starts");
 };
+
+// The arrays of a kernel over landmarks (N, n, 2) seen from poses (N, 2), (N,) into out
+// (N, n) agree in shape: std::invalid_argument naming the one that does not.
+template <class T>
+void check_landmark_rows(View3<const double> landmarks, View2<const double> positions,
+                         View1<const double> headings, const View2<T>& out) {
+    check_axis(landmarks, 2, 2, "landmarks");
+    check_axis(positions, 0, landmarks.shape[0], "positions");
+    check_axis(positions, 1, 2, "positions");
+    check_axis(headings, 0, landmarks.shape[0], "headings");
+    check_axis(out, 0, landmarks.shape[0], "out");
+    check_axis(out, 1, landmarks.shape[1], "out");
+}
 
 double edge_entry(double x, double y, double dx, double dy, double ax, double ay, double bx,
                   double by, double margin);
@@ -34,6 +53,8 @@ bool line_of_sight(double x, double y, double target_x, double target_y,
                    const Obstacles& obstacles);
 bool visible(double x, double y, double heading, double target_x, double target_y, double half_fov,
              double max_range, const Obstacles& obstacles);
+// Whether (x, y) lies inside the polygon vertices[first:last] (std::invalid_argument if
+// that range leaves the vertices).
 bool inside_polygon(double x, double y, View2<const double> vertices, int64_t first, int64_t last);
 double segment_distance(double x, double y, double ax, double ay, double bx, double by);
 double clearance(double x, double y, const Obstacles& obstacles);
