@@ -128,6 +128,14 @@ def find_vecnormalize(model_path: Path) -> Path | None:
     return None
 
 
+#: The modules of the actor-critic policies (SB3's and this package's own).
+ACTOR_CRITIC_MODULES: tuple[str, ...] = (
+    "stable_baselines3.common.policies",
+    "bearing_env.agents.extractors",
+    "bearing_env.agents.candidate_policy",
+)
+
+
 def infer_algorithm(model_path: Path) -> str:
     """The algorithm name (``"PPO"``, ``"SAC"``, ...) of a saved model, from its metadata."""
     try:
@@ -142,7 +150,7 @@ def infer_algorithm(model_path: Path) -> str:
         return _ALGORITHM_BY_POLICY_MODULE[module]
     if module.startswith("sb3_contrib.common.recurrent"):
         return "RecurrentPPO"
-    if module in ("stable_baselines3.common.policies", "bearing_env.agents.extractors"):
+    if module in ACTOR_CRITIC_MODULES:
         # Actor-critic: PPO and A2C share the policy; PPO alone saves n_epochs.
         return "PPO" if "n_epochs" in data else "A2C"
     raise ModelLoadError(

@@ -61,3 +61,12 @@ def test_it_refuses_an_observation_without_candidates() -> None:
     env = gym.make("bearing_env:BearingSLAMDiscrete-Khepera-v1")
     with pytest.raises(TypeError, match="planner_features"):
         PPO(CandidateScorerPolicy, env, device="cpu")
+
+
+def test_its_saved_model_is_read_as_ppo(tmp_path: Path) -> None:
+    from bearing_env.agents.sb3 import infer_algorithm
+
+    env = gym.make(KHEPERA)
+    model = PPO(CandidateScorerPolicy, env, n_steps=16, batch_size=16, device="cpu")
+    model.save(tmp_path / "model.zip")
+    assert infer_algorithm(tmp_path / "model.zip") == "PPO"
