@@ -160,6 +160,28 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--init-from pretrained:ppo_khepera --timesteps 2000000 "
     "--output runs/ppo_khepera_finetune": ("parse", ()),
     "bearing-env observability": ("parse", ()),
+    # The learned designs on the planner features (docs/evaluation.md).
+    "bearing-env train --algo ppo --env BearingSLAMDiscrete-Khepera-Planner-v1 --seeds 0 1 2 "
+    "--workers 2 --timesteps 1000000 --eval-freq 250000 --output runs/ppo_planner_khepera": (
+        "parse",
+        (),
+    ),
+    'bearing-env train --algo ppo --conf-file "$(bearing-env hyperparams ppo_candidates)" '
+    "--seeds 0 1 2 --timesteps 250000 --eval-freq 125000 "
+    "--output runs/ppo_planner_scorer_khepera": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAMDiscrete-Khepera-Planner-v1 --timesteps 4096 "
+    "--output runs/bc_init_khepera --export runs/bc_init_khepera/export/model": ("parse", ()),
+    "bearing-env distill --student runs/bc_init_khepera/export/model.zip --teacher lookahead "
+    "--iterations 4 --episodes 50 --output runs/bc_khepera": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAMDiscrete-Khepera-Planner-v1 --init-from "
+    "runs/bc_khepera/model.zip --seeds 0 1 2 --timesteps 250000 --eval-freq 125000 "
+    "--output runs/ppo_planner_bc_khepera": ("parse", ()),
+    "bearing-env evaluate runs/ppo_planner_khepera --name ppo_planner_mlp "
+    "--out outputs/evaluate_ppo_planner_mlp": ("parse", ()),
+    "bearing-env evaluate runs/ppo_planner_scorer_khepera --name ppo_planner_scorer "
+    "--out outputs/evaluate_ppo_planner_scorer": ("parse", ()),
+    "bearing-env evaluate runs/ppo_planner_bc_khepera --name ppo_planner_bc "
+    "--out outputs/evaluate_ppo_planner_bc": ("parse", ()),
     "bearing-env distill": ("help", ()),
     "bearing-env distill --student pretrained:ppo_khepera --teacher lookahead_oracle "
     "--iterations 4 --episodes 50 --output runs/distill_khepera": ("parse", ()),
@@ -215,13 +237,13 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "ray start --address=A_IP:6379": ("help", ()),
     "ray status": ("help", ()),
     "ray stop": ("help", ()),
-    'bearing-env bench --help': ('help', ()),
+    "bearing-env bench --help": ("help", ()),
     "bearing-env bench-callgrind --json benchmarks/results/bench_callgrind.json": ("help", ()),
-    'bearing-env bench --json benchmarks/results/bench_env.json': ('parse', ()),
-    'bearing-env compare --policies greedy oracle lookahead lookahead_oracle': ('parse', ()),
-    'bearing-env docs-tables': ('parse', ()),
-    'bearing-env generalisation': ('help', ()),
-    'bearing-env suite --episodes 200': ('parse', ()),
+    "bearing-env bench --json benchmarks/results/bench_env.json": ("parse", ()),
+    "bearing-env compare --policies greedy oracle lookahead lookahead_oracle": ("parse", ()),
+    "bearing-env docs-tables": ("parse", ()),
+    "bearing-env generalisation": ("help", ()),
+    "bearing-env suite --episodes 200": ("parse", ()),
     "bearing-env compare --policies random greedy --env bearing_env:BearingSLAM-Khepera-v0 "
     "--episodes 200": ("parse", ()),
     "bearing-env compare --policies random greedy --env bearing_env:BearingSLAM-Khepera-v1 "
@@ -231,8 +253,8 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "benchmarks/results/transfer_tightness_conservative.json": ("help", ()),
     "bearing-env transfer-tightness --transfer conservative_global --no-progress --json "
     "benchmarks/results/transfer_tightness_conservative_global.json": ("help", ()),
-    'bearing-env suite --tasks BearingSLAM-FurnishedRoom-v1 --workers 2': ('parse', ()),
-    'bearing-env suite --tasks BearingSLAM-Khepera-v1 --workers 2': ('parse', ()),
+    "bearing-env suite --tasks BearingSLAM-FurnishedRoom-v1 --workers 2": ("parse", ()),
+    "bearing-env suite --tasks BearingSLAM-Khepera-v1 --workers 2": ("parse", ()),
     "python -m bearing_env.train.studies.generalisation --model ppo_generalist --counts 3 8 12 "
     "16 --episodes 200 --out outputs/generalisation_generalist": ("parse", ()),
     "python -m rl_zoo3.train --algo ppo --env BearingSLAM-Random3to16-Entities-v1 "
@@ -240,17 +262,19 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
         "zoo",
         (),
     ),
-    'bearing-env suite --episodes 200 --workers 2': ('parse', ()),
-    'bearing-env docs-tables --check': ('parse', ()),
+    "bearing-env suite --episodes 200 --workers 2": ("parse", ()),
+    "bearing-env docs-tables --check": ("parse", ()),
     "cp outputs/compare_khepera_25cm/summary.json docs/compare/results/khepera_25cm.json": (
         "copy",
         (),
     ),
     "cp outputs/compare_khepera_discrete/summary.json "
     "docs/compare/results/settings_discrete.json": ("copy", ()),
-    "cp outputs/compare_random6/summary.json "
-    "docs/compare/results/settings_random6.json": ("copy", ()),
-    'cp outputs/compare_lookahead/summary.json docs/compare/results/lookahead.json': ('copy', ()),
+    "cp outputs/compare_random6/summary.json docs/compare/results/settings_random6.json": (
+        "copy",
+        (),
+    ),
+    "cp outputs/compare_lookahead/summary.json docs/compare/results/lookahead.json": ("copy", ()),
     "cmake -S . -B build/cpp -G Ninja -DBEARING_ENV_PYTHON=OFF": ("cpp", ()),
     "cmake --build build/cpp": ("cpp", ()),
     "ctest --test-dir build/cpp --output-on-failure": ("cpp", ()),
@@ -466,9 +490,7 @@ def test_readme_command_runs_or_parses(command: str, tmp_path: Path) -> None:
             program = [sys.executable, *argv[1:3]]
         else:
             program = [str(BIN / argv[0]), argv[1]]
-        result = subprocess.run(
-            [*program, "--help"], capture_output=True, text=True, timeout=120
-        )
+        result = subprocess.run([*program, "--help"], capture_output=True, text=True, timeout=120)
         assert result.returncode == 0, result.stderr[-3000:]
         assert documented_options(argv) <= set(re.findall(r"--[\w-]+", result.stdout))
     else:
