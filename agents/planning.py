@@ -150,7 +150,7 @@ def _simulate_natively(
     _core._simulate_potentials(
         batch._kernel_state(), slam.index, batch._kernel_params(False), complex(start),
         np.ascontiguousarray(landmarks, dtype=np.complex128), headings, distances,
-        float(area_cap), AREA_FLOOR, float(min_distance), bool(log_area),
+        float(min_distance), float(area_cap), AREA_FLOOR, bool(log_area),
         trials._kernel_state(), potentials,
     )  # fmt: skip
     return potentials

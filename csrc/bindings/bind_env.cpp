@@ -17,7 +17,6 @@
 #include <bearing_core/env/checked.hpp>
 #include <bearing_core/env/kernels.hpp>
 #include <bearing_core/env/robot_map.hpp>
-#include "bindings/args.hpp"
 #include "bindings/def.hpp"
 
 namespace nb = nanobind;
@@ -55,6 +54,28 @@ struct EnvInputs {
         env::checked::check_inputs(inputs);
     }
 };
+
+}  // namespace
+
+namespace bearing::bindings {
+// A group's inputs: an EnvInputs'.
+template <>
+struct Param<env::Inputs> {
+    using Args = std::tuple<const EnvInputs&>;
+    static const env::Inputs& from(Taken&, size_t, const EnvInputs& s) { return s.inputs; }
+};
+// The planners' structs, each from one Python argument per field.
+template <>
+struct Param<env::Candidates> : Fields<env::Candidates, cplx, View1<const cplx>,
+                                       View1<const double>, View1<const double>, double> {};
+template <>
+struct Param<env::Scoring> : Fields<env::Scoring, double, double, bool> {};
+template <>
+struct Param<env::Readings>
+    : Fields<env::Readings, View1<const int64_t>, View2<const double>, View2<const double>> {};
+}  // namespace bearing::bindings
+
+namespace {
 
 // The map state the codec reads, and its axes: an EnvInputs' (no arrays checked again:
 // the cheap form for a step's info), or what map_state_of takes.
@@ -254,20 +275,10 @@ void bind_env(nb::module_& m) {
         "rows"_a, "inputs"_a, "outputs"_a, "with_map"_a,
         "report_rows into outputs' first len(rows) rows (a step's reused arrays, as step_rows "
         "writes them): the rows' observations and infos as they stand.");
-    def(
-        m, "potentials",
-        +[](View1<const int64_t> rows, const EnvInputs& inputs, View1<double> out) {
-            env::checked::potentials(rows, inputs.inputs, out);
-        },
-        "rows"_a, "inputs"_a, "out"_a, "The uncertainty potential of each row's map into out.");
-    def(
-        m, "move_and_read",
-        +[](int64_t row, double turn, double length, const EnvInputs& inputs,
-            View1<double> reading_start, View1<double> reading_end) {
-            return env::checked::move_and_read(row, turn, length, inputs.inputs, reading_start,
-                                               reading_end);
-        },
-        "row"_a, "turn"_a, "length"_a, "inputs"_a, "reading_start"_a, "reading_end"_a,
+    def(m, "potentials", &env::checked::potentials, "rows"_a, "inputs"_a, "out"_a,
+        "The uncertainty potential of each row's map into out.");
+    def(m, "move_and_read", &env::checked::move_and_read, "row"_a, "turn"_a, "length"_a, "inputs"_a,
+        "reading_start"_a, "reading_end"_a,
         "Turn, read, move, read again: one row's movement; returns the distance travelled.");
     def(m, "append_positions", &env::checked::append_positions, "rows"_a, "positions"_a,
         "trajectory"_a, "lengths"_a,
@@ -322,42 +333,19 @@ void bind_env(nb::module_& m) {
     def(m, "_bearings_of", &env::checked::bearings_of, "differences"_a, "headings"_a, "out"_a,
         "out[k] = wrap(angle(differences[k]) - headings[k]), with libm's atan2.");
     def_released(
-        m, "_simulate_potentials",
-        +[](const PyMapState& maps, int64_t row, const slam::Params& params, cplx start,
-            View1<const cplx> landmarks, View1<const double> headings,
-            View1<const double> distances, double area_cap, double floor, double min_distance,
-            bool log_area, const PyMapState& trials, View1<double> out) {
-            env::checked::simulate_potentials(
-                maps.views, row, params, {start, landmarks, headings, distances},
-                {area_cap, floor, min_distance, log_area}, trials.views, out);
-        },
-        "maps"_a, "row"_a, "params"_a, "start"_a, "landmarks"_a, "headings"_a, "distances"_a,
-        "area_cap"_a, "floor"_a, "min_distance"_a, "log_area"_a, "trials"_a, "out"_a,
+        m, "_simulate_potentials", &env::checked::simulate_potentials, "maps"_a, "row"_a,
+        "params"_a, "start"_a, "landmarks"_a, "headings"_a, "distances"_a, "min_distance"_a,
+        "area_cap"_a, "floor"_a, "log_area"_a, "trials"_a, "out"_a,
         "The potential after each candidate move, simulated on copies of map row in trials' "
         "first maps (agents/planning.py's simulate_potentials without a sensor).");
     def_released(
-        m, "_score_readings",
-        +[](const PyMapState& maps, int64_t row, const slam::Params& params,
-            View1<const int64_t> moving, View2<const double> start, View2<const double> end,
-            double area_cap, double floor, bool log_area, const PyMapState& trials,
-            View1<double> out) {
-            env::checked::score_readings(maps.views, row, params, {moving, start, end},
-                                         {area_cap, floor, 0.0, log_area}, trials.views, out);
-        },
-        "maps"_a, "row"_a, "params"_a, "moving"_a, "start"_a, "end"_a, "area_cap"_a, "floor"_a,
-        "log_area"_a, "trials"_a, "out"_a,
+        m, "_score_readings", &env::checked::score_readings, "maps"_a, "row"_a, "params"_a,
+        "moving"_a, "start"_a, "end"_a, "area_cap"_a, "floor"_a, "log_area"_a, "trials"_a, "out"_a,
         "The potential after each candidate into out: moving[i] fused from readings start[i], "
         "end[i] into its own copy of map row (trials' map i); the others the map's own.");
     def_released(
-        m, "_score_rows",
-        +[](const PyMapState& maps, View1<const int64_t> rows, const slam::Params& params,
-            View2<const double> start, View2<const double> end, double area_cap, double floor,
-            bool log_area, const PyMapState& trials, View1<double> out, int64_t threads) {
-            env::checked::score_rows(maps.views, rows, params, start, end,
-                                     {area_cap, floor, 0.0, log_area}, trials.views, out, threads);
-        },
-        "maps"_a, "rows"_a, "params"_a, "start"_a, "end"_a, "area_cap"_a, "floor"_a, "log_area"_a,
-        "trials"_a, "out"_a, "threads"_a = 1,
+        m, "_score_rows", &env::checked::score_rows, "maps"_a, "rows"_a, "params"_a, "start"_a,
+        "end"_a, "area_cap"_a, "floor"_a, "log_area"_a, "trials"_a, "out"_a, "threads"_a = 1,
         "trials' map i: a copy of map rows[i] fused from readings start[i], end[i]; out[i] "
         "its potential (Lookahead's beam expansions).");
     def(m, "_move_ends", &env::checked::move_ends, "start"_a, "headings"_a, "distances"_a, "out"_a,

@@ -8,29 +8,32 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
-#include <vector>
 
 #include <bearing_core/slam/checked.hpp>
 #include <bearing_core/slam/robust.hpp>
 #include <bearing_core/slam/state.hpp>
 #include <bearing_core/slam/update.hpp>
-#include "bindings/args.hpp"
 #include "bindings/def.hpp"
-#include "bindings/structs.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
 
 namespace {
 
-using bearing::View1;
-using bearing::View2;
 using bearing::bindings::PyMapState;
 namespace checked = bearing::slam::checked;
 namespace slam = bearing::slam;
 
-// Whether no element of the float64 array `values` is +-inf: any strides (numba's
-// ravel() takes any layout), an odometer over the indices.
+// Whether no element of `array` from axis d on (at data) is +-inf: any strides (numba's
+// ravel() takes any layout).
+bool none_infinite_from(const nb::ndarray<nb::numpy, nb::ro>& array, const double* data, size_t d) {
+    if (d == array.ndim()) return !std::isinf(*data);
+    for (size_t k = 0; k < array.shape(d); ++k) {
+        if (!none_infinite_from(array, data + int64_t(k) * array.stride(d), d + 1)) return false;
+    }
+    return true;
+}
+
 bool none_infinite_binding(nb::handle values) {
     nb::ndarray<nb::numpy, nb::ro> array;  // read-only arrays too: it only reads them
     if (!nb::try_cast(values, array, false) || array.dtype() != nb::dtype<double>()) {
@@ -38,17 +41,7 @@ bool none_infinite_binding(nb::handle values) {
                                                   "float64, not ") +
                                       nb::type_name(values.type()).c_str());
     }
-    const auto* data = static_cast<const double*>(array.data());
-    std::vector<int64_t> index(array.ndim(), 0);
-    for (size_t k = 0; k < array.size(); ++k) {
-        int64_t offset = 0;
-        for (size_t d = 0; d < array.ndim(); ++d) offset += index[d] * array.stride(d);
-        if (std::isinf(data[offset])) return false;
-        for (size_t d = array.ndim(); d-- > 0 && ++index[d] == int64_t(array.shape(d));) {
-            index[d] = 0;
-        }
-    }
-    return true;
+    return none_infinite_from(array, static_cast<const double*>(array.data()), 0);
 }
 
 }  // namespace
@@ -63,7 +56,6 @@ void bind_slam_geometry(nb::module_& m);
 void bind_slam(nb::module_& m) {
     bind_slam_geometry(m);
     using namespace bearing::slam;
-    using bearing::cplx;
     using bearing::bindings::def;
     using bearing::bindings::def_released;
     BEARING_BINDINGS_ENUM(m, FrStatus, BEARING_CORE_FR_STATUS)
@@ -95,24 +87,11 @@ void bind_slam(nb::module_& m) {
              } BEARING_CORE_PARAMS(BEARING_BINDINGS_PARAM_ARG))
             BEARING_CORE_PARAMS(BEARING_BINDINGS_PARAM_READ);
 
-    def_released(
-        m, "update_maps",
-        +[](View2<const double> bearings_start, View2<const double> bearings_end,
-            View1<const int64_t> rows, const Params& params, const PyMapState& state, Outputs out,
-            int64_t threads) {
-            checked::update_maps(bearings_start, bearings_end, rows, params, state.views, out,
-                                 threads);
-        },
-        "bearings_start"_a, "bearings_end"_a, "rows"_a, "params"_a, "state"_a, "out"_a,
-        "threads"_a = 1,
-        "Fuse one movement into each map rows[i] (bearings row i), in place, reporting to "
-        "out (an Outputs); threads > 1 splits the rows into that many blocks.");
-    def(
-        m, "copy_maps",
-        +[](const PyMapState& from, View1<const int64_t> rows, const PyMapState& to) {
-            checked::copy_maps(from.views, rows, to.views);
-        },
-        "from_state"_a, "rows"_a, "to_state"_a,
+    def_released(m, "update_maps", &checked::update_maps, "bearings_start"_a, "bearings_end"_a,
+                 "rows"_a, "params"_a, "state"_a, "out"_a, "threads"_a = 1,
+                 "Fuse one movement into each map rows[i] (bearings row i), in place, reporting to "
+                 "out (an Outputs); threads > 1 splits the rows into that many blocks.");
+    def(m, "copy_maps", &checked::copy_maps, "from_state"_a, "rows"_a, "to_state"_a,
         "Map i of to_state becomes a copy of map rows[i] of from_state (rows may repeat; "
         "same landmarks and fusion arrays).");
     def(m, "check_indices", &checked::check_indices, "indices"_a, "size"_a, "distinct"_a,
@@ -122,20 +101,10 @@ void bind_slam(nb::module_& m) {
     def_released(m, "contains_points", &checked::contains_points, "vertices"_a, "counts"_a,
                  "rows"_a, "points"_a, "relative"_a, "out"_a,
                  "out[i, j]: region j of map rows[i] contains points[i, j].");
-    def(
-        m, "relaxed_region",
-        +[](const PyMapState& state, int64_t row, int64_t j, View1<const int64_t> slots,
-            bool use_base, int64_t max_outliers, View1<cplx> out) {
-            return checked::relaxed_region(state.views, row, j, slots, use_base, max_outliers, out);
-        },
-        "state"_a, "row"_a, "j"_a, "slots"_a, "use_base"_a, "max_outliers"_a, "out"_a,
+    def(m, "relaxed_region", &checked::relaxed_region, "state"_a, "row"_a, "j"_a, "slots"_a,
+        "use_base"_a, "max_outliers"_a, "out"_a,
         "(n, q): landmark j's q-relaxed region over the window slots, into out[:n].");
-    def(
-        m, "update_levels",
-        +[](const PyMapState& state, int64_t row, int64_t j, View1<const cplx> fresh) {
-            checked::update_levels(state.views, row, j, fresh);
-        },
-        "state"_a, "row"_a, "j"_a, "fresh"_a,
+    def(m, "update_levels", &checked::update_levels, "state"_a, "row"_a, "j"_a, "fresh"_a,
         "Fuse the region `fresh` into landmark j's robust levels of map `row`.");
     m.def("binomial_q", &binomial_q, "n"_a, "p"_a, "risk"_a, "q_cap"_a,
           "The smallest q (at most q_cap) with P(Bin(n, p) > q) < risk.");
@@ -151,26 +120,6 @@ void bind_slam(nb::module_& m) {
 
     // Constants the Python side reads.
 #define BEARING_BINDINGS_CONSTANT(name) m.attr(#name) = name;
-    BEARING_BINDINGS_CONSTANT(CAPACITY)
-    BEARING_BINDINGS_CONSTANT(MAX_EDGE_SAMPLES)
-    BEARING_BINDINGS_CONSTANT(FR_VERTICES)
-    BEARING_BINDINGS_CONSTANT(MAX_SAMPLES)
-    BEARING_BINDINGS_CONSTANT(MAX_PAIRS)
-    BEARING_BINDINGS_CONSTANT(SCRATCH)
-    BEARING_BINDINGS_CONSTANT(MAX_CLOUD)
-    BEARING_BINDINGS_CONSTANT(MAX_FR_EXTENT)
-    BEARING_BINDINGS_CONSTANT(RELATIVE_TOLERANCE)
-    BEARING_BINDINGS_CONSTANT(MAX_WINDOW)
-    BEARING_BINDINGS_CONSTANT(PARALLEL_MIN_MAPS)
-    BEARING_BINDINGS_CONSTANT(MAX_LANDMARKS)
-    BEARING_BINDINGS_CONSTANT(ROBUST_LEVELS)
-    BEARING_BINDINGS_CONSTANT(HISTORY)
-    BEARING_BINDINGS_CONSTANT(PROBE_SHRINK)
-    BEARING_BINDINGS_CONSTANT(BOUND_GROWTH)
-    BEARING_BINDINGS_CONSTANT(MAX_NOISE_SCALE)
-    BEARING_BINDINGS_CONSTANT(MAX_BOUND)
-    BEARING_BINDINGS_CONSTANT(PRIOR_CONTRADICTIONS)
-    BEARING_BINDINGS_CONSTANT(PRIOR_REGIONS)
-    BEARING_BINDINGS_CONSTANT(UNSEEN_FACTOR)
+    BEARING_CORE_SLAM_CONSTANTS(BEARING_BINDINGS_CONSTANT)
 #undef BEARING_BINDINGS_CONSTANT
 }

@@ -79,7 +79,7 @@ void simulate_potentials(const slam::MapState& maps, int64_t row, const slam::Pa
     const int64_t n = maps.counts.shape[1] + 2, count = candidates.headings.shape[0];
     std::vector<int64_t> moving;
     for (int64_t k = 0; k < count; ++k) {
-        if (candidates.distances[k] >= scoring.min_distance) moving.push_back(k);
+        if (candidates.distances[k] >= candidates.min_distance) moving.push_back(k);
     }
     const auto size = static_cast<int64_t>(moving.size());
     // The readings at both ends of each moving candidate (an unknown landmark is read at

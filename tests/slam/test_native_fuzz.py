@@ -1524,7 +1524,7 @@ def test_simulate_potentials_of_any_state(fusion: str, data: st.DataObject) -> N
         assert scores.size >= rows.size
     if completes(
         _core._simulate_potentials, maps, row, params_of(fusion), data.draw(hard_complexes),
-        landmarks, headings.astype(np.float64), distances.astype(np.float64), 4.0, 1e-3, 1e-9,
+        landmarks, headings.astype(np.float64), distances.astype(np.float64), 1e-9, 4.0, 1e-3,
         data.draw(st.booleans()), trials, out,
     ):  # fmt: skip
         assert out.size == count

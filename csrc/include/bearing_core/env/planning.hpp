@@ -22,20 +22,20 @@ void bearings_of(View1<const cplx> differences, View1<const double> headings, Vi
 
 // What simulate_potentials scores: candidate k turns to headings[k] and travels
 // distances[k] (FL units) from `start`; the map's landmarks are at `landmarks` (n, FL; NaN
-// where unknown: parallel readings, no region).
+// where unknown: parallel readings, no region). A candidate shorter than min_distance
+// does not update the map.
 struct Candidates {
     cplx start;
     View1<const cplx> landmarks;    // (n,) L1 = 0, L2 = 1 first
     View1<const double> headings;   // (K,)
     View1<const double> distances;  // (K,)
+    double min_distance = 0.0;
 };
 
-// How a simulated map is scored: the env's uncertainty potential, and the shortest move
-// that updates the map.
+// How a simulated map is scored: the env's uncertainty potential.
 struct Scoring {
     double area_cap = 0.0;
     double floor = 0.0;
-    double min_distance = 0.0;
     bool log_area = true;
 };
 

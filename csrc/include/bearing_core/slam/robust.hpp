@@ -30,6 +30,31 @@ inline constexpr double MAX_BOUND = 0.25 * PI;
 // Movements whose bearings each map keeps, to rebuild its regions at a new bound.
 inline constexpr int64_t HISTORY = 16;
 
+// The world model's constants by name, X(name) each (state.hpp's, scratch.hpp's and the
+// above), for a consumer that exports or prints them (the Python module reads them so).
+#define BEARING_CORE_SLAM_CONSTANTS(X) \
+    X(CAPACITY)                        \
+    X(MAX_EDGE_SAMPLES)                \
+    X(FR_VERTICES)                     \
+    X(MAX_SAMPLES)                     \
+    X(MAX_PAIRS)                       \
+    X(SCRATCH)                         \
+    X(MAX_CLOUD)                       \
+    X(MAX_FR_EXTENT)                   \
+    X(RELATIVE_TOLERANCE)              \
+    X(MAX_WINDOW)                      \
+    X(PARALLEL_MIN_MAPS)               \
+    X(MAX_LANDMARKS)                   \
+    X(ROBUST_LEVELS)                   \
+    X(HISTORY)                         \
+    X(PROBE_SHRINK)                    \
+    X(BOUND_GROWTH)                    \
+    X(MAX_NOISE_SCALE)                 \
+    X(MAX_BOUND)                       \
+    X(PRIOR_CONTRADICTIONS)            \
+    X(PRIOR_REGIONS)                   \
+    X(UNSEEN_FACTOR)
+
 // The smallest q (at most q_cap) with P(Bin(n, p) > q) < risk.
 int64_t binomial_q(int64_t n, double p, double risk, int64_t q_cap);
 // Map row's estimated share of contaminated regions.
