@@ -167,8 +167,9 @@ def functions_of(annotate: str, top: int) -> list[dict[str, Any]]:
     return functions
 
 
-#: nanobind's frames between the interpreter and a bound function.
-NANOBIND_WRAPPERS = ("nanobind::", "nb_func_", "func_create<")
+#: nanobind's frames between the interpreter and a bound function, and the bindings' own
+#: (``csrc/bindings``: argument parsing around each kernel).
+NANOBIND_WRAPPERS = ("nanobind::", "nb_func_", "func_create<", "bearing::bindings::")
 
 
 def _short_name(signature: str) -> str:
@@ -247,9 +248,14 @@ def markdown_callgrind(record: dict[str, Any]) -> str:
         + "; per Khepera env "
         f"step (native part, {step['count']} steps): {step['per_call']:,.0f}, of which:"
     )
-    names = [(entry["function"].rpartition("::")[2], entry) for entry in step["functions"][1:]]
-    # The update's per-row loop (update_rows, update_row) holds what update_maps holds.
-    parts = [(name, entry) for name, entry in names if not name.startswith("update_row")]
+    names = [(entry["function"].rpartition("::")[2], entry) for entry in step["functions"]]
+    # The entry point (its checked form and the kernel) holds every instruction, and the
+    # update's per-row loop (update_rows, update_row) holds what update_maps holds.
+    parts = [
+        (name, entry)
+        for name, entry in names
+        if name != "step_rows" and not name.startswith("update_row")
+    ]
     rows = [(f"`{name}`", f"{entry['share']:.0%}") for name, entry in parts[:PAGE_FUNCTIONS]]
     return sentence + "\n\n" + markdown_table(("function (inclusive)", "share of a step"), rows)
 
