@@ -168,8 +168,9 @@ def functions_of(annotate: str, top: int) -> list[dict[str, Any]]:
 
 
 #: nanobind's frames between the interpreter and a bound function, and the bindings' own
-#: (``csrc/bindings``: argument parsing around each kernel).
-NANOBIND_WRAPPERS = ("nanobind::", "nb_func_", "func_create<", "bearing::bindings::")
+#: (``csrc/bindings``: argument parsing around each kernel, the lambdas of the module's
+#: ``bind_*`` registration functions among them).
+NANOBIND_WRAPPERS = ("nanobind::", "nb_func_", "func_create<", "bearing::bindings::", "bind_")
 
 
 def _short_name(signature: str) -> str:
