@@ -66,6 +66,24 @@ def make_pair(
     return batched, reference
 
 
+def assert_pair_agrees(
+    batched: gym.vector.VectorEnv,
+    reference: gym.vector.VectorEnv,
+    seed: int,
+    steps: int,
+    action_seed: int | None = None,
+) -> None:
+    """``batched`` and ``reference`` give the same results, bit for bit, from a reset with
+    ``seed`` over ``steps`` steps of the same sampled actions; both are closed after."""
+    assert_same(batched.reset(seed=seed), reference.reset(seed=seed))
+    batched.action_space.seed(seed if action_seed is None else action_seed)
+    for _ in range(steps):
+        actions = batched.action_space.sample()
+        assert_same(batched.step(actions), reference.step(actions))
+    batched.close()
+    reference.close()
+
+
 @pytest.mark.parametrize("env_id", sorted(BASE_IDS.values()))
 def test_make_vec_returns_the_batched_env_with_the_spec_time_limit(env_id: str) -> None:
     env = gym.make_vec(env_id, num_envs=3, scenario="khepera")
