@@ -213,6 +213,7 @@ def test_the_batched_env_reproduces_single_envs(env_id: str) -> None:
     assert_pair_agrees(*make_pair(env_id, 4, AutoresetMode.NEXT_STEP, **kwargs), seed=2, steps=45)
 
 
+@needs("render")  # the checker renders every mode the metadata lists
 @pytest.mark.parametrize("observation", ["flat", "entities"])
 @pytest.mark.parametrize("env_id", [KHEPERA, RANDOM])
 def test_gymnasiums_checker_passes_without_warnings(env_id: str, observation: str) -> None:
