@@ -330,7 +330,9 @@ def check_indices(indices: object, size: int, distinct: bool) -> int:
     """
 
 def none_infinite(values: object) -> bool:
-    """Whether no element of a float64 array is +-inf (NaN allowed)."""
+    """
+    Whether no element of values (float64, 1-D: a C-contiguous array's reshape(-1)) is +-inf (NaN allowed).
+    """
 
 def contains_points(
     vertices: object, counts: object, rows: object, points: object, relative: float, out: object
@@ -592,7 +594,7 @@ def step_rows(
     threads: int,
     outputs: StepOutputs,
     with_map: bool,
-) -> int:
+) -> StepStatus:
     """
     One movement of every row of a group into outputs' first len(rows) rows (kernels.step_rows, or step_rows_bare without with_map); returns the status (STEP_DONE, or nothing done: STEP_NEEDS_NOISE, STEP_NEEDS_TRAJECTORY).
     """

@@ -470,7 +470,7 @@ def check_bearings(bearings: ArrayLike, shape: tuple[int, ...], name: str) -> Fl
         and bearings.dtype == np.float64
         and bearings.shape == shape
         and bearings.flags.c_contiguous
-        and kernels.none_infinite(bearings)
+        and kernels.none_infinite(bearings.reshape(-1))
     ):
         return bearings  # the common case, checked without temporaries
     raw = np.asarray(bearings)

@@ -1,15 +1,14 @@
 // Bindings of the env step (csrc/env/): EnvInputs (a group's long-lived inputs, made once
-// where core.py made kernels.inputs_ref), StepOutputs (a group's output arrays and per-call
-// buffers, made once where core._outputs made them), step_rows (the whole step, the GIL
+// where core.py made kernels.inputs_ref), StepOutputs (the library's, over a group's output
+// arrays, made once where core._outputs made them), step_rows (the whole step, the GIL
 // released) and the other kernels of bearing_env/envs/kernels.py, robot_map.py and
 // agents/planning.py with their Python names and return conventions.
 #include <nanobind/nanobind.h>
 #include <nanobind/stl/map.h>
 #include <nanobind/stl/string.h>
 
-#include <atomic>
-#include <limits>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -55,6 +54,34 @@ struct EnvInputs {
     }
 };
 
+// A group's step outputs (the library's StepOutputs) over Python's arrays: a Report's
+// (any number of rows) and the robot map's Encoded (None without it), kept alive with the
+// group's inputs.
+struct PyStepOutputs {
+    Kept kept;
+    env::checked::StepOutputs outputs;
+
+    PyStepOutputs(nb::handle inputs, nb::handle report, nb::handle encoded)
+        : outputs(inputs_of(inputs), read<env::Report>(report, "report"),
+                  encoded.is_none() ? std::nullopt
+                                    : std::optional(read<env::Encoded>(encoded, "encoded"))) {}
+
+    const env::Inputs& inputs_of(nb::handle obj) {
+        EnvInputs* inputs = nullptr;
+        if (!nb::try_cast(obj, inputs) || inputs == nullptr) {
+            type_error(std::string("inputs must be an EnvInputs, not ") +
+                       nb::type_name(obj.type()).c_str());
+        }
+        kept.push_back(nb::borrow(obj));
+        return inputs->inputs;
+    }
+    template <class Struct>
+    Struct read(nb::handle source, const char* label) {
+        schema::Sizes sizes = bindings::map_sizes();
+        return bindings::read_struct<Struct>(source, label, sizes, kept, false);
+    }
+};
+
 }  // namespace
 
 namespace bearing::bindings {
@@ -63,6 +90,12 @@ template <>
 struct Param<env::Inputs> {
     using Args = std::tuple<const EnvInputs&>;
     static const env::Inputs& from(Taken&, size_t, const EnvInputs& s) { return s.inputs; }
+};
+// A group's step outputs: a StepOutputs binding's.
+template <>
+struct Param<env::checked::StepOutputs&> {
+    using Args = std::tuple<PyStepOutputs&>;
+    static env::checked::StepOutputs& from(Taken&, size_t, PyStepOutputs& s) { return s.outputs; }
 };
 // The planners' structs, each from one Python argument per field.
 template <>
@@ -90,80 +123,20 @@ slam::MapState maps_of(nb::handle obj, schema::Sizes& sizes, Kept& kept) {
     return bindings::map_state_of(obj, sizes, kept);
 }
 
-// A group's step outputs: a Report's arrays and (optionally) the robot map's encoded
-// arrays, of `capacity` rows (a step of len(rows) <= capacity rows writes their first
-// len(rows) rows), and the step's per-call buffers, all made once.
-struct StepOutputs {
-    nb::object inputs_object;  // the EnvInputs these outputs were made for (kept alive)
-    const EnvInputs* inputs = nullptr;
-    env::Report report;
-    env::Encoded encoded;
-    bool with_map = false;
-    int64_t capacity = 0;
-    env::checked::OwnedStepBuffers buffers;
-    std::atomic<bool> busy{false};
-    Kept kept;
-
-    StepOutputs(nb::handle inputs_handle, nb::handle report_handle, nb::handle encoded_handle) {
-        if (!nb::try_cast(inputs_handle, inputs) || inputs == nullptr) {
-            type_error(std::string("inputs must be an EnvInputs, not ") +
-                       nb::type_name(inputs_handle.type()).c_str());
-        }
-        inputs_object = nb::borrow(inputs_handle);
-        const int64_t n = inputs->inputs.settings.n;
-        schema::Sizes sizes{{"m", n - 2}, {"obs", env::observation_size(inputs->inputs.settings)}};
-        report = bindings::read_struct<env::Report>(report_handle, "report", sizes, kept, false);
-        capacity = sizes.at("rows");
-        if (!encoded_handle.is_none()) {
-            schema::Sizes rows{{"CAPACITY", slam::CAPACITY}};
-            encoded =
-                bindings::read_struct<env::Encoded>(encoded_handle, "encoded", rows, kept, false);
-            env::checked::check_encoded(encoded, capacity, n - 2);
-            with_map = true;
-        }
-        buffers = env::checked::OwnedStepBuffers(capacity, n);
-    }
-};
-
-// A call that writes into outputs (step_rows, report_rows_into): outputs made for these
-// inputs, with the encoded arrays when with_map, and in use by this call alone (two
-// threads may not step one group at once).
-struct Writing {
-    std::atomic<bool>& busy;
-    Writing(const EnvInputs& inputs, StepOutputs& outputs, bool with_map) : busy(outputs.busy) {
-        require(outputs.inputs == &inputs,
-                "outputs were made for other inputs (StepOutputs(inputs, ...))");
-        require(!with_map || outputs.with_map,
-                "with_map needs outputs made with the encoded arrays");
-        if (busy.exchange(true)) {
-            throw std::runtime_error("these StepOutputs are in use by another thread");
-        }
-    }
-    ~Writing() { busy.store(false); }
-};
-
 // A codec's new arrays (encode_map's, encode_window's, encode_levels'): `rows` of the map
-// state `maps` (an EnvInputs or what map_state_of takes), `slots` landmark slots. Encoded's
-// padding: zeros, inf areas and inf + inf j centroids.
+// state `maps` (an EnvInputs or what map_state_of takes), `slots` landmark slots, padded.
 template <class Struct, void (*encode)(const slam::MapState&, View1<const int64_t>, const Struct&)>
 nb::tuple encode_new(nb::handle maps, nb::handle rows, int64_t slots) {
     Kept kept;
     schema::Sizes sizes;
     const slam::MapState state = maps_of(maps, sizes, kept);
     const auto r = view_of<const int64_t, 1>(rows, "rows");
-    slam::checked::check_rows(r, sizes.at("maps"), false);
-    require(slots >= sizes.at("m"), "slots (" + std::to_string(slots) +
-                                        ") must be at least the mapped landmarks (" +
-                                        std::to_string(sizes.at("m")) + ")");
+    env::checked::check_encoding(state, r, slots);
     sizes.bind("maps", r.shape[0], "rows");  // (found first: the new arrays' own axes)
     sizes.bind("m", slots, "slots");
     Struct out;
     nb::tuple arrays = bindings::new_struct(sizes, out);
-    if constexpr (std::is_same_v<Struct, env::Encoded>) {
-        const double inf = std::numeric_limits<double>::infinity();
-        std::fill_n(out.areas.data, out.areas.size(), inf);
-        std::fill_n(out.centroids.data, out.centroids.size(), cplx(inf, inf));
-    }
+    if constexpr (std::is_same_v<Struct, env::Encoded>) env::pad_encoded(out);
     nb::gil_scoped_release release;
     encode(state, r, out);
     return arrays;
@@ -228,32 +201,21 @@ void bind_env(nb::module_& m) {
             return env::observation_size(self.inputs.settings);
         });
 
-    nb::class_<StepOutputs>(m, "StepOutputs",
-                            "A group's step outputs, made once: a Report's arrays (any number "
-                            "of rows: a step writes the first len(rows)), the robot map's "
-                            "encoded arrays (encode_map's, complex views; None without the "
-                            "robot_map info) and the step's buffers.")
+    nb::class_<PyStepOutputs>(m, "StepOutputs",
+                              "A group's step outputs, made once: a Report's arrays (any number "
+                              "of rows: a step writes the first len(rows)), the robot map's "
+                              "encoded arrays (encode_map's, complex views; None without the "
+                              "robot_map info) and the step's buffers.")
         .def(nb::init<nb::handle, nb::handle, nb::handle>(), "inputs"_a, "report"_a,
              "encoded"_a = nb::none())
-        .def_prop_ro("capacity", [](const StepOutputs& self) { return self.capacity; })
-        .def_prop_ro("with_map", [](const StepOutputs& self) { return self.with_map; });
+        .def_prop_ro("capacity", [](const PyStepOutputs& self) { return self.outputs.capacity(); })
+        .def_prop_ro("with_map", [](const PyStepOutputs& self) { return self.outputs.with_map(); });
 
-    def_released(
-        m, "step_rows",
-        +[](View1<const int64_t> rows, View1<const double> turns, View1<const double> lengths,
-            EnvInputs& inputs, View3<double> trajectory, int64_t threads, StepOutputs& outputs,
-            bool with_map) {
-            Writing writing(inputs, outputs, with_map);
-            const env::Encoded* encoded = with_map ? &outputs.encoded : nullptr;
-            return static_cast<int64_t>(env::checked::step_rows(rows, turns, lengths, inputs.inputs,
-                                                                trajectory, threads, outputs.report,
-                                                                outputs.buffers.views(), encoded));
-        },
-        "rows"_a, "turns"_a, "lengths"_a, "inputs"_a, "trajectory"_a, "threads"_a, "outputs"_a,
-        "with_map"_a,
-        "One movement of every row of a group into outputs' first len(rows) rows "
-        "(kernels.step_rows, or step_rows_bare without with_map); returns the status "
-        "(STEP_DONE, or nothing done: STEP_NEEDS_NOISE, STEP_NEEDS_TRAJECTORY).");
+    def_released(m, "step_rows", &env::checked::step_into, "rows"_a, "turns"_a, "lengths"_a,
+                 "inputs"_a, "trajectory"_a, "threads"_a, "outputs"_a, "with_map"_a,
+                 "One movement of every row of a group into outputs' first len(rows) rows "
+                 "(kernels.step_rows, or step_rows_bare without with_map); returns the status "
+                 "(STEP_DONE, or nothing done: STEP_NEEDS_NOISE, STEP_NEEDS_TRAJECTORY).");
 
     m.def(
         "new_report",
@@ -265,16 +227,10 @@ void bind_env(nb::module_& m) {
                 report);
         },
         "size"_a, "inputs"_a, "A Report's arrays of size rows for the group of inputs, zeros.");
-    def_released(
-        m, "report_rows_into",
-        +[](View1<const int64_t> rows, EnvInputs& inputs, StepOutputs& outputs, bool with_map) {
-            Writing writing(inputs, outputs, with_map);
-            env::checked::report_rows(rows, inputs.inputs, outputs.report,
-                                      with_map ? &outputs.encoded : nullptr);
-        },
-        "rows"_a, "inputs"_a, "outputs"_a, "with_map"_a,
-        "report_rows into outputs' first len(rows) rows (a step's reused arrays, as step_rows "
-        "writes them): the rows' observations and infos as they stand.");
+    def_released(m, "report_rows_into", &env::checked::report_into, "rows"_a, "inputs"_a,
+                 "outputs"_a, "with_map"_a,
+                 "report_rows into outputs' first len(rows) rows (a step's reused arrays, as "
+                 "step_rows writes them): the rows' observations and infos as they stand.");
     def(m, "potentials", &env::checked::potentials, "rows"_a, "inputs"_a, "out"_a,
         "The uncertainty potential of each row's map into out.");
     def(m, "move_and_read", &env::checked::move_and_read, "row"_a, "turn"_a, "length"_a, "inputs"_a,

@@ -5,9 +5,7 @@
 #include <nanobind/nanobind.h>
 #include <nanobind/stl/string.h>
 
-#include <cmath>
 #include <cstdint>
-#include <string>
 
 #include <bearing_core/slam/checked.hpp>
 #include <bearing_core/slam/robust.hpp>
@@ -17,34 +15,9 @@
 
 namespace nb = nanobind;
 using namespace nb::literals;
-
-namespace {
-
 using bearing::bindings::PyMapState;
 namespace checked = bearing::slam::checked;
 namespace slam = bearing::slam;
-
-// Whether no element of `array` from axis d on (at data) is +-inf: any strides (numba's
-// ravel() takes any layout).
-bool none_infinite_from(const nb::ndarray<nb::numpy, nb::ro>& array, const double* data, size_t d) {
-    if (d == array.ndim()) return !std::isinf(*data);
-    for (size_t k = 0; k < array.shape(d); ++k) {
-        if (!none_infinite_from(array, data + int64_t(k) * array.stride(d), d + 1)) return false;
-    }
-    return true;
-}
-
-bool none_infinite_binding(nb::handle values) {
-    nb::ndarray<nb::numpy, nb::ro> array;  // read-only arrays too: it only reads them
-    if (!nb::try_cast(values, array, false) || array.dtype() != nb::dtype<double>()) {
-        bearing::bindings::type_error(std::string("values must be a numpy array of dtype "
-                                                  "float64, not ") +
-                                      nb::type_name(values.type()).c_str());
-    }
-    return none_infinite_from(array, static_cast<const double*>(array.data()), 0);
-}
-
-}  // namespace
 
 #define BEARING_BINDINGS_PARAM(T, name, value, doc) , T name
 #define BEARING_BINDINGS_PARAM_SET(T, name, value, doc) p.name = name;
@@ -96,8 +69,9 @@ void bind_slam(nb::module_& m) {
         "same landmarks and fusion arrays).");
     def(m, "check_indices", &checked::check_indices, "indices"_a, "size"_a, "distinct"_a,
         "INDEX_OK, INDEX_OUT_OF_RANGE or INDEX_REPEATED for int64 indices into [0, size).");
-    m.def("none_infinite", &none_infinite_binding, "values"_a,
-          "Whether no element of a float64 array is +-inf (NaN allowed).");
+    def(m, "none_infinite", &checked::none_infinite, "values"_a,
+        "Whether no element of values (float64, 1-D: a C-contiguous array's reshape(-1)) is "
+        "+-inf (NaN allowed).");
     def_released(m, "contains_points", &checked::contains_points, "vertices"_a, "counts"_a,
                  "rows"_a, "points"_a, "relative"_a, "out"_a,
                  "out[i, j]: region j of map rows[i] contains points[i, j].");

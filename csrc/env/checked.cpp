@@ -3,11 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <bearing_core/core/checks.hpp>
 #include <bearing_core/core/errors.hpp>
+#include <bearing_core/core/schema.hpp>
 #include <bearing_core/env/kernels.hpp>
 #include <bearing_core/env/robot_map.hpp>
 #include <bearing_core/slam/checked.hpp>
@@ -109,6 +111,61 @@ void check_encoded(const Encoded& encoded, int64_t rows, int64_t mapped) {
     }
 }
 
+StepOutputs::StepOutputs(const Inputs& inputs, const Report& report, std::optional<Encoded> encoded)
+    : inputs_(&inputs), report_(report), encoded_(std::move(encoded)) {
+    const int64_t n = inputs.settings.n;
+    schema::Sizes sizes{{"m", n - 2}, {"obs", observation_size(inputs.settings)}};
+    schema::check_shapes(report_, sizes, "report");
+    if (encoded_) {
+        schema::Sizes map_sizes{{"CAPACITY", slam::CAPACITY}};
+        schema::check_shapes(*encoded_, map_sizes, "encoded");
+        check_encoded(*encoded_, capacity(), n - 2);
+    }
+    buffers_ = OwnedStepBuffers(capacity(), n);
+}
+
+// A call that writes into outputs: made for these inputs, with the encoded arrays when
+// with_map, and in use by this call alone (two threads may not step one group at once).
+class Writing {
+public:
+    Writing(StepOutputs& outputs, const Inputs& inputs, bool with_map) : busy_(outputs.busy_) {
+        require(outputs.inputs_ == &inputs,
+                "outputs were made for other inputs (StepOutputs(inputs, ...))");
+        require(!with_map || outputs.with_map(),
+                "with_map needs outputs made with the encoded arrays");
+        if (busy_.exchange(true)) {
+            throw std::runtime_error("these StepOutputs are in use by another thread");
+        }
+        report = outputs.report_;
+        buffers = outputs.buffers_.views();
+        encoded = with_map ? &*outputs.encoded_ : nullptr;
+    }
+    ~Writing() { busy_.store(false); }
+    Writing(const Writing&) = delete;
+    Writing& operator=(const Writing&) = delete;
+
+    Report report;  // the outputs' arrays the call writes
+    StepBuffers buffers;
+    const Encoded* encoded = nullptr;  // (none without with_map)
+
+private:
+    std::atomic<bool>& busy_;
+};
+
+StepStatus step_into(View1<const int64_t> rows, View1<const double> turns,
+                     View1<const double> lengths, const Inputs& inputs, View3<double> trajectory,
+                     int64_t threads, StepOutputs& outputs, bool with_map) {
+    const Writing writing(outputs, inputs, with_map);
+    return checked::step_rows(rows, turns, lengths, inputs, trajectory, threads, writing.report,
+                              writing.buffers, writing.encoded);
+}
+
+void report_into(View1<const int64_t> rows, const Inputs& inputs, StepOutputs& outputs,
+                 bool with_map) {
+    const Writing writing(outputs, inputs, with_map);
+    checked::report_rows(rows, inputs, writing.report, writing.encoded);
+}
+
 StepStatus step_rows(View1<const int64_t> rows, View1<const double> turns,
                      View1<const double> lengths, const Inputs& inputs, View3<double> trajectory,
                      int64_t threads, const Report& report, const StepBuffers& buffers,
@@ -136,6 +193,14 @@ void report_rows(View1<const int64_t> rows, const Inputs& inputs, const Report& 
     clear_report(views);
     observe(rows, inputs, views);
     if (encoded != nullptr) env::encode_map_into(inputs.maps, rows, encoded->first(rows.shape[0]));
+}
+
+void check_encoding(const slam::MapState& state, View1<const int64_t> rows, int64_t slots) {
+    slam::checked::check_rows(rows, state.vertices.shape[0], false);
+    const int64_t mapped = state.vertices.shape[1];
+    require(slots >= mapped, "slots (" + std::to_string(slots) +
+                                 ") must be at least the mapped landmarks (" +
+                                 std::to_string(mapped) + ")");
 }
 
 void encode_map_into(const slam::MapState& state, View1<const int64_t> rows,

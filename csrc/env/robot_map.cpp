@@ -22,6 +22,12 @@ void copy_prefix(T* dst, int64_t dst_length, const T* src, int64_t src_length, i
 
 }  // namespace
 
+void pad_encoded(const Encoded& encoded) {
+    const double inf = std::numeric_limits<double>::infinity();
+    std::fill_n(encoded.areas.data, encoded.areas.size(), inf);
+    std::fill_n(encoded.centroids.data, encoded.centroids.size(), cplx(inf, inf));
+}
+
 void encode_map_into(const slam::MapState& state, View1<const int64_t> rows,
                      const Encoded& encoded) {
     const int64_t mapped = state.counts.shape[1];

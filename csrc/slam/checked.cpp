@@ -3,6 +3,7 @@
 #include <bearing_core/slam/checked.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <tuple>
@@ -345,6 +346,11 @@ void copy_maps(const MapState& from, View1<const int64_t> rows, const MapState& 
             "rows has " + std::to_string(rows.shape[0]) + " entries, more than to's " +
                 std::to_string(to.vertices.shape[0]) + " maps");
     slam::copy_maps(from, rows, to);
+}
+
+bool none_infinite(View1<const double> values) {
+    return std::none_of(values.data, values.data + values.size(),
+                        [](double value) { return std::isinf(value); });
 }
 
 int64_t check_indices(View1<const int64_t> indices, int64_t size, bool distinct) {

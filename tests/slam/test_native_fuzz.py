@@ -861,21 +861,22 @@ def test_check_indices_of_any_indices_and_size(
 
 @fuzz(
     shape=st.lists(st.integers(0, 4), max_size=3),
-    view=st.sampled_from(("contiguous", "strided", "transposed", "read_only")),
+    view=st.sampled_from(("contiguous", "strided", "read_only")),
     data=st.data(),
 )
 def test_none_infinite_of_any_float_array(shape: list[int], view: str, data: st.DataObject) -> None:
     values = np.random.default_rng(data.draw(SEEDS)).uniform(-1.0, 1.0, [2 * s for s in shape])
     corrupt(data.draw, values)
-    if view == "strided" and shape:
-        values = values[tuple(slice(None, None, 2) for _ in shape)]
-    elif view == "transposed":
-        values = values.T
+    flat = values.reshape(-1)  # (check_bearings' C-contiguous bearings, as it passes them)
+    if view == "strided":
+        flat = flat[::2]
+        if flat.size > 1:
+            with pytest.raises(ValueError, match="values must be C-contiguous"):
+                _core.none_infinite(flat)
+            return
     elif view == "read_only":
-        values.flags.writeable = False
-    # Any float64 array is taken, whatever its layout, read-only too (check_bearings
-    # passes the caller's arrays as they are).
-    assert result(_core.none_infinite, values) == (not np.any(np.isinf(values)))
+        flat.flags.writeable = False
+    assert result(_core.none_infinite, flat) == (not np.any(np.isinf(flat)))
 
 
 @fuzz(data=st.data())
@@ -1314,6 +1315,26 @@ def test_step_rows_of_any_state_and_actions(name: str, with_map: bool, data: st.
         assert not clean or finite(report[0][: rows.size])
 
 
+def test_step_outputs_belong_to_their_group_and_settings() -> None:
+    """StepOutputs are checked against the group they were made for: a report shaped for
+    other settings, another group's inputs and with_map without the encoded arrays are
+    refused, each with its reason."""
+    inputs, other = env_inputs(fresh("intersect")), env_inputs(fresh("intersect"))
+    every_row = np.arange(ENV_ROWS, dtype=np.int64)
+    report = _core.new_report(ENV_ROWS, inputs)
+    fewer_columns = tuple(np.ascontiguousarray(a[:, :-1]) if a.ndim == 2 else a for a in report)
+    with pytest.raises(ValueError, match=r"report\.observations has axis 1"):
+        _core.StepOutputs(inputs, fewer_columns)
+    outputs = _core.StepOutputs(inputs, report)
+    assert outputs.capacity == ENV_ROWS and not outputs.with_map
+    with pytest.raises(ValueError, match="outputs were made for other inputs"):
+        _core.report_rows_into(every_row, other, outputs, False)
+    with pytest.raises(ValueError, match="with_map needs outputs made with the encoded arrays"):
+        _core.report_rows_into(every_row, inputs, outputs, True)
+    _core.report_rows_into(every_row, inputs, outputs, False)
+    assert np.all(np.isfinite(report[0]))
+
+
 @fuzz(name=st.sampled_from(sorted(WORLDS)), data=st.data())
 def test_reports_and_potentials_of_any_state(name: str, data: st.DataObject) -> None:
     world = fresh(name)
@@ -1666,7 +1687,7 @@ def update_arguments(entry: str) -> dict[str, Any]:
             "to_state": _core.MapState(state_copy("robust")),
         },
         "check_indices": {"indices": rows, "size": 4, "distinct": True},
-        "none_infinite": {"values": start},
+        "none_infinite": {"values": start.reshape(-1)},
         "contains_points": {
             "vertices": state.vertices,
             "counts": state.counts,
@@ -1941,6 +1962,7 @@ BAD_ARGUMENTS: list[tuple[str, str, str, str, type[Exception], str]] = [
     ("update", "check_indices", "indices", "dtype", TypeError, "indices"),
     ("update", "check_indices", "indices", "ndim", ValueError, "indices"),
     ("update", "none_infinite", "values", "dtype", TypeError, "values"),
+    ("update", "none_infinite", "values", "strided", ValueError, "values"),
     ("update", "contains_points", "points", "short", ValueError, "points"),
     ("update", "contains_points", "counts", "dtype", TypeError, "counts"),
     ("update", "contains_points", "out", "read_only", ValueError, "out"),

@@ -141,6 +141,17 @@ inline std::string mismatch(std::string_view rule, const int64_t* shape, int ndi
     return {};
 }
 
+// Every array of the struct of arrays `s` follows its rule with `sizes`: otherwise
+// std::invalid_argument naming the first that does not (label.field).
+template <class Struct>
+void check_shapes(const Struct& s, Sizes& sizes, const std::string& label) {
+    for_each_field(s, [&](const char* name, const char* rule, const auto& view) {
+        const int ndim = static_cast<int>(view.shape.size());
+        const std::string why = mismatch(rule, view.shape.data(), ndim, label + "." + name, sizes);
+        if (!why.empty()) throw std::invalid_argument(why);
+    });
+}
+
 // The shape `rule` gives (`_` is 0), every name known: std::invalid_argument otherwise.
 inline std::vector<int64_t> shape_of(std::string_view rule, const Sizes& sizes) {
     std::vector<int64_t> shape;

@@ -4,7 +4,9 @@
 // throws std::invalid_argument naming it (the Python bindings are these).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <bearing_core/core/complex.hpp>
@@ -37,6 +39,33 @@ private:
 // The encoded arrays of `rows` maps hold every one of `mapped` landmarks.
 void check_encoded(const Encoded& encoded, int64_t rows, int64_t mapped);
 
+// A group's step outputs, made once for its inputs: a Report's views of `capacity` rows
+// (shaped for the settings' landmarks and observation), the robot map's encoded views
+// (optional) and the step's buffers (owned). step_into and report_into write their first
+// len(rows) rows, one call at a time: a second thread's call throws std::runtime_error.
+class StepOutputs {
+public:
+    StepOutputs(const Inputs& inputs, const Report& report, std::optional<Encoded> encoded);
+    int64_t capacity() const { return report_.rewards.shape[0]; }
+    bool with_map() const { return encoded_.has_value(); }
+
+private:
+    friend class Writing;
+    const Inputs* inputs_;
+    Report report_;
+    std::optional<Encoded> encoded_;
+    OwnedStepBuffers buffers_;
+    std::atomic<bool> busy_{false};
+};
+
+// step_rows into outputs made for `inputs` (with the encoded arrays when with_map).
+StepStatus step_into(View1<const int64_t> rows, View1<const double> turns,
+                     View1<const double> lengths, const Inputs& inputs, View3<double> trajectory,
+                     int64_t threads, StepOutputs& outputs, bool with_map);
+// report_rows into outputs made for `inputs`, as step_into writes them.
+void report_into(View1<const int64_t> rows, const Inputs& inputs, StepOutputs& outputs,
+                 bool with_map);
+
 // step_rows (kernels.hpp) with its arguments checked: the rows (none repeated) in the
 // state and within the report's and the buffers' rows, the actions, the trajectory and
 // the rows' cursors.
@@ -48,6 +77,9 @@ StepStatus step_rows(View1<const int64_t> rows, View1<const double> turns,
 // null) first len(rows) rows (kernels.report_rows).
 void report_rows(View1<const int64_t> rows, const Inputs& inputs, const Report& report,
                  const Encoded* encoded);
+// A codec's new arrays can take `rows` of `state` in `slots` landmark slots: the rows are
+// in the state, the slots at least its mapped landmarks.
+void check_encoding(const slam::MapState& state, View1<const int64_t> rows, int64_t slots);
 // encode_map_into (robot_map.hpp) with `rows` in the state and encoded's rows and slots
 // checked.
 void encode_map_into(const slam::MapState& state, View1<const int64_t> rows,

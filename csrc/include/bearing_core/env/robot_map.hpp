@@ -24,6 +24,10 @@ inline int64_t slice_stop(int64_t count, int64_t length) {
     return count < length ? count : length;
 }
 
+// Encoded's padding over the whole of `encoded` (new arrays, before encode_map_into):
+// inf areas and inf + inf j centroids, the other arrays' padding left as it is (zeros).
+void pad_encoded(const Encoded& encoded);
+
 // encode_map_into: the arrays every fusion uses, for rows, into `encoded` (its padding
 // kept: only the mapped slots are written).
 void encode_map_into(const slam::MapState& state, View1<const int64_t> rows,

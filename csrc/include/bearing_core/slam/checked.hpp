@@ -79,6 +79,8 @@ void copy_maps(const MapState& from, View1<const int64_t> rows, const MapState& 
 // check_indices (update.hpp) of any size: its table of seen indices is as long as the
 // largest index given needs, not `size`.
 int64_t check_indices(View1<const int64_t> indices, int64_t size, bool distinct);
+// Whether no value is +-inf (NaN allowed: a missed reading).
+bool none_infinite(View1<const double> values);
 void contains_points(View3<const cplx> vertices, View2<const int64_t> counts,
                      View1<const int64_t> rows, View2<const cplx> points, double relative,
                      View2<bool> out);
