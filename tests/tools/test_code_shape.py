@@ -12,6 +12,7 @@ import pytest
 from tests.tools.code_shape import (
     MAX_FUNCTION_LINES,
     MAX_PUBLIC_PARAMETERS,
+    ROOT,
     function_shapes,
     project_shapes,
     too_long,
@@ -19,6 +20,8 @@ from tests.tools.code_shape import (
 )
 from tests.tools.cpp_shape import (
     ALLOWED_LONG,
+    BINDINGS_FOLDER,
+    MAX_BINDINGS_LINES,
     cpp_functions,
     project_cpp_functions,
     too_long_cpp,
@@ -78,6 +81,12 @@ def test_no_cpp_function_outside_the_allowances_is_longer_than_80_lines() -> Non
         if f.key not in ALLOWED_LONG
     ]
     assert long_ones == [], f"C++ over {MAX_FUNCTION_LINES} lines (split, or allow): {long_ones}"
+
+
+def test_the_bindings_stay_thin() -> None:
+    files = sorted((ROOT / BINDINGS_FOLDER).iterdir())
+    lines = {f.name: len(f.read_text().splitlines()) for f in files}
+    assert files and sum(lines.values()) <= MAX_BINDINGS_LINES, lines
 
 
 def test_the_cpp_allowances_are_still_needed() -> None:
