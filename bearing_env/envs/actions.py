@@ -29,6 +29,8 @@ from bearing_env.numerics import wrap, wrap_angle
 from bearing_env.validation import is_real
 
 FloatArray = NDArray[np.float64]
+#: The action dtypes the native decoder takes (C-contiguous): others are cast first.
+_DECODED_DTYPES = (np.dtype(np.float32), np.dtype(np.float64))
 
 
 def real_values(actions: Any, what: str) -> NDArray[Any]:
@@ -69,16 +71,22 @@ class ContinuousActions:
 
     def decode(self, config: EnvConfig, actions: Any) -> tuple[FloatArray, FloatArray]:
         """(turn angles, move lengths) of actions (N, 2) in [-1, 1]^2."""
-        values = real_values(actions, "actions")
+        values = actions
+        if not (  # the common case, an array the native decoder takes as it is
+            type(values) is np.ndarray
+            and values.dtype in _DECODED_DTYPES
+            and values.flags.c_contiguous
+        ):
+            values = real_values(actions, "actions")
+            if values.dtype not in _DECODED_DTYPES:
+                # float16, longdouble and integer actions: the native decoder takes float32
+                # or float64 only. Cast; the range check follows.
+                values = values.astype(np.float64)
+            values = np.ascontiguousarray(values)
         if values.ndim != 2 or values.shape[1] != 2:
             raise ValueError(f"actions must have shape (N, 2), got shape {values.shape}")
-        if values.dtype != np.float32 and values.dtype != np.float64:
-            # float16, longdouble and integer actions: the native decoder takes float32 or
-            # float64 only. Cast; the range check follows.
-            values = values.astype(np.float64)
         turns, lengths = np.empty(values.shape[0]), np.empty(values.shape[0])
         lo, hi = config.actions.move_length
-        values = np.ascontiguousarray(values)  # the native decoder takes C-contiguous arrays
         outcome = _core.decode_continuous(values, lo, hi, turns, lengths)
         if outcome == kernels.ACTIONS_NOT_FINITE:
             raise ValueError(f"actions must be finite, got {actions!r}")

@@ -509,7 +509,9 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
         report, robot_map_info = core.report(self._state, group)
         if self.render_mode == "human":
             self.render()
-        info = core.single_info(report, robot_map_info, core.sensor_info(self._state, group))
+        info = core.single_info(
+            group, report, robot_map_info, core.sensor_info(self._state, group)
+        )
         return self._observation(report.observations[0].copy()), info  # a step reuses it
 
     def step(
@@ -531,7 +533,7 @@ class BearingSLAMEnv(gym.Env[NDArray[np.float32], NDArray[np.float32]]):
             report.rewards.item(),
             report.terminated.item(),
             report.truncated.item(),
-            core.single_info(report, robot_map_info, core.sensor_info(self._state, group)),
+            core.single_info(group, report, robot_map_info, core.sensor_info(self._state, group)),
         )
 
     def _observation(self, flat: NDArray[np.float32]) -> Any:

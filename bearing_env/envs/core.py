@@ -618,6 +618,23 @@ def potentials(state: BatchState, group: Group) -> FloatArray:
     return out
 
 
+#: The info's entries from a step's report, in order: the name, and whether it is an
+#: array per row (per landmark) rather than one value per row. The reward's parts follow,
+#: under ``"rewards"`` (see the env's Info section).
+INFO_FIELDS: tuple[tuple[str, bool], ...] = (
+    ("landmark_area", True),
+    ("landmark_error", True),
+    ("landmark_contains_truth", True),
+    ("total_area", False),
+    ("robot_error", False),
+    ("frame_changed", False),
+    ("inconsistent", False),
+    ("outliers", True),
+    ("path_length", False),
+)
+REWARD_PARTS: tuple[str, ...] = ("uncertainty", "path_cost", "move_cost")
+
+
 def infos(
     report: kernels.Report,
     robot_map_info: dict[str, Any] | None,
@@ -626,22 +643,8 @@ def infos(
     """The group's infos, batched along a first axis (see the env's Info section): copies
     of the report's arrays (the step reuses them), ``robot_map`` unless it is None (the
     setting off), and the :func:`sensor_info` entries unless they are None."""
-    infos: dict[str, Any] = {
-        "landmark_area": report.landmark_area.copy(),
-        "landmark_error": report.landmark_error.copy(),
-        "landmark_contains_truth": report.landmark_contains_truth.copy(),
-        "total_area": report.total_area.copy(),
-        "robot_error": report.robot_error.copy(),
-        "frame_changed": report.frame_changed.copy(),
-        "inconsistent": report.inconsistent.copy(),
-        "outliers": report.outliers.copy(),
-        "path_length": report.path_length.copy(),
-        "rewards": {
-            "uncertainty": report.uncertainty.copy(),
-            "path_cost": report.path_cost.copy(),
-            "move_cost": report.move_cost.copy(),
-        },
-    }
+    infos: dict[str, Any] = {name: getattr(report, name).copy() for name, _ in INFO_FIELDS}
+    infos["rewards"] = {name: getattr(report, name).copy() for name in REWARD_PARTS}
     if robot_map_info is not None:
         infos[robot_map.KEY] = {key: value.copy() for key, value in robot_map_info.items()}
     if sensor is not None:
@@ -662,34 +665,56 @@ def sensor_info(state: BatchState, group: Group) -> dict[str, Any] | None:
     }
 
 
+class _FirstRow(NamedTuple):
+    """A group of one row's reused arrays (its report, and its robot map's encoded arrays
+    unless None) as views of their first row, made once: a step's info then copies each
+    per-landmark view once and reads each value once (:func:`single_info`)."""
+
+    report: kernels.Report  #: the report these are views of
+    info: tuple[tuple[str, NDArray[Any], bool], ...]  #: (name, view, copied) per INFO_FIELDS
+    rewards: tuple[tuple[str, NDArray[Any]], ...]
+    encoded: tuple[tuple[str, NDArray[Any], bool], ...]  #: the robot map's, as its info
+
+    @classmethod
+    def of(cls, report: kernels.Report, encoded: robot_map.Buffers | None) -> _FirstRow:
+        def first_row(values: NDArray[Any]) -> tuple[NDArray[Any], bool]:
+            return (values[0], True) if values.ndim > 1 else (values, False)
+
+        info = tuple((name, *first_row(getattr(report, name))) for name, _ in INFO_FIELDS)
+        rewards = tuple((name, getattr(report, name)) for name in REWARD_PARTS)
+        arrays = {} if encoded is None else encoded.info
+        return cls(report, info, rewards, tuple((k, *first_row(v)) for k, v in arrays.items()))
+
+
 def single_info(
+    group: Group,
     report: kernels.Report,
     robot_map_info: dict[str, Any] | None,
     sensor: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The info of a group of one row (the single env): Python scalars and copies of the
-    per-landmark arrays (the step reuses its report)."""
+    per-landmark arrays (the step reuses its report and encoded arrays), through views of
+    their first row made once per group (:class:`_FirstRow`)."""
+    first = group.reused.get(_FIRST_ROW)
+    if first is None or first.report is not report:
+        _, encoded, _ = group.reused[_OUTPUTS]
+        first = group.reused[_FIRST_ROW] = _FirstRow.of(report, encoded)
     info: dict[str, Any] = {
-        "landmark_area": report.landmark_area[0].copy(),
-        "landmark_error": report.landmark_error[0].copy(),
-        "landmark_contains_truth": report.landmark_contains_truth[0].copy(),
-        "total_area": report.total_area.item(),
-        "robot_error": report.robot_error.item(),
-        "frame_changed": report.frame_changed.item(),
-        "inconsistent": report.inconsistent.item(),
-        "outliers": report.outliers[0].copy(),
-        "path_length": report.path_length.item(),
-        "rewards": {
-            "uncertainty": report.uncertainty.item(),
-            "path_cost": report.path_cost.item(),
-            "move_cost": report.move_cost.item(),
-        },
+        name: view.copy() if copied else view.item() for name, view, copied in first.info
     }
+    info["rewards"] = {name: view.item() for name, view in first.rewards}
     if robot_map_info is not None:
-        info[robot_map.KEY] = {
-            key: value[0].copy() if value.ndim > 1 else value.item()
-            for key, value in robot_map_info.items()
+        info[robot_map.KEY] = entries = {
+            key: view.copy() if copied else view.item() for key, view, copied in first.encoded
         }
+        if len(robot_map_info) > len(entries):  # the relaxed or robust fusion's own arrays,
+            for key, value in robot_map_info.items():  # new every step: no copy needed
+                if key not in entries:
+                    entries[key] = value[0] if value.ndim > 1 else value.item()
     if sensor is not None:
         info["seen"], info["blocked"] = sensor["seen"][0], bool(sensor["blocked"][0])
     return info
+
+
+#: The key of a group of one row's :class:`_FirstRow` in :attr:`Group.reused`.
+_FIRST_ROW = "first row"

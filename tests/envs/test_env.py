@@ -314,6 +314,37 @@ def test_info_keys_and_shapes() -> None:
         assert np.array_equal(np.isinf(info["landmark_area"]), np.isinf(info["landmark_error"]))
 
 
+@pytest.mark.parametrize("fusion", ["intersect", "relaxed", "robust"])
+def test_a_kept_observation_and_info_stay_as_they_were(fusion: str) -> None:
+    # The step reuses its output arrays: what it hands out must be the caller's own, so
+    # later steps and resets leave a kept observation and info as they were.
+    env = BearingSLAMEnv(scenario="khepera", fusion=fusion, sensor_info=True)
+    env.action_space.seed(1)
+    kept = [env.reset(seed=1)]
+    for _ in range(12):
+        observation, _, terminated, truncated, info = env.step(env.action_space.sample())
+        kept.append((observation, info))
+        if terminated or truncated:
+            kept.append(env.reset())
+    snapshots = [pickle.loads(pickle.dumps(item)) for item in kept]
+    for _ in range(12):
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if terminated or truncated:
+            env.reset()
+    changed = [k for k, (a, b) in enumerate(zip(kept, snapshots, strict=True)) if not same(a, b)]
+    assert changed == []
+    assert len({id(info["robot_map"]["vertices"]) for _, info in kept}) == len(kept)
+
+
+def same(a: Any, b: Any) -> bool:
+    """Whether two observations, infos or (observation, info) pairs are equal, bit for bit."""
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(same(a[key], b[key]) for key in a)
+    if isinstance(a, tuple):
+        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b, strict=True))
+    return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True)
+
+
 def test_observation_layout_and_padding() -> None:
     env = BearingSLAMEnv(scenario="khepera", max_landmarks=6)
     assert env.observation_space.shape == (observation_size(6),) == (9 + 5 * 4 + 3 * 6,)
