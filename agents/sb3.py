@@ -287,6 +287,47 @@ def space_summary(space: spaces.Space[Any]) -> str:
     return type(space).__name__
 
 
+def _greedy_actor(model: Any) -> Any:
+    """``model.predict(obs, deterministic=True)`` for one Box observation, as a function,
+    when the model is a plain actor-critic (PPO's, A2C's ``MlpPolicy``) with a categorical
+    or unsquashed Gaussian head; None otherwise. It runs SB3's very operations (features,
+    actor network, action head; the categorical mode as the argmax of the normalised
+    probabilities; the Gaussian mode clipped to the space) without ``predict``'s batching,
+    checks and distribution objects, which cost about half a move's decision time."""
+    import torch
+    from stable_baselines3.common.distributions import (
+        CategoricalDistribution,
+        DiagGaussianDistribution,
+    )
+    from stable_baselines3.common.policies import ActorCriticPolicy, BaseModel
+
+    policy = model.policy
+    head = getattr(policy, "action_dist", None)
+    if type(policy) is not ActorCriticPolicy or policy.squash_output:
+        return None
+    if not isinstance(policy.observation_space, spaces.Box):
+        return None
+    categorical = type(head) is CategoricalDistribution
+    if not categorical and type(head) is not DiagGaussianDistribution:
+        return None
+    policy.set_training_mode(False)
+    space = model.action_space
+
+    def greedy(obs: NDArray[np.float32]) -> Action:
+        with torch.no_grad():
+            tensor = torch.as_tensor(obs[None], device=policy.device)
+            # (BaseModel's, as get_distribution calls it: the actor's features alone)
+            features = BaseModel.extract_features(policy, tensor, policy.pi_features_extractor)
+            output = policy.action_net(policy.mlp_extractor.forward_actor(features))
+            if categorical:  # torch's Categorical: probs = softmax(logits - logsumexp)
+                logits = output - output.logsumexp(dim=-1, keepdim=True)
+                return int(torch.softmax(logits, dim=-1).argmax(dim=1)[0])
+        mean = output.cpu().numpy().reshape(space.shape)
+        return np.clip(mean, space.low, space.high).astype(np.float32).reshape(-1)
+
+    return greedy
+
+
 class SB3Policy:
     """A saved stable-baselines3 model, acting greedily (``deterministic=True``) by default.
 
@@ -346,6 +387,7 @@ class SB3Policy:
         self.deterministic = bool(deterministic)
         self.discrete = isinstance(self.model.action_space, spaces.Discrete)
         self.name = name or f"sb3_{self.algo.lower()}_{self.model_path.stem}"
+        self._greedy = _greedy_actor(self.model) if self.deterministic else None
 
     def check_env(self, env: gym.Env) -> None:
         """Refuse an env the model cannot act in: another task than its recorded one
@@ -435,6 +477,8 @@ class SB3Policy:
             obs = np.asarray(observation, dtype=np.float32)
         if self.obs_normalizer is not None:
             obs = self.obs_normalizer.normalize_obs(obs)
+        if self._greedy is not None and isinstance(obs, np.ndarray):
+            return self._greedy(obs)
         action, _ = self.model.predict(obs, deterministic=self.deterministic)
         if self.discrete:
             return int(np.asarray(action).reshape(-1)[0])

@@ -527,6 +527,33 @@ def test_sb3_policy_runs_a_dqn_on_the_discrete_id(tiny_dqn: Path) -> None:
 
 
 @needs("train")
+@pytest.mark.parametrize("env_id", ["BearingSLAM-v1", "BearingSLAMDiscrete-v1"])
+def test_the_greedy_path_acts_as_sb3_predict(env_id: str, tmp_path: Path) -> None:
+    # SB3Policy's greedy actor-critic path runs SB3's own operations without predict's
+    # machinery: the same action on every observation, inside the space and far outside.
+    import torch
+    from stable_baselines3 import PPO
+
+    env = gym.make(env_id, scenario="khepera", max_moves=5, max_episode_steps=5)
+    model = PPO("MlpPolicy", env, seed=3, device="cpu", policy_kwargs={"net_arch": [16]})
+    with torch.no_grad():  # outputs well outside [-1, 1], so that predict's clip matters
+        model.policy.action_net.weight.mul_(50.0)
+    model.save(tmp_path / "model.zip")
+    policy = SB3Policy(env, tmp_path / "model.zip")
+    assert policy._greedy is not None
+    rng = np.random.default_rng(0)
+    shape = env.observation_space.shape
+    for scale in (0.1, 1.0, 100.0):
+        for _ in range(50):
+            observation = rng.normal(0.0, scale, shape).astype(np.float32)
+            expected, _ = model.predict(observation, deterministic=True)
+            action = policy.act(observation, {})
+            assert np.array_equal(np.asarray(action).reshape(-1), np.asarray(expected).reshape(-1))
+            assert env.action_space.contains(action)
+    assert SB3Policy(env, tmp_path / "model.zip", deterministic=False)._greedy is None
+
+
+@needs("train")
 def test_sb3_policy_load_errors(tiny_ppo: Path, tmp_path: Path) -> None:
     env = gym.make("BearingSLAM-v1", scenario="khepera")
     with pytest.raises(FileNotFoundError, match="not found"):
