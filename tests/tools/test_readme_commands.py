@@ -182,6 +182,11 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--out outputs/evaluate_ppo_planner_scorer": ("parse", ()),
     "bearing-env evaluate runs/ppo_planner_bc_khepera --name ppo_planner_bc "
     "--out outputs/evaluate_ppo_planner_bc": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAMDiscrete-Khepera-Planner-v1 --init-from "
+    "runs/bc_khepera/model.zip --seeds 0 1 2 --workers 2 --timesteps 1000000 --eval-freq 250000 "
+    "--output runs/ppo_planner_bc_khepera_1m": ("parse", ()),
+    "bearing-env evaluate runs/ppo_planner_bc_khepera_1m --name ppo_planner_bc_1m "
+    "--out outputs/evaluate_ppo_planner_bc_1m": ("parse", ()),
     "bearing-env distill": ("help", ()),
     "bearing-env distill --student pretrained:ppo_khepera --teacher lookahead_oracle "
     "--iterations 4 --episodes 50 --output runs/distill_khepera": ("parse", ()),
