@@ -15,6 +15,7 @@ relative to the heading) and a length (metres).
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any, ClassVar
 
@@ -45,6 +46,18 @@ def real_values(actions: Any, what: str) -> NDArray[Any]:
     elif values.dtype.kind not in "iuf":
         raise ValueError(f"{what} must be real numbers, got {actions!r} (dtype {values.dtype})")
     return values
+
+
+@functools.lru_cache(maxsize=64)
+def grid_tables(
+    n_turns: int, n_move_lengths: int, lo: float, hi: float
+) -> tuple[FloatArray, FloatArray]:
+    """A discrete grid's (turn angles, move lengths), read-only: ``n_turns`` evenly spaced
+    turns from 0 (wrapped to [-pi, pi)) and ``n_move_lengths`` lengths from lo to hi."""
+    turns = wrap_angle(2.0 * math.pi * np.arange(n_turns) / n_turns)
+    lengths = np.linspace(lo, hi, n_move_lengths)
+    turns.flags.writeable = lengths.flags.writeable = False
+    return turns, lengths
 
 
 class ContinuousActions:
@@ -114,11 +127,11 @@ class DiscreteActions:
         return spaces.Discrete(config.actions.n_turns * config.actions.n_move_lengths)
 
     def tables(self, config: EnvConfig) -> tuple[FloatArray, FloatArray]:
-        """The grid: (turn angles (n_turns,), move lengths (n_move_lengths,))."""
+        """The grid: (turn angles (n_turns,), move lengths (n_move_lengths,)), read-only
+        (made once per grid: every step decodes through them)."""
         grid = config.actions
         lo, hi = grid.move_length
-        turns = wrap_angle(2.0 * math.pi * np.arange(grid.n_turns) / grid.n_turns)
-        return turns, np.linspace(lo, hi, grid.n_move_lengths)
+        return grid_tables(grid.n_turns, grid.n_move_lengths, float(lo), float(hi))
 
     def check_one(self, config: EnvConfig, action: Any) -> NDArray[Any]:
         """One action index as an array of shape () (ValueError otherwise)."""

@@ -28,6 +28,7 @@ truth: the map, the readings the robot took, and its commands.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import TYPE_CHECKING, Any
 
@@ -36,7 +37,7 @@ from numpy.typing import NDArray
 
 from bearing_env import _core
 from bearing_env.belief import bearings_from
-from bearing_env.envs.actions import DISCRETE
+from bearing_env.envs.actions import grid_tables
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig
 from bearing_env.slam import BatchedPolygonSLAM
 from bearing_env.slam import kernels as slam_kernels
@@ -57,9 +58,21 @@ BLOCKED_AHEAD = math.pi / 3
 
 def candidate_moves(config: EnvConfig) -> tuple[FloatArray, FloatArray]:
     """The candidates' (turns (K,), lengths (K,)): the discrete action grid's moves, in
-    its order (candidate ``k`` is action ``k``)."""
-    turns, lengths = DISCRETE.tables(config)
-    return np.repeat(turns, lengths.size), np.tile(lengths, turns.size)
+    its order (candidate ``k`` is action ``k``), read-only (made once per grid)."""
+    grid = config.actions
+    lo, hi = grid.move_length
+    return _grid_moves_of(grid.n_turns, grid.n_move_lengths, float(lo), float(hi))
+
+
+@functools.lru_cache(maxsize=64)
+def _grid_moves_of(
+    n_turns: int, n_move_lengths: int, lo: float, hi: float
+) -> tuple[FloatArray, FloatArray]:
+    turns, lengths = grid_tables(n_turns, n_move_lengths, lo, hi)
+    moves = np.repeat(turns, lengths.size), np.tile(lengths, turns.size)
+    for values in moves:
+        values.flags.writeable = False
+    return moves
 
 
 def candidate_count(config: EnvConfig) -> int:
