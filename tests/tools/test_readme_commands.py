@@ -187,6 +187,15 @@ CHECKS: dict[str, tuple[str, tuple[str, ...]]] = {
     "--output runs/ppo_planner_bc_khepera_1m": ("parse", ()),
     "bearing-env evaluate runs/ppo_planner_bc_khepera_1m --name ppo_planner_bc_1m "
     "--out outputs/evaluate_ppo_planner_bc_1m": ("parse", ()),
+    "bearing-env train --algo ppo --env BearingSLAMDiscrete-Random3to16-Planner-v1 --seeds 0 1 2 "
+    "--workers 2 --timesteps 500000 --eval-freq 250000 --output runs/ppo_planner_random": (
+        "parse",
+        (),
+    ),
+    "bearing-env evaluate runs/ppo_planner_random --name ppo_planner_random "
+    "--out outputs/evaluate_ppo_planner_random": ("parse", ()),
+    "bearing-env evaluate runs/ppo_planner_random/seed0 runs/ppo_planner_random_b "
+    "--name ppo_planner_random --out outputs/evaluate_ppo_planner_random": ("parse", ()),
     "bearing-env distill": ("help", ()),
     "bearing-env distill --student pretrained:ppo_khepera --teacher lookahead_oracle "
     "--iterations 4 --episodes 50 --output runs/distill_khepera": ("parse", ()),
