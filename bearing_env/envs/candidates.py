@@ -36,7 +36,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from bearing_env import _core
-from bearing_env.belief import bearings_from
 from bearing_env.envs.actions import grid_tables
 from bearing_env.envs.config import AREA_FLOOR, EnvConfig
 from bearing_env.slam import BatchedPolygonSLAM
@@ -156,20 +155,27 @@ def _predict(
     n, count = batch.n_landmarks, turns.size
     headings = heading[:, None] + turns[None, :]  # (R, K)
     ends = position[:, None] + lengths[None, :] / scale[:, None] * np.exp(1j * headings)
-    counts = batch.counts[rows]
-    mapped = np.where(counts > 0, batch.centroids[rows], complex(np.nan, np.nan))
-    frame = np.broadcast_to(np.array([0.0, 1.0], dtype=np.complex128), (rows.size, 2))
-    landmarks = np.concatenate([frame, mapped], axis=1)  # (R, n), FL
+    landmarks = np.empty((rows.size, n), dtype=np.complex128)  # (R, n), FL: L1, L2, the rest
+    landmarks[:, 0], landmarks[:, 1] = 0.0, 1.0
+    landmarks[:, 2:] = np.where(batch.counts[rows] > 0, batch.centroids[rows], np.nan + 0j)
     known = np.isfinite(landmarks)
-    targets = np.where(known, landmarks, 0.0)[:, None, :]  # (R, 1, n)
-    starts = np.broadcast_to(position[:, None], headings.shape)
-    b1 = bearings_from(starts, headings, targets)  # (R, K, n)
+    targets = np.where(known, landmarks, 0.0)
+    # Both readings' bearings in one native call: from the start (0) and the end (1).
+    places = np.empty((2, *headings.shape), dtype=np.complex128)
+    places[0], places[1] = position[:, None], ends
+    differences = targets[None, :, None, :] - places[..., None]  # (2, R, K, n)
+    angles = np.empty(differences.shape)
+    angles[...] = headings[None, :, :, None]
+    bearings = np.empty(differences.shape)
+    _core._bearings_of(differences.reshape(-1), angles.reshape(-1), bearings.reshape(-1))
+    b1 = bearings[0]
     # A landmark without a region gives no information: the same bearing at both ends.
-    b2 = np.where(known[:, None, :], bearings_from(ends, headings, targets), b1)
+    b2 = np.where(known[:, None, :], bearings[1], b1)
     sensor = config.sensor
     if sensor.half_fov < math.pi or math.isfinite(sensor.max_range):
-        b1 = _missed(b1, starts[:, :, None], targets, scale, sensor.half_fov, sensor.max_range)
-        b2 = _missed(b2, ends[:, :, None], targets, scale, sensor.half_fov, sensor.max_range)
+        limits = (scale, sensor.half_fov, sensor.max_range)
+        b1 = _missed(b1, places[0][:, :, None], targets[:, None, :], *limits)
+        b2 = _missed(b2, ends[:, :, None], targets[:, None, :], *limits)
     sees = np.isfinite(b1[:, :, :2]) & np.isfinite(b2[:, :, :2])
     after = np.repeat(before[:, None], count, axis=1)
     moving = np.flatnonzero(lengths >= config.layout.arena.min_baseline)
@@ -180,10 +186,11 @@ def _predict(
     if trials is None or not trials.same_settings(batch):
         trials = scratch["candidates", size] = batch.empty_like(size)
     potentials = np.empty(size)
+    if moving.size < count:
+        b1, b2 = b1[:, moving], b2[:, moving]
     _core._score_rows(
         batch._kernel_state(), np.repeat(rows, moving.size), batch._kernel_params(False),
-        np.ascontiguousarray(b1[:, moving].reshape(size, n)),
-        np.ascontiguousarray(b2[:, moving].reshape(size, n)),
+        np.ascontiguousarray(b1).reshape(size, n), np.ascontiguousarray(b2).reshape(size, n),
         float(config.task.area_cap), AREA_FLOOR, config.task.reward == "log_area",
         trials._kernel_state(), potentials,
         slam_kernels.threads() if size >= PARALLEL_MIN_MAPS else 1,

@@ -317,7 +317,9 @@ class BatchedPolygonSLAM(HasMapSettings, StateArrays):
 
     def same_settings(self, other: BatchedPolygonSLAM) -> bool:
         """Whether ``other`` was made with this batch's settings (its map count aside)."""
-        return self.n_landmarks == other.n_landmarks and self.settings == other.settings
+        return self.n_landmarks == other.n_landmarks and (
+            self.settings is other.settings or self.settings == other.settings
+        )
 
     def fill_from(self, source: BatchedPolygonSLAM, map_index: int) -> None:
         """Make every map of this batch a copy of ``source``'s map ``map_index`` (same
