@@ -50,6 +50,8 @@ from bearing_env.train.common.provenance import measured_here, measured_sentence
 
 #: The native entry point each measurement collects inside.
 ENTRY_POINTS = {"update": "bearing::slam::update_maps*", "step": "bearing::env::step_rows*"}
+#: The step's entry functions (each holds the whole step), left out of the page's table.
+ENTRY_NAMES = ("step_into", "step_rows")
 
 #: The workloads of the update counts: (key, what the page calls them), the first primary.
 UPDATE_WORKLOADS: tuple[tuple[str, str], ...] = (
@@ -250,12 +252,13 @@ def markdown_callgrind(record: dict[str, Any]) -> str:
         f"step (native part, {step['count']} steps): {step['per_call']:,.0f}, of which:"
     )
     names = [(entry["function"].rpartition("::")[2], entry) for entry in step["functions"]]
-    # The entry point (its checked form and the kernel) holds every instruction, and the
-    # update's per-row loop (update_rows, update_row) holds what update_maps holds.
+    # The entry point (its checked forms, step_into and step_rows, and the kernel) holds
+    # every instruction, and the update's per-row loop (update_rows, update_row) holds
+    # what update_maps holds.
     parts = [
         (name, entry)
         for name, entry in names
-        if name != "step_rows" and not name.startswith("update_row")
+        if name not in ENTRY_NAMES and not name.startswith("update_row")
     ]
     rows = [(f"`{name}`", f"{entry['share']:.0%}") for name, entry in parts[:PAGE_FUNCTIONS]]
     return sentence + "\n\n" + markdown_table(("function (inclusive)", "share of a step"), rows)
